@@ -1,0 +1,95 @@
+// In-memory form of the contract's data files (see shared/spec/interface.md):
+// endpoint runs (return errors only) and trajectory runs (encoder samples with
+// optional ground truth). Readers live in io/; this header only holds data.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/robot.hpp"
+#include "kinematics/pose2.hpp"
+
+namespace umbmark {
+
+/// One run of an endpoint CSV: the return error e = absolute - odometry
+/// (Borenstein & Feng eq. 3.1) in the run's start frame.
+struct EndpointRun {
+  std::string run;        ///< run id as written in the file
+  std::string direction;  ///< "cw", "ccw", or free text
+  double ex_m = 0.0;
+  double ey_m = 0.0;
+  std::optional<double> etheta_rad;  ///< empty cell -> not measured
+  std::size_t line = 0;              ///< 1-based source line (for messages)
+};
+
+/// One run of a trajectory CSV, samples in file order.
+struct TrajectoryRun {
+  std::string run;
+  std::string direction;
+  std::vector<double> t_s;
+  /// Cumulative wheel travel [m] for each sample. When the file gives ticks,
+  /// the reader leaves these empty and fills ticks_*; call
+  /// ComputeWheelTravel() (trajectory.hpp) to convert with a robot.
+  std::vector<double> dist_left_m, dist_right_m;
+  std::vector<std::int64_t> ticks_left, ticks_right;  ///< cumulative counts
+  /// Ground truth per sample; NaN where not measured.
+  std::vector<double> gt_x_m, gt_y_m, gt_theta_rad;
+  std::vector<std::size_t> lines;  ///< 1-based source line of each sample
+
+  bool has_ticks() const { return !ticks_left.empty(); }
+  std::size_t size() const { return t_s.size(); }
+  bool HasGroundTruth(std::size_t i) const {
+    return !std::isnan(gt_x_m[i]) && !std::isnan(gt_y_m[i]) && !std::isnan(gt_theta_rad[i]);
+  }
+  Pose2 GroundTruth(std::size_t i) const { return {gt_x_m[i], gt_y_m[i], gt_theta_rad[i]}; }
+};
+
+struct EndpointData {
+  std::string path;
+  std::vector<EndpointRun> runs;
+};
+
+struct TrajectoryData {
+  std::string path;
+  std::vector<TrajectoryRun> runs;
+};
+
+/// Experiment kinds of the campaign manifest.
+enum class ExperimentKind { kSquare, kBackAndForth, kFree };
+
+inline const char* ExperimentKindToString(ExperimentKind k) {
+  switch (k) {
+    case ExperimentKind::kSquare: return "square";
+    case ExperimentKind::kBackAndForth: return "back_and_forth";
+    case ExperimentKind::kFree: return "free";
+  }
+  return "?";
+}
+
+struct Experiment {
+  ExperimentKind kind = ExperimentKind::kSquare;
+  double side_m = 0.0;      ///< square only
+  double distance_m = 0.0;  ///< back_and_forth only
+  std::string file;         ///< as written in the manifest (relative to it)
+  std::string resolved_file;  ///< path usable from the current directory
+};
+
+/// Ground-truth measurement noise, when the manifest states it.
+struct GroundTruthNoise {
+  double sigma_xy_m = 0.0;
+  double sigma_theta_rad = 0.0;
+};
+
+struct Manifest {
+  std::string path;
+  RobotParams robot;
+  std::vector<Experiment> experiments;
+  std::optional<GroundTruthNoise> ground_truth;
+};
+
+}  // namespace umbmark

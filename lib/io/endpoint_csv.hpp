@@ -1,0 +1,24 @@
+// Reader for the contract's endpoint CSV:
+//   run,direction,ex_m,ey_m,etheta_rad            (etheta_rad cell may be empty)
+// or, instead of errors, both poses:
+//   run,direction,x_abs_m,y_abs_m,theta_abs_rad,x_odo_m,y_odo_m,theta_odo_rad
+// Columns are found by name (any order); unit suffixes _m/_mm, _rad/_deg are
+// converted to SI. Comments (#), blank lines, BOM and CRLF are accepted.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "core/runs.hpp"
+
+namespace umbmark::io {
+
+/// Reads an endpoint CSV file. Throws InputError (file, line, column) on any
+/// fault: unreadable file, missing/duplicated/unknown-unit column, text or
+/// NaN/Inf in a number, a truncated row, an empty file.
+EndpointData ReadEndpointCsv(const std::string& path);
+
+/// Same, from text already in memory; `name` is used in error messages.
+EndpointData ParseEndpointCsv(std::string_view text, const std::string& name);
+
+}  // namespace umbmark::io
