@@ -16,8 +16,5 @@ struct Command {
   std::function<int()> run;
 };
 
-Command SetupCalibrate(CLI::App& parent);
-Command SetupEvaluate(CLI::App& parent);
-Command SetupImport(CLI::App& parent);
 
 }  // namespace umbmark::cli

@@ -18,9 +18,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "umbmark 0.1.0");
 
   std::vector<cli::Command> commands;
-  commands.push_back(cli::SetupCalibrate(app));
-  commands.push_back(cli::SetupEvaluate(app));
-  commands.push_back(cli::SetupImport(app));
+  // Registered subcommands (one cmd_*.cpp each).
 
   try {
     app.parse(argc, argv);
