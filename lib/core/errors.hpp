@@ -30,11 +30,19 @@ class InputError : public std::runtime_error {
   static std::string Format(const std::string& file, std::size_t line, std::size_t column,
                             const std::string& message) {
     std::string out = file.empty() ? std::string("<input>") : file;
+    // Appended piecewise: `":" + std::to_string(n)` trips GCC 12's -Wrestrict
+    // false positive (GCC bug 105329) at -O3.
     if (line > 0) {
-      out += ":" + std::to_string(line);
-      if (column > 0) out += ":" + std::to_string(column);
+      out += ':';
+      out += std::to_string(line);
+      if (column > 0) {
+        out += ':';
+        out += std::to_string(column);
+      }
     }
-    return out + ": " + message;
+    out += ": ";
+    out += message;
+    return out;
   }
   std::string file_;
   std::size_t line_;
