@@ -153,7 +153,8 @@ TrajectoryData ParseTrajectoryCsv(std::string_view text, const std::string& name
       run->gt_y_m.reserve(reserve);
       run->gt_theta_rad.reserve(reserve);
     } else if (direction != run->direction) {
-      csv.FailCell(c_dir.index, fmt::format("direction changes from {} to {} within run {}",
+      csv.FailCell(c_dir.index, fmt::format("direction changes from {} to {} within run {} (a run keeps one direction; give "
+                                            "each run its own id)",
                                             QuoteForMessage(run->direction), QuoteForMessage(direction),
                                             QuoteForMessage(run->run)));
     }
