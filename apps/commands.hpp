@@ -17,4 +17,8 @@ struct Command {
 };
 
 
+Command SetupCalibrate(CLI::App& parent);
+Command SetupEvaluate(CLI::App& parent);
+Command SetupImport(CLI::App& parent);
+
 }  // namespace umbmark::cli

@@ -19,6 +19,9 @@ int main(int argc, char** argv) {
 
   std::vector<cli::Command> commands;
   // Registered subcommands (one cmd_*.cpp each).
+  commands.push_back(cli::SetupCalibrate(app));
+  commands.push_back(cli::SetupEvaluate(app));
+  commands.push_back(cli::SetupImport(app));
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,298 @@
+// `umbmark calibrate DATA... --robot R.toml --side S [--estimator x|y|mean]`:
+// classic UMBmark (Borenstein & Feng) from CW/CCW square runs, endpoint or
+// trajectory CSV, or campaign manifests (their square experiments). Several
+// inputs give one result each plus a summary table (factory batch use).
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <variant>
+
+#include <fmt/format.h>
+
+#include "calibrate_plot.hpp"
+#include "calibration/calibrate_job.hpp"
+#include "commands.hpp"
+#include "common.hpp"
+#include "core/angles.hpp"
+#include "core/errors.hpp"
+#include "io/atomic_write.hpp"
+#include "io/data_file.hpp"
+#include "io/manifest.hpp"
+
+namespace umbmark::cli {
+
+namespace {
+
+struct CalibrateOptions {
+  std::vector<std::string> inputs;
+  RobotFlags robot;
+  std::optional<double> side_m;
+  std::string estimator = "mean";
+  std::string integrator = "arc";
+  std::string ed_wheelbase = "corrected";
+  std::vector<std::string> exclude_runs;
+  bool reject_outliers = false;
+  double outlier_threshold = 3.5;
+  JsonFlag json;
+  std::string ros2;
+  std::string plot;
+};
+
+// Turns one command-line input into calibration inputs (a manifest may hold
+// several square experiments; each is calibrated on its own).
+std::vector<CalibrateInput> LoadInputs(const std::string& path, const CalibrateOptions& o, Integrator integrator) {
+  std::vector<CalibrateInput> out;
+  auto from_file = [&](const std::string& file, const RobotParams& robot, double side, const std::string& label) {
+    io::RunFile rf = io::ReadRunFile(file);
+    if (auto* t = std::get_if<TrajectoryData>(&rf)) return InputFromTrajectories(*t, robot, side, integrator, label);
+    return InputFromEndpoints(std::get<EndpointData>(rf), robot, side, label);
+  };
+  if (io::IsManifestPath(path)) {
+    const Manifest m = io::ReadManifest(path);
+    const RobotParams robot = o.robot.Resolve(m.robot);
+    int index = 0;
+    for (const auto& e : m.experiments) {
+      ++index;
+      if (e.kind != ExperimentKind::kSquare) continue;
+      const double side = o.side_m.value_or(e.side_m);
+      out.push_back(from_file(e.resolved_file, robot, side, fmt::format("{}#{}", path, index)));
+    }
+    if (out.empty()) throw InputError(path, "the manifest has no square experiment to calibrate from");
+  } else {
+    if (!o.side_m) throw InvalidOptions("--side S (square side in metres) is required for CSV input");
+    out.push_back(from_file(path, o.robot.Resolve(), *o.side_m, path));
+  }
+  return out;
+}
+
+nlohmann::json JsonCluster(const ClusterStats& c) {
+  return {{"n", c.n}, {"x_m", c.x_cg_m}, {"y_m", c.y_cg_m}, {"r_m", c.r_cg_m}, {"sigma_m", c.sigma_m}, {"sem_m", c.sem_m}};
+}
+
+nlohmann::json JsonEstimate(const UmbmarkEstimate& e) {
+  return {{"alpha_rad", e.alpha_rad}, {"beta_rad", e.beta_rad}, {"R_m", JsonNumber(e.R_m)}, {"E_b", e.E_b}, {"E_d", e.E_d}};
+}
+
+nlohmann::json JsonResult(const CalibrateInput& in, const CalibrateJobResult& r, const CalibrateOptions& o) {
+  const UmbmarkSummary& s = r.umbmark;
+  nlohmann::json j;
+  j["input"] = r.label;
+  j["method"] = "umbmark";
+  j["estimator"] = UmbmarkEstimatorToString(s.estimator);
+  j["side_m"] = s.side_m;
+  j["integrator"] = o.integrator;
+  j["E_d"] = s.selected.E_d;
+  j["E_b"] = s.selected.E_b;
+  j["alpha_rad"] = s.selected.alpha_rad;
+  j["beta_rad"] = s.selected.beta_rad;
+  j["R_m"] = JsonNumber(s.selected.R_m);
+  j["c_L"] = s.c_L;
+  j["c_R"] = s.c_R;
+  j["E_max_syst_m"] = s.E_max_syst_m;
+  j["parameters"] = JsonParams(s.corrected);
+  j["recorded_parameters"] = JsonParams(s.recorded);
+  j["estimates"] = {{"x", JsonEstimate(s.from_x)},
+                    {"y", JsonEstimate(s.from_y)},
+                    {"spread", {{"E_d", s.spread_E_d}, {"E_b", s.spread_E_b}}}};
+  j["centres_of_gravity"] = {{"cw", JsonCluster(s.cw)}, {"ccw", JsonCluster(s.ccw)}};
+  j["sem_m"] = s.sem_m;
+  j["three_sem_m"] = 3.0 * s.sem_m;
+  j["compensation_worthwhile"] = s.compensation_worthwhile;
+  nlohmann::json runs = nlohmann::json::array();
+  for (std::size_t i = 0; i < s.runs.size(); ++i) {
+    const auto& f = s.runs[i];
+    nlohmann::json jr = {{"run", f.run},         {"direction", f.direction}, {"ex_m", f.ex_m},
+                         {"ey_m", f.ey_m},       {"outlier", f.outlier},     {"excluded", f.excluded},
+                         {"rejected", f.rejected}};
+    jr["etheta_rad"] = in.errors[i].etheta_rad ? nlohmann::json(*in.errors[i].etheta_rad) : nlohmann::json(nullptr);
+    jr["outlier_score"] = f.score ? nlohmann::json(*f.score) : nlohmann::json(nullptr);
+    runs.push_back(jr);
+  }
+  j["runs"] = runs;
+  if (r.evaluation) {
+    const auto& a = *r.evaluation;
+    j["evaluation"] = {{"before", JsonEvaluationSummary(a.before)},
+                       {"after", JsonEvaluationSummary(a.after)},
+                       {"before_runs", JsonEvaluationRuns(a.before)},
+                       {"after_runs", JsonEvaluationRuns(a.after)},
+                       {"E_max_syst_after_m", a.E_max_syst_m},
+                       {"centres_of_gravity_after", {{"cw", JsonCluster(a.cw)}, {"ccw", JsonCluster(a.ccw)}}},
+                       {"sem_after_m", a.sem_m},
+                       {"second_pass_worthwhile", a.second_pass_worthwhile}};
+  }
+  return j;
+}
+
+void PrintEvaluation(const char* title, const EvaluationSummary& e) {
+  fmt::print("  {:<7} position error max {:7.2f} mm (mean over runs {:6.2f}), final max {:7.2f} mm (mean {:6.2f});"
+             " heading max {:6.3f} deg, final max {:6.3f} deg\n",
+             title, e.max_max_position_error_m * 1e3, e.mean_max_position_error_m * 1e3,
+             e.max_final_position_error_m * 1e3, e.mean_final_position_error_m * 1e3,
+             Rad2Deg(e.max_max_heading_error_rad), Rad2Deg(e.max_final_heading_error_rad));
+}
+
+void PrintResult(const CalibrateJobResult& r) {
+  const UmbmarkSummary& s = r.umbmark;
+  fmt::print("UMBmark calibration: {}\n", r.label);
+  fmt::print("  square side {} m, estimator {}, {} runs ({} cw, {} ccw used)\n", s.side_m,
+             UmbmarkEstimatorToString(s.estimator), s.runs.size(), s.cw.n, s.ccw.n);
+  fmt::print("  centre of gravity cw  ({:+8.2f}, {:+8.2f}) mm  r = {:7.2f} mm  sigma {:6.2f} mm  SEM {:6.2f} mm\n",
+             s.cw.x_cg_m * 1e3, s.cw.y_cg_m * 1e3, s.cw.r_cg_m * 1e3, s.cw.sigma_m * 1e3, s.cw.sem_m * 1e3);
+  fmt::print("  centre of gravity ccw ({:+8.2f}, {:+8.2f}) mm  r = {:7.2f} mm  sigma {:6.2f} mm  SEM {:6.2f} mm\n",
+             s.ccw.x_cg_m * 1e3, s.ccw.y_cg_m * 1e3, s.ccw.r_cg_m * 1e3, s.ccw.sigma_m * 1e3, s.ccw.sem_m * 1e3);
+  fmt::print("  E_max,syst = {:.2f} mm   (3*SEM = {:.2f} mm: {})\n", s.E_max_syst_m * 1e3, 3e3 * s.sem_m,
+             s.compensation_worthwhile ? "systematic error stands out of the scatter, compensation worthwhile"
+                                       : "systematic error within the scatter, compensation unlikely to help");
+  fmt::print("  alpha = {:+.5f} deg, beta = {:+.5f} deg, R = {:.3f} m\n", Rad2Deg(s.selected.alpha_rad),
+             Rad2Deg(s.selected.beta_rad), s.selected.R_m);
+  fmt::print("  E_d = {:.6f}   E_b = {:.6f}   c_L = {:.6f}   c_R = {:.6f}\n", s.selected.E_d, s.selected.E_b, s.c_L, s.c_R);
+  fmt::print("  x vs y estimators: E_d {:.6f} / {:.6f}, E_b {:.6f} / {:.6f} (spread {:.2e}, {:.2e})\n", s.from_x.E_d,
+             s.from_y.E_d, s.from_x.E_b, s.from_y.E_b, s.spread_E_d, s.spread_E_b);
+  fmt::print("  wheelbase        {:.6f} m -> {:.6f} m\n", s.recorded.wheelbase_m, s.corrected.wheelbase_m);
+  fmt::print("  left diameter    {:.6f} m -> {:.6f} m\n", s.recorded.wheel_diameter_left_m, s.corrected.wheel_diameter_left_m);
+  fmt::print("  right diameter   {:.6f} m -> {:.6f} m\n", s.recorded.wheel_diameter_right_m, s.corrected.wheel_diameter_right_m);
+  for (const auto& f : s.runs) {
+    if (!f.outlier && !f.excluded) continue;
+    fmt::print("  run {} ({}): {}{}\n", f.run, f.direction,
+               f.excluded ? "excluded by --exclude-runs" : fmt::format("outlier, robust score {:.1f}", *f.score),
+               f.rejected ? ", rejected (--reject-outliers)" : (f.outlier ? ", kept (use --reject-outliers to drop)" : ""));
+  }
+  if (r.evaluation) {
+    const auto& a = *r.evaluation;
+    PrintEvaluation("before", a.before);
+    PrintEvaluation("after", a.after);
+    fmt::print("  after correction: E_max,syst = {:.2f} mm, 3*SEM = {:.2f} mm: {}\n", a.E_max_syst_m * 1e3, 3e3 * a.sem_m,
+               a.second_pass_worthwhile ? "a second compensation pass is indicated"
+                                        : "a second compensation pass is unlikely to help");
+  }
+}
+
+std::string Ros2Snippet(const CalibrateJobResult& r) {
+  const UmbmarkSummary& s = r.umbmark;
+  return fmt::format(
+      "# ros2_control diff_drive_controller parameters from umbmark calibrate ({})\n"
+      "# Multipliers are relative to the parameters the runs were recorded with:\n"
+      "#   wheel_separation = {} m, left/right wheel diameter = {} / {} m.\n"
+      "diff_drive_controller:\n"
+      "  ros__parameters:\n"
+      "    wheel_separation_multiplier: {}\n"
+      "    left_wheel_radius_multiplier: {}\n"
+      "    right_wheel_radius_multiplier: {}\n",
+      r.label, s.recorded.wheelbase_m, s.recorded.wheel_diameter_left_m, s.recorded.wheel_diameter_right_m,
+      s.selected.E_b, s.c_L, s.c_R);
+}
+
+int RunCalibrate(const CalibrateOptions& o) {
+  CalibrateJobOptions jo;
+  jo.umbmark.estimator = *UmbmarkEstimatorFromString(o.estimator);
+  jo.umbmark.ed_with_corrected_wheelbase = o.ed_wheelbase == "corrected";
+  jo.umbmark.exclude_runs = o.exclude_runs;
+  jo.umbmark.reject_outliers = o.reject_outliers;
+  jo.umbmark.outlier_threshold = o.outlier_threshold;
+  jo.integrator = *IntegratorFromString(o.integrator);
+
+  // Collect every calibration unit first; with one input, errors propagate
+  // (exit 1). With several, a failing input is reported and skipped, and the
+  // exit status is 1 at the end.
+  const bool batch = o.inputs.size() > 1;
+  nlohmann::json results = nlohmann::json::array();
+  struct Row {
+    std::string label;
+    std::optional<CalibrateJobResult> result;
+    std::string error;
+  };
+  std::vector<Row> rows;
+  int status = 0;
+  for (const auto& path : o.inputs) {
+    std::vector<CalibrateInput> inputs;
+    try {
+      inputs = LoadInputs(path, o, jo.integrator);
+    } catch (const InputError& e) {
+      if (!batch) throw;
+      fmt::print(stderr, "{}\n", e.what());
+      rows.push_back({path, std::nullopt, e.what()});
+      results.push_back({{"input", path}, {"error", e.what()}});
+      status = 1;
+      continue;
+    }
+    for (const auto& in : inputs) {
+      CalibrateJobResult r;
+      try {
+        r = RunCalibrateJob(in, jo);
+      } catch (const InputError& e) {
+        if (!batch) throw;
+        fmt::print(stderr, "{}\n", e.what());
+        rows.push_back({in.label, std::nullopt, e.what()});
+        results.push_back({{"input", in.label}, {"error", e.what()}});
+        status = 1;
+        continue;
+      }
+      const std::string tag = std::filesystem::path(in.path).stem().string() + "-" + std::to_string(rows.size() + 1);
+      if (!o.ros2.empty()) io::WriteFileAtomically(batch ? TaggedPath(o.ros2, tag) : o.ros2, Ros2Snippet(r));
+      if (!o.plot.empty())
+        io::WriteFileAtomically(batch ? TaggedPath(o.plot, tag) : o.plot, CalibrationPlotSvg(in, r, jo.integrator));
+      if (o.json.PrintText()) {
+        PrintResult(r);
+        fmt::print("\n");
+      }
+      results.push_back(JsonResult(in, r, o));
+      rows.push_back({in.label, std::move(r), ""});
+    }
+  }
+  if (o.json.PrintText() && rows.size() > 1) {
+    fmt::print("Summary ({} calibrations)\n", rows.size());
+    fmt::print("  {:<40} {:>10} {:>10} {:>11} {:>11} {:>11} {:>10} {:>10}\n", "input", "E_d", "E_b", "wheelbase_m",
+               "D_left_m", "D_right_m", "Emax_mm", "after_mm");
+    for (const auto& row : rows) {
+      if (!row.result) {
+        fmt::print("  {:<40} FAILED: {}\n", row.label, row.error);
+        continue;
+      }
+      const auto& s = row.result->umbmark;
+      const std::string after =
+          row.result->evaluation ? fmt::format("{:.2f}", row.result->evaluation->E_max_syst_m * 1e3) : "-";
+      fmt::print("  {:<40} {:>10.6f} {:>10.6f} {:>11.6f} {:>11.6f} {:>11.6f} {:>10.2f} {:>10}\n", row.label,
+                 s.selected.E_d, s.selected.E_b, s.corrected.wheelbase_m, s.corrected.wheel_diameter_left_m,
+                 s.corrected.wheel_diameter_right_m, s.E_max_syst_m * 1e3, after);
+    }
+  }
+  if (rows.size() == 1 && rows.front().result) {
+    o.json.Emit(results.front());
+  } else {
+    o.json.Emit({{"results", results}, {"failed", status != 0}});
+  }
+  return status;
+}
+
+}  // namespace
+
+Command SetupCalibrate(CLI::App& parent) {
+  auto opts = std::make_shared<CalibrateOptions>();
+  auto* app = parent.add_subcommand("calibrate", "UMBmark calibration from CW/CCW square runs");
+  app->add_option("DATA", opts->inputs, "Endpoint or trajectory CSV, or campaign manifest (.toml); several = batch")
+      ->required()
+      ->check(CLI::ExistingFile);
+  opts->robot.Bind(*app);
+  app->add_option("--side", opts->side_m, "Square side L [m] (required for CSV input)")->check(CLI::PositiveNumber);
+  app->add_option("--estimator", opts->estimator, "alpha/beta from x (4.20a, 4.24a), y (4.20b, 4.24b) or their mean")
+      ->check(CLI::IsMember({"x", "y", "mean"}))
+      ->capture_default_str();
+  app->add_option("--integrator", opts->integrator,
+                  "Odometry from ticks: exact arc, or midpoint (as the OptiOdom reference implementation)")
+      ->check(CLI::IsMember({"arc", "midpoint"}))
+      ->capture_default_str();
+  app->add_option("--ed-wheelbase", opts->ed_wheelbase, "Wheelbase used in eq. 4.22 for E_d")
+      ->check(CLI::IsMember({"corrected", "recorded"}))
+      ->capture_default_str();
+  app->add_option("--exclude-runs", opts->exclude_runs, "Run ids to leave out (listed in the output)")->delimiter(',');
+  app->add_flag("--reject-outliers", opts->reject_outliers, "Drop runs flagged as outliers (listed in the output)");
+  app->add_option("--outlier-threshold", opts->outlier_threshold, "Robust score above which a run is flagged")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  opts->json.Bind(*app);
+  app->add_option("--ros2", opts->ros2, "Write a ros2_control diff_drive_controller parameter snippet (YAML)");
+  app->add_option("--plot", opts->plot, "Write an SVG of the return errors, centres of gravity and E_max,syst");
+  return {app, [opts] { return RunCalibrate(*opts); }};
+}
+
+}  // namespace umbmark::cli

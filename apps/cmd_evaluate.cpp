@@ -1,0 +1,226 @@
+// `umbmark evaluate DATA... --robot R.toml [--params CAL.json]`: errors of
+// odometry against ground truth along trajectories (any path shape) for the
+// recorded parameters or a calibration, per run and over all runs.
+#include <cmath>
+#include <memory>
+#include <variant>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "core/angles.hpp"
+#include "core/errors.hpp"
+#include "evaluation/run_track.hpp"
+#include "io/atomic_write.hpp"
+#include "io/data_file.hpp"
+#include "io/manifest.hpp"
+#include "io/svg_plot.hpp"
+
+namespace umbmark::cli {
+
+namespace {
+
+struct EvaluateOptions {
+  std::vector<std::string> inputs;
+  RobotFlags robot;
+  std::string params_file;
+  std::string integrator = "arc";
+  JsonFlag json;
+  std::string plot;
+};
+
+struct Source {
+  std::string label;
+  RobotParams recorded;
+  TrajectoryData data;
+};
+
+std::vector<Source> LoadSources(const EvaluateOptions& o) {
+  std::vector<Source> out;
+  for (const auto& path : o.inputs) {
+    if (io::IsManifestPath(path)) {
+      const Manifest m = io::ReadManifest(path);
+      const RobotParams robot = o.robot.Resolve(m.robot);
+      int index = 0;
+      for (const auto& e : m.experiments) {
+        ++index;
+        io::RunFile rf = io::ReadRunFile(e.resolved_file);
+        if (auto* t = std::get_if<TrajectoryData>(&rf))
+          out.push_back({fmt::format("{}#{}:{}", path, index, ExperimentKindToString(e.kind)), robot, std::move(*t)});
+      }
+      if (out.empty()) throw InputError(path, "no experiment of the manifest has trajectory data to evaluate");
+    } else {
+      io::RunFile rf = io::ReadRunFile(path);
+      auto* t = std::get_if<TrajectoryData>(&rf);
+      if (!t) throw InputError(path, "evaluate needs a trajectory CSV (ticks or wheel travel with ground truth)");
+      out.push_back({path, o.robot.Resolve(), std::move(*t)});
+    }
+  }
+  return out;
+}
+
+// Reads calibrated parameters from a `calibrate` JSON: refined.parameters
+// when present, else parameters (contract).
+RobotParams ReadParams(const std::string& path, const RobotParams& recorded) {
+  const std::string text = io::ReadWholeFile(path);
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    std::size_t line = 1, col = 1;
+    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
+      if (text[i] == '\n') {
+        ++line;
+        col = 1;
+      } else {
+        ++col;
+      }
+    }
+    throw InputError(path, line, col, "invalid JSON");
+  }
+  if (j.contains("results")) {
+    if (!j["results"].is_array() || j["results"].size() != 1)
+      throw InputError(path, "a batch calibration result holds several calibrations; pass a single one");
+    j = j["results"][0];
+  }
+  const nlohmann::json* p = nullptr;
+  if (j.contains("refined") && j["refined"].is_object() && j["refined"].contains("parameters"))
+    p = &j["refined"]["parameters"];
+  else if (j.contains("parameters"))
+    p = &j["parameters"];
+  if (!p || !p->is_object()) throw InputError(path, "no 'parameters' (or 'refined.parameters') object");
+  RobotParams out = recorded;
+  auto get = [&](const char* key, double& field) {
+    if (!p->contains(key) || !(*p)[key].is_number()) throw InputError(path, fmt::format("parameters.{} is missing or not a number", key));
+    field = (*p)[key].get<double>();
+  };
+  get("wheelbase_m", out.wheelbase_m);
+  get("wheel_diameter_left_m", out.wheel_diameter_left_m);
+  get("wheel_diameter_right_m", out.wheel_diameter_right_m);
+  if (p->contains("ticks_per_rev") && (*p)["ticks_per_rev"].is_number()) out.ticks_per_rev = (*p)["ticks_per_rev"].get<double>();
+  if (auto err = out.Check(); !err.empty()) throw InputError(path, "parameters: " + err);
+  return out;
+}
+
+void PrintSummary(const char* title, const EvaluationSummary& s) {
+  fmt::print("{} ({} runs)\n", title, s.runs.size());
+  fmt::print("  {:<44} {:>6} {:<10} {:>10} {:>10} {:>10} {:>10}\n", "experiment", "run", "direction", "final_mm",
+             "max_mm", "final_deg", "max_deg");
+  for (const auto& r : s.runs) {
+    fmt::print("  {:<44} {:>6} {:<10} {:>10.2f} {:>10.2f} {:>10.3f} {:>10.3f}\n", r.experiment, r.run, r.direction,
+               r.final_position_error_m * 1e3, r.max_position_error_m * 1e3, Rad2Deg(r.final_heading_error_rad),
+               Rad2Deg(r.max_heading_error_rad));
+  }
+  fmt::print("  {:<62} {:>10.2f} {:>10.2f} {:>10.3f} {:>10.3f}\n", "mean", s.mean_final_position_error_m * 1e3,
+             s.mean_max_position_error_m * 1e3, Rad2Deg(s.mean_final_heading_error_rad),
+             Rad2Deg(s.mean_max_heading_error_rad));
+  fmt::print("  {:<62} {:>10.2f} {:>10.2f} {:>10.3f} {:>10.3f}\n", "max", s.max_final_position_error_m * 1e3,
+             s.max_max_position_error_m * 1e3, Rad2Deg(s.max_final_heading_error_rad),
+             Rad2Deg(s.max_max_heading_error_rad));
+}
+
+std::string PlotSvg(const std::vector<Source>& sources, const std::optional<RobotParams>& params, Integrator integ) {
+  std::vector<std::string> parts;
+  const double size = 380;
+  double x = 60, y = 40;
+  int col = 0;
+  for (const auto& src : sources) {
+    for (const auto& run : src.data.runs) {
+      if (parts.size() >= 12) break;  // keep the figure readable
+      io::SvgPanel p(x, y, size, size, fmt::format("{} run {}", src.label, run.run));
+      const RunTrack before = TrackRun(run, src.recorded, src.recorded, integ);
+      std::vector<io::SvgPoint> gt, od, od2, all;
+      for (std::size_t i = 0; i < run.size(); ++i) {
+        if (before.has_ground_truth[i]) gt.push_back({before.ground_truth[i].x, before.ground_truth[i].y});
+        od.push_back({before.odometry[i].x, before.odometry[i].y});
+      }
+      all = gt;
+      all.insert(all.end(), od.begin(), od.end());
+      if (params) {
+        const RunTrack after = TrackRun(run, *params, src.recorded, integ);
+        for (const auto& q : after.odometry) od2.push_back({q.x, q.y});
+        all.insert(all.end(), od2.begin(), od2.end());
+      }
+      p.FitExtent(all, true, true);
+      p.Axes("x [m]", "y [m]");
+      p.Polyline(gt, "#111", 2.0);
+      p.Polyline(od, "#d62728", 1.2, "4,3");
+      if (params) p.Polyline(od2, "#2ca02c", 1.2);
+      std::vector<std::pair<std::string, std::string>> legend = {{"#111", "ground truth"},
+                                                                 {"#d62728", "odometry, recorded parameters"}};
+      if (params) legend.push_back({"#2ca02c", "odometry, --params"});
+      p.Legend(legend);
+      parts.push_back(p.Render());
+      if (++col == 3) {
+        col = 0;
+        x = 60;
+        y += size + 60;
+      } else {
+        x += size + 60;
+      }
+    }
+  }
+  const double rows = std::ceil(static_cast<double>(parts.size()) / 3.0);
+  return io::SvgDocument(3 * (size + 60) + 40, rows * (size + 60) + 40, parts);
+}
+
+int RunEvaluate(const EvaluateOptions& o) {
+  const Integrator integ = *IntegratorFromString(o.integrator);
+  const std::vector<Source> sources = LoadSources(o);
+  std::optional<RobotParams> params;
+  if (!o.params_file.empty()) params = ReadParams(o.params_file, sources.front().recorded);
+
+  std::vector<RunEvaluation> base_runs, param_runs;
+  for (const auto& src : sources) {
+    auto b = EvaluateRuns(src.data, src.label, src.recorded, src.recorded, integ);
+    base_runs.insert(base_runs.end(), b.begin(), b.end());
+    if (params) {
+      auto a = EvaluateRuns(src.data, src.label, *params, src.recorded, integ);
+      param_runs.insert(param_runs.end(), a.begin(), a.end());
+    }
+  }
+  const EvaluationSummary base = Summarise(std::move(base_runs));
+  const EvaluationSummary& main = params ? Summarise(std::move(param_runs)) : base;
+  if (o.json.PrintText()) {
+    if (params) {
+      PrintSummary("Recorded parameters", base);
+      fmt::print("\n");
+      PrintSummary(fmt::format("Parameters from {}", o.params_file).c_str(), main);
+    } else {
+      PrintSummary("Recorded parameters", base);
+    }
+  }
+  nlohmann::json j = {{"integrator", o.integrator},
+                      {"parameters", JsonParams(params ? *params : sources.front().recorded)},
+                      {"runs", JsonEvaluationRuns(main)},
+                      {"summary", JsonEvaluationSummary(main)}};
+  if (params) {
+    j["recorded"] = {{"parameters", JsonParams(sources.front().recorded)},
+                     {"runs", JsonEvaluationRuns(base)},
+                     {"summary", JsonEvaluationSummary(base)}};
+  }
+  if (!o.plot.empty()) io::WriteFileAtomically(o.plot, PlotSvg(sources, params, integ));
+  o.json.Emit(j);
+  return 0;
+}
+
+}  // namespace
+
+Command SetupEvaluate(CLI::App& parent) {
+  auto opts = std::make_shared<EvaluateOptions>();
+  auto* app = parent.add_subcommand("evaluate", "Odometry vs ground truth along trajectories, for any parameters");
+  app->add_option("DATA", opts->inputs, "Trajectory CSV(s) or campaign manifest(s)")->required()->check(CLI::ExistingFile);
+  opts->robot.Bind(*app);
+  app->add_option("--params", opts->params_file, "Calibration JSON from `umbmark calibrate` (refined.parameters if present)")
+      ->check(CLI::ExistingFile);
+  app->add_option("--integrator", opts->integrator, "Odometry from ticks: arc (exact) or midpoint")
+      ->check(CLI::IsMember({"arc", "midpoint"}))
+      ->capture_default_str();
+  opts->json.Bind(*app);
+  app->add_option("--plot", opts->plot, "Write an SVG overlaying ground truth and odometry (before/after)");
+  return {app, [opts] { return RunEvaluate(*opts); }};
+}
+
+}  // namespace umbmark::cli

@@ -1,0 +1,57 @@
+// Shared command-line plumbing for the subcommands: robot parameters from a
+// robot file and/or flags, JSON output to a file or stdout, and input
+// resolution (DATA.csv + --robot, or a campaign manifest).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "core/robot.hpp"
+#include "core/runs.hpp"
+#include "evaluation/trajectory_eval.hpp"
+
+namespace umbmark::cli {
+
+/// --robot FILE and the per-field override flags of the contract.
+struct RobotFlags {
+  std::string robot_file;
+  std::optional<double> wheelbase_m, diameter_left_m, diameter_right_m, ticks_per_rev;
+
+  /// Binds --robot, --wheelbase, --diameter-left, --diameter-right, --ticks-per-rev.
+  void Bind(CLI::App& app);
+  bool Given() const;
+  /// Robot from the file (if any) with flag overrides applied, on top of
+  /// `base` (e.g. a manifest's [robot]). Throws InputError for a bad file,
+  /// InvalidOptions when the result fails RobotParams::Check() or a required
+  /// field is missing everywhere.
+  RobotParams Resolve(const std::optional<RobotParams>& base = std::nullopt) const;
+};
+
+/// Where the machine-readable result goes: "" = nowhere, "-" = stdout alone.
+struct JsonFlag {
+  std::string path;
+  void Bind(CLI::App& app);
+  bool ToStdout() const { return path == "-"; }
+  /// True when the human-readable text should be printed (not `--json -`).
+  bool PrintText() const { return !ToStdout(); }
+  /// Writes `j` (pretty, 2-space indent) to stdout or atomically to the file.
+  void Emit(const nlohmann::json& j) const;
+};
+
+/// Rounds-trips doubles; NaN/Inf become null so the JSON stays valid.
+nlohmann::json JsonNumber(double v);
+nlohmann::json JsonParams(const RobotParams& p);
+
+/// The contract's evaluation keys: `runs` (per run) and `summary`.
+nlohmann::json JsonEvaluationRuns(const EvaluationSummary& s);
+nlohmann::json JsonEvaluationSummary(const EvaluationSummary& s);
+
+/// Inserts "-<tag>" before the extension: ("out.svg", "run1") -> "out-run1.svg".
+/// Used when one flag names an output and several inputs are processed.
+std::string TaggedPath(const std::string& path, const std::string& tag);
+
+}  // namespace umbmark::cli

@@ -1,0 +1,93 @@
+// One `calibrate` job (see calibrate_job.hpp).
+#include "calibration/calibrate_job.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/angles.hpp"
+#include "core/errors.hpp"
+
+namespace umbmark {
+
+CalibrateInput InputFromTrajectories(const TrajectoryData& data, const RobotParams& recorded, double side_m,
+                                     Integrator integrator, const std::string& label) {
+  CalibrateInput in;
+  in.label = label;
+  in.path = data.path;
+  in.recorded = recorded;
+  in.side_m = side_m;
+  in.errors = ReturnErrorsFromTrajectories(data, recorded, recorded, integrator);
+  for (const auto& e : in.errors) {
+    if (!e.gt_total_rotation_rad || std::abs(*e.gt_total_rotation_rad) < kPi) continue;
+    const char* gt_dir = *e.gt_total_rotation_rad < 0.0 ? "cw" : "ccw";
+    if ((e.direction == "cw" || e.direction == "ccw") && e.direction != gt_dir) {
+      throw InputError(data.path, e.line, 0,
+                       fmt::format("run {} is labelled {} but its ground truth turns {:+.1f} deg ({})", e.run,
+                                   e.direction, Rad2Deg(*e.gt_total_rotation_rad), gt_dir));
+    }
+  }
+  in.trajectories = data;
+  return in;
+}
+
+CalibrateInput InputFromEndpoints(const EndpointData& data, const RobotParams& recorded, double side_m,
+                                  const std::string& label) {
+  CalibrateInput in;
+  in.label = label;
+  in.path = data.path;
+  in.recorded = recorded;
+  in.side_m = side_m;
+  in.errors = ReturnErrorsFromEndpoints(data);
+  return in;
+}
+
+namespace {
+ClusterStats ClusterOf(const std::vector<ReturnError>& errors, const std::vector<RunFlag>& flags,
+                       const std::string& direction) {
+  ClusterStats c;
+  std::vector<const ReturnError*> used;
+  for (std::size_t i = 0; i < errors.size(); ++i)
+    if (errors[i].direction == direction && flags[i].used()) used.push_back(&errors[i]);
+  c.n = static_cast<int>(used.size());
+  if (c.n == 0) return c;
+  for (const auto* e : used) {
+    c.x_cg_m += e->ex_m / c.n;
+    c.y_cg_m += e->ey_m / c.n;
+  }
+  c.r_cg_m = std::hypot(c.x_cg_m, c.y_cg_m);
+  if (c.n > 1) {
+    double ss = 0.0;
+    for (const auto* e : used) ss += std::pow(e->ex_m - c.x_cg_m, 2) + std::pow(e->ey_m - c.y_cg_m, 2);
+    c.sigma_m = std::sqrt(ss / (c.n - 1));
+    c.sem_m = c.sigma_m / std::sqrt(static_cast<double>(c.n));
+  }
+  return c;
+}
+}  // namespace
+
+CalibrateJobResult RunCalibrateJob(const CalibrateInput& input, const CalibrateJobOptions& options) {
+  CalibrateJobResult r;
+  r.label = input.label;
+  r.path = input.path;
+  UmbmarkOptions uo = options.umbmark;
+  uo.side_m = input.side_m;
+  r.umbmark = CalibrateUmbmark(input.errors, input.recorded, uo, input.path);
+  if (input.trajectories) {
+    AfterCorrection a;
+    const auto& data = *input.trajectories;
+    a.before = Summarise(EvaluateRuns(data, input.label, input.recorded, input.recorded, options.integrator));
+    a.after = Summarise(EvaluateRuns(data, input.label, r.umbmark.corrected, input.recorded, options.integrator));
+    const auto after_errors = ReturnErrorsFromTrajectories(data, r.umbmark.corrected, input.recorded, options.integrator);
+    a.cw = ClusterOf(after_errors, r.umbmark.runs, "cw");
+    a.ccw = ClusterOf(after_errors, r.umbmark.runs, "ccw");
+    a.E_max_syst_m = std::max(a.cw.r_cg_m, a.ccw.r_cg_m);
+    a.sem_m = std::max(a.cw.sem_m, a.ccw.sem_m);
+    a.second_pass_worthwhile = a.E_max_syst_m > 3.0 * a.sem_m;
+    r.evaluation = std::move(a);
+  }
+  return r;
+}
+
+}  // namespace umbmark

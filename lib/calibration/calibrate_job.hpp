@@ -1,0 +1,61 @@
+// One `calibrate` job: classic UMBmark on one set of square runs, plus (for
+// trajectory input) the evaluation measures before and after the correction
+// and the 3*SEM rule applied to the corrected runs.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "calibration/umbmark.hpp"
+#include "core/runs.hpp"
+#include "evaluation/return_error.hpp"
+#include "evaluation/trajectory_eval.hpp"
+
+namespace umbmark {
+
+/// The runs of one calibration, already loaded.
+struct CalibrateInput {
+  std::string label;   ///< what the user called it (file, or file#experiment)
+  std::string path;    ///< data file, for messages
+  RobotParams recorded;
+  double side_m = 0.0;
+  std::vector<ReturnError> errors;           ///< from endpoints, or computed from trajectories
+  std::optional<TrajectoryData> trajectories;  ///< trajectory input only
+};
+
+struct CalibrateJobOptions {
+  /// side_m is taken from the input; the other fields as documented there.
+  UmbmarkOptions umbmark;
+  /// Integrator for odometry from ticks (trajectory input). Default kArc.
+  Integrator integrator = Integrator::kArc;
+};
+
+/// What the corrected parameters do on the same runs (trajectory input).
+struct AfterCorrection {
+  EvaluationSummary before, after;
+  ClusterStats cw, ccw;       ///< return-error clusters with the corrected parameters
+  double E_max_syst_m = 0.0;  ///< eq. 3.4 after correction
+  double sem_m = 0.0;
+  /// E_max,syst after > 3*SEM: a second compensation pass is indicated.
+  bool second_pass_worthwhile = false;
+};
+
+struct CalibrateJobResult {
+  std::string label, path;
+  UmbmarkSummary umbmark;
+  std::optional<AfterCorrection> evaluation;
+};
+
+/// Builds the input from trajectories: return errors with the recorded
+/// parameters, and a check that every run's cw/ccw label agrees with the
+/// sign of its ground-truth total rotation. Throws InputError otherwise.
+CalibrateInput InputFromTrajectories(const TrajectoryData& data, const RobotParams& recorded, double side_m,
+                                     Integrator integrator, const std::string& label);
+CalibrateInput InputFromEndpoints(const EndpointData& data, const RobotParams& recorded, double side_m,
+                                  const std::string& label);
+
+/// Runs UMBmark (and the after-correction evaluation when trajectories are present).
+CalibrateJobResult RunCalibrateJob(const CalibrateInput& input, const CalibrateJobOptions& options);
+
+}  // namespace umbmark

@@ -1,0 +1,53 @@
+// Return errors from endpoint files or trajectories (see return_error.hpp).
+#include "evaluation/return_error.hpp"
+
+#include "core/angles.hpp"
+#include "core/errors.hpp"
+#include "evaluation/run_track.hpp"
+
+namespace umbmark {
+
+std::vector<ReturnError> ReturnErrorsFromEndpoints(const EndpointData& data) {
+  std::vector<ReturnError> out;
+  out.reserve(data.runs.size());
+  for (const auto& r : data.runs) {
+    ReturnError e;
+    e.run = r.run;
+    e.direction = r.direction;
+    e.ex_m = r.ex_m;
+    e.ey_m = r.ey_m;
+    if (r.etheta_rad) e.etheta_rad = WrapAngle(*r.etheta_rad);
+    e.line = r.line;
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
+std::vector<ReturnError> ReturnErrorsFromTrajectories(const TrajectoryData& data, const RobotParams& params,
+                                                      const RobotParams& recorded, Integrator integrator) {
+  std::vector<ReturnError> out;
+  out.reserve(data.runs.size());
+  for (const auto& run : data.runs) {
+    RunTrack track;
+    try {
+      track = TrackRun(run, params, recorded, integrator);
+    } catch (const InputError& err) {
+      throw InputError(data.path, err.line(), err.column(), err.message());
+    }
+    const std::size_t k = track.last_gt;
+    const Pose2& gt = track.ground_truth[k];
+    const Pose2& odo = track.odometry[k];
+    ReturnError e;
+    e.run = run.run;
+    e.direction = run.direction;
+    e.ex_m = gt.x - odo.x;
+    e.ey_m = gt.y - odo.y;
+    e.etheta_rad = WrapAngle(gt.theta - odo.theta);
+    e.line = run.lines.empty() ? 0 : run.lines.front();
+    e.gt_total_rotation_rad = track.gt_total_rotation_rad;
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
+}  // namespace umbmark
