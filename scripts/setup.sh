@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Installs the Debian packages umbmark needs (compiler, CMake, Ninja, Eigen,
+# Ceres, CLI11, fmt, nlohmann-json, toml++, fast_float, Catch2 v2, clang for
+# the fuzz targets). Uses sudo when not root. Safe to re-run.
+set -euo pipefail
+PACKAGES=(build-essential cmake ninja-build pkg-config libeigen3-dev libceres-dev libcli11-dev libfmt-dev
+  nlohmann-json3-dev libtomlplusplus-dev libfast-float-dev catch2 clang libclang-rt-dev)
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  echo "Installing: ${missing[*]}"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
