@@ -18,7 +18,7 @@ namespace {
 
 constexpr std::string_view kBom = "\xEF\xBB\xBF";
 
-inline bool IsBlank(char c) { return c == ' ' || c == '\t'; }
+using csv_internal::IsBlank;
 
 inline std::string_view Trim(const char* b, const char* e) {
   while (b < e && IsBlank(*b)) ++b;
@@ -209,31 +209,27 @@ bool CsvReader::HasNoDataRows() const {
   return !copy.NextContentLine();
 }
 
-bool CsvReader::Next() {
-  if (!NextContentLine()) return false;
-  const std::size_t expected = cells_.size();
-  std::size_t n = 0;
-  const char* c = line_begin_;
-  const char* const end = line_end_;
-  for (;;) {
-    const char* e = c;
-    while (e < end && *e != ',') ++e;
-    if (n < expected) {
-      cells_[n] = Trim(c, e);
-    } else if (n == expected) {
-      extra_ = Trim(c, e).data();
-    }
-    ++n;
-    if (e == end) break;
-    c = e + 1;
-  }
-  if (n != expected) {
-    const char* at = n < expected ? end : extra_;
-    throw InputError(name_, line_, ColumnOf(at),
-                     fmt::format("row has {} cells but the header has {}{}", n, expected,
-                                 n < expected ? " (truncated row?)" : ""));
-  }
+bool CsvReader::SkipIfBlankOrComment(const char* b) {
+  const char* const end = text_.data() + text_.size();
+  const char* q = b;
+  while (q < end && IsBlank(*q)) ++q;
+  if (q < end && *q == '\r' && (q + 1 == end || q[1] == '\n')) ++q;
+  if (q < end && *q != '#' && *q != '\n') return false;
+  const auto* nl = static_cast<const char*>(std::memchr(q, '\n', static_cast<std::size_t>(end - q)));
+  pos_ = nl != nullptr ? static_cast<std::size_t>(nl - text_.data()) + 1 : text_.size();
   return true;
+}
+
+void CsvReader::FailCellCount(std::size_t n) const {
+  const std::size_t expected = cells_.size();
+  const char* at = line_end_;
+  if (n > expected) {
+    at = extra_;
+    while (at < line_end_ && IsBlank(*at)) ++at;
+  }
+  throw InputError(name_, line_, ColumnOf(at),
+                   fmt::format("row has {} cells but the header has {}{}", n, expected,
+                               n < expected ? " (truncated row?)" : ""));
 }
 
 std::size_t CsvReader::ColumnIn(const char* row_begin, const char* p) {
@@ -270,9 +266,16 @@ void CsvReader::FailNumber(const ResolvedColumn& c, std::string_view cell, const
   FailCell(c.index, fmt::format("{}: {} {}", c.header, QuoteForMessage(cell), what));
 }
 
-bool CsvReader::OptionalNumber(const ResolvedColumn& c, double& out) const {
-  const std::string_view s = cells_[c.index];
-  if (s.empty()) return false;
+void CsvReader::FailEmpty(const ResolvedColumn& c) const {
+  FailCell(c.index, fmt::format("{}: empty cell", c.header));
+}
+
+void CsvReader::FailQuoted(const ResolvedColumn& c) const {
+  FailCell(c.index,
+           fmt::format("{}: quoted cells are not supported ({})", c.header, QuoteForMessage(cells_[c.index])));
+}
+
+double CsvReader::ParseNumberSlow(const ResolvedColumn& c, std::string_view s) const {
   double v = 0.0;
   const char* const end = s.data() + s.size();
   const auto r = fast_float::from_chars(s.data(), end, v);
@@ -280,36 +283,18 @@ bool CsvReader::OptionalNumber(const ResolvedColumn& c, double& out) const {
     FailNumber(c, s, "is not a number");
   }
   if (std::isnan(v)) FailNumber(c, s, "is NaN, which is not allowed (leave the cell empty if unknown)");
-  v = v * c.multiply / c.divide;
   if (!std::isfinite(v)) FailNumber(c, s, "is infinite or out of range");
-  out = v;
-  return true;
-}
-
-double CsvReader::Number(const ResolvedColumn& c) const {
-  double v = 0.0;
-  if (!OptionalNumber(c, v)) FailCell(c.index, fmt::format("{}: empty cell", c.header));
   return v;
 }
 
-std::int64_t CsvReader::Count(const ResolvedColumn& c) const {
-  const std::string_view s = cells_[c.index];
-  if (s.empty()) FailCell(c.index, fmt::format("{}: empty cell", c.header));
+std::int64_t CsvReader::ParseCountSlow(const ResolvedColumn& c, std::string_view s) const {
+  if (s.empty()) FailEmpty(c);
   std::int64_t v = 0;
   const char* const end = s.data() + s.size();
   const auto r = std::from_chars(s.data(), end, v);
   if (r.ec == std::errc::result_out_of_range) FailNumber(c, s, "is out of the signed 64-bit range");
   if (r.ec != std::errc() || r.ptr != end) FailNumber(c, s, "is not an integer count");
   return v;
-}
-
-std::string_view CsvReader::Text(const ResolvedColumn& c) const {
-  const std::string_view s = cells_[c.index];
-  if (s.empty()) FailCell(c.index, fmt::format("{}: empty cell", c.header));
-  if (s.find('"') != std::string_view::npos) {
-    FailCell(c.index, fmt::format("{}: quoted cells are not supported ({})", c.header, QuoteForMessage(s)));
-  }
-  return s;
 }
 
 }  // namespace umbmark::io::detail

@@ -11,6 +11,7 @@
 // only when an error is reported.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -72,7 +73,7 @@ class CsvReader {
 
   /// Advances to the next data row; false at the end of the text. Throws
   /// InputError at the row when its cell count differs from the header's.
-  bool Next();
+  inline bool Next();
   /// True when no data row follows the header (call before Next()).
   bool HasNoDataRows() const;
 
@@ -95,21 +96,27 @@ class CsvReader {
   /// Numeric cells, converted to SI with the column's factor. Throw InputError
   /// at the cell for an empty cell (except Optional*), text, trailing garbage,
   /// NaN or Inf.
-  double Number(const ResolvedColumn& c) const;
+  inline double Number(const ResolvedColumn& c) const;
   /// Returns false (leaving `out` untouched) when the cell is empty.
-  bool OptionalNumber(const ResolvedColumn& c, double& out) const;
-  std::int64_t Count(const ResolvedColumn& c) const;
+  inline bool OptionalNumber(const ResolvedColumn& c, double& out) const;
+  inline std::int64_t Count(const ResolvedColumn& c) const;
   /// A non-empty text cell without a double quote.
-  std::string_view Text(const ResolvedColumn& c) const;
+  inline std::string_view Text(const ResolvedColumn& c) const;
 
  private:
   /// Finds the next line that is neither blank nor a comment, starting at
   /// pos_. Sets line_, line_begin_, line_end_ (without \r). False at end.
   bool NextContentLine();
-  /// Splits [line_begin_, line_end_) at commas into `out`; returns the count.
-  /// Only the first `max_cells` are stored; extra_ points at the first extra.
-  std::size_t Split(std::vector<std::string_view>& out, std::size_t max_cells);
+  /// The line at `b` (whose first byte is a blank, `#` or a line end) is
+  /// blank or a comment: skips it (advancing pos_) and returns true.
+  bool SkipIfBlankOrComment(const char* b);
   std::size_t ColumnOf(const char* p) const;
+  /// The general number parser (fast_float) with all the checks.
+  double ParseNumberSlow(const ResolvedColumn& c, std::string_view s) const;
+  std::int64_t ParseCountSlow(const ResolvedColumn& c, std::string_view s) const;
+  [[noreturn]] void FailCellCount(std::size_t n) const;
+  [[noreturn]] void FailEmpty(const ResolvedColumn& c) const;
+  [[noreturn]] void FailQuoted(const ResolvedColumn& c) const;
   [[noreturn]] void FailHeader(std::size_t i, const std::string& message) const;
   [[noreturn]] void FailNumber(const ResolvedColumn& c, std::string_view cell, const char* what) const;
 
@@ -127,5 +134,143 @@ class CsvReader {
   std::vector<std::size_t> header_columns_;  ///< 1-based column of each name
   std::vector<std::string_view> cells_;
 };
+
+// ---- Hot paths, inline: one call per row / cell of a large log. ----------
+
+namespace csv_internal {
+
+inline bool IsBlank(char c) { return c == ' ' || c == '\t'; }
+
+inline bool IsDigit(char c) { return static_cast<unsigned char>(c - '0') < 10; }
+
+/// Exact powers of ten up to 1e22 (all representable in a double).
+inline constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+                                    1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+/// Fast path for the plain decimals logs are made of: [-]digits[.digits]
+/// with at most 15 digits. Then mantissa < 2^53 and the power of ten is
+/// exact, so one IEEE division gives the correctly rounded value (Clinger's
+/// fast path), identical to what fast_float returns. False for anything else
+/// (exponent, NaN, long numbers, garbage), which goes to the slow parser.
+inline bool ParseSimpleDecimal(const char* p, const char* end, double& out) {
+  const bool negative = p < end && *p == '-';
+  if (negative) ++p;
+  std::uint64_t mantissa = 0;
+  int digits = 0;
+  while (p < end && IsDigit(*p)) {
+    mantissa = mantissa * 10 + static_cast<std::uint64_t>(*p - '0');
+    ++p;
+    ++digits;
+  }
+  int fraction = 0;
+  if (p < end && *p == '.') {
+    ++p;
+    while (p < end && IsDigit(*p)) {
+      mantissa = mantissa * 10 + static_cast<std::uint64_t>(*p - '0');
+      ++p;
+      ++fraction;
+    }
+    digits += fraction;
+  }
+  if (p != end || digits == 0 || digits > 15) return false;
+  const double v = static_cast<double>(mantissa) / kPow10[fraction];
+  out = negative ? -v : v;
+  return true;
+}
+
+/// Fast path for counts: [-]digits, at most 18 digits (no overflow).
+inline bool ParseSimpleCount(const char* p, const char* end, std::int64_t& out) {
+  const bool negative = p < end && *p == '-';
+  if (negative) ++p;
+  const char* const first = p;
+  std::int64_t v = 0;
+  while (p < end && IsDigit(*p)) {
+    v = v * 10 + (*p - '0');
+    ++p;
+  }
+  if (p != end || p == first || p - first > 18) return false;
+  out = negative ? -v : v;
+  return true;
+}
+
+}  // namespace csv_internal
+
+inline bool CsvReader::Next() {
+  using csv_internal::IsBlank;
+  const char* const data = text_.data();
+  const char* const end = data + text_.size();
+  for (;;) {
+    const char* const b = data + pos_;
+    if (b >= end) return false;
+    line_ = next_line_++;
+    const char c0 = *b;
+    if ((c0 == '#' || c0 == '\n' || c0 == '\r' || IsBlank(c0)) && SkipIfBlankOrComment(b)) continue;
+    // One pass: split at commas up to the line end.
+    const std::size_t expected = cells_.size();
+    std::string_view* const cells = cells_.data();
+    std::size_t n = 0;
+    const char* c = b;
+    const char* e = b;
+    for (;;) {
+      while (e < end && *e != ',' && *e != '\n') ++e;
+      if (n < expected) {
+        cells[n] = std::string_view(c, static_cast<std::size_t>(e - c));
+      } else if (n == expected) {
+        extra_ = c;
+      }
+      ++n;
+      if (e == end || *e == '\n') break;
+      c = ++e;
+    }
+    pos_ = static_cast<std::size_t>(e - data) + (e < end ? 1 : 0);
+    line_begin_ = b;
+    line_end_ = e > b && e[-1] == '\r' ? e - 1 : e;
+    if (n != expected) FailCellCount(n);
+    // Drop the \r of a CRLF line end and blanks around cells.
+    std::string_view& last = cells[expected - 1];
+    if (!last.empty() && last.back() == '\r') last.remove_suffix(1);
+    for (std::size_t i = 0; i < expected; ++i) {
+      std::string_view& s = cells[i];
+      if (!s.empty() && (IsBlank(s.front()) || IsBlank(s.back()))) {
+        while (!s.empty() && IsBlank(s.front())) s.remove_prefix(1);
+        while (!s.empty() && IsBlank(s.back())) s.remove_suffix(1);
+      }
+    }
+    return true;
+  }
+}
+
+inline bool CsvReader::OptionalNumber(const ResolvedColumn& c, double& out) const {
+  const std::string_view s = cells_[c.index];
+  if (s.empty()) return false;
+  double v = 0.0;
+  if (!csv_internal::ParseSimpleDecimal(s.data(), s.data() + s.size(), v)) v = ParseNumberSlow(c, s);
+  if (c.multiply != 1.0 || c.divide != 1.0) {
+    v = v * c.multiply / c.divide;
+    if (!std::isfinite(v)) FailNumber(c, s, "is infinite or out of range");
+  }
+  out = v;
+  return true;
+}
+
+inline double CsvReader::Number(const ResolvedColumn& c) const {
+  double v = 0.0;
+  if (!OptionalNumber(c, v)) FailEmpty(c);
+  return v;
+}
+
+inline std::int64_t CsvReader::Count(const ResolvedColumn& c) const {
+  const std::string_view s = cells_[c.index];
+  std::int64_t v = 0;
+  if (csv_internal::ParseSimpleCount(s.data(), s.data() + s.size(), v)) return v;
+  return ParseCountSlow(c, s);
+}
+
+inline std::string_view CsvReader::Text(const ResolvedColumn& c) const {
+  const std::string_view s = cells_[c.index];
+  if (s.empty()) FailEmpty(c);
+  if (s.find('"') != std::string_view::npos) FailQuoted(c);
+  return s;
+}
 
 }  // namespace umbmark::io::detail

@@ -2,7 +2,7 @@
 // the header row (ticks_* / dist_* / t_* columns -> trajectory CSV).
 #include "io/data_file.hpp"
 
-#include "io/atomic_write.hpp"
+#include "io/file_text.hpp"
 #include "io/csv_table.hpp"
 #include "io/endpoint_csv.hpp"
 #include "io/trajectory_csv.hpp"
@@ -15,7 +15,8 @@ bool StartsWith(std::string_view s, std::string_view prefix) { return s.substr(0
 }  // namespace
 
 RunFile ReadRunFile(const std::string& path) {
-  const std::string text = ReadWholeFile(path);
+  const detail::FileText file(path);
+  const std::string_view text = file.view();
   bool trajectory = false;
   {
     const detail::CsvReader csv(text, path);  // throws for an empty file

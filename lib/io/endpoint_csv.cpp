@@ -9,7 +9,7 @@
 
 #include "core/angles.hpp"
 #include "core/errors.hpp"
-#include "io/atomic_write.hpp"
+#include "io/file_text.hpp"
 #include "io/csv_table.hpp"
 
 namespace umbmark::io {
@@ -106,6 +106,9 @@ EndpointData ParseEndpointCsv(std::string_view text, const std::string& name) {
   return data;
 }
 
-EndpointData ReadEndpointCsv(const std::string& path) { return ParseEndpointCsv(ReadWholeFile(path), path); }
+EndpointData ReadEndpointCsv(const std::string& path) {
+  const detail::FileText text(path);
+  return ParseEndpointCsv(text.view(), path);
+}
 
 }  // namespace umbmark::io

@@ -12,7 +12,7 @@
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
-#include "io/atomic_write.hpp"
+#include "io/file_text.hpp"
 #include "io/csv_table.hpp"
 
 namespace umbmark::io {
@@ -124,9 +124,13 @@ TrajectoryData ParseTrajectoryCsv(std::string_view text, const std::string& name
   };
 
   while (csv.Next()) {
-    const std::string_view run_id = csv.Text(c_run);
-    const std::string_view direction = csv.Text(c_dir);
+    // Run id and direction are validated (Text) when a run starts; later rows
+    // only compare them with the run's, which they must equal.
+    std::string_view run_id = csv.cell(c_run.index);
+    std::string_view direction = csv.cell(c_dir.index);
     if (run == nullptr || run_id != run->run) {
+      run_id = csv.Text(c_run);
+      direction = csv.Text(c_dir);
       finish_run();
       if (const auto it = finished.find(std::string(run_id)); it != finished.end()) {
         csv.FailCell(c_run.index, fmt::format("run {} appears again after run {}: the rows of a run must be "
@@ -153,6 +157,7 @@ TrajectoryData ParseTrajectoryCsv(std::string_view text, const std::string& name
       run->gt_y_m.reserve(reserve);
       run->gt_theta_rad.reserve(reserve);
     } else if (direction != run->direction) {
+      direction = csv.Text(c_dir);
       csv.FailCell(c_dir.index, fmt::format("direction changes from {} to {} within run {} (a run keeps one direction; give "
                                             "each run its own id)",
                                             QuoteForMessage(run->direction), QuoteForMessage(direction),
@@ -212,6 +217,9 @@ TrajectoryData ParseTrajectoryCsv(std::string_view text, const std::string& name
   return data;
 }
 
-TrajectoryData ReadTrajectoryCsv(const std::string& path) { return ParseTrajectoryCsv(ReadWholeFile(path), path); }
+TrajectoryData ReadTrajectoryCsv(const std::string& path) {
+  const detail::FileText text(path);
+  return ParseTrajectoryCsv(text.view(), path);
+}
 
 }  // namespace umbmark::io
