@@ -204,3 +204,16 @@ TEST_CASE("A cw/ccw label that contradicts the ground truth is an input error", 
   CHECK(r.status == 1);
   CHECK(r.err.find("run 1 is labelled ccw but its ground truth turns") != std::string::npos);
 }
+
+TEST_CASE("Runs in one direction only: exit 1 naming the file", "[cli][bad-input]") {
+  const auto dir = TempDir("onedir");
+  std::ofstream(dir / "cw_only.csv") << "run,direction,ex_m,ey_m,etheta_rad\n1,cw,0.01,0.02,\n2,cw,0.011,0.019,\n";
+  const auto r = RunCli("calibrate " + Q(dir / "cw_only.csv") + " --robot " + Q(kGood / "robot.toml") + " --side 4");
+  CHECK(r.status == 1);
+  CHECK(r.err.rfind((dir / "cw_only.csv").string() + ": UMBmark needs runs in both directions", 0) == 0);
+  // A direction that is not cw/ccw names the line.
+  std::ofstream(dir / "bad_dir.csv") << "run,direction,ex_m,ey_m,etheta_rad\n1,cw,0.01,0.02,\n2,sideways,0.011,0.019,\n";
+  const auto r2 = RunCli("calibrate " + Q(dir / "bad_dir.csv") + " --robot " + Q(kGood / "robot.toml") + " --side 4");
+  CHECK(r2.status == 1);
+  CHECK(r2.err.rfind((dir / "bad_dir.csv").string() + ":3:", 0) == 0);
+}
