@@ -1,0 +1,222 @@
+// Residuals of the refined calibration (calibrate --refine), as templated
+// functors for ceres::AutoDiffCostFunction. Both act on ONE parameter block
+// theta = [E_b, E_d, E_s], all relative to a REFERENCE robot (the recorded
+// parameters the summary reports against):
+//
+//   E_b = b_true / b_ref                                   (eq. 2.4, relative)
+//   E_d = (D_R / D_L)_true / (D_R / D_L)_ref               (eq. 2.3, relative)
+//   E_s = (c_L + c_R) / 2  (Borenstein & Feng's scaling error, section 2.2)
+//   c_L = 2 E_s / (E_d + 1)    = D_L,true / D_L,ref        (eq. 4.31 times E_s)
+//   c_R = 2 E_s / (1/E_d + 1)  = D_R,true / D_R,ref        (eq. 4.32 times E_s)
+//
+// With E_s = 1 this is exactly the classic UMBmark correction (mean of the
+// two factors kept), so fixing E_s fixes the unobservable overall scale.
+// All three are dimensionless and close to 1, which makes the Jacobian's
+// columns directly comparable (identifiability report).
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+#include <ceres/autodiff_cost_function.h>
+#include <ceres/jet.h>
+
+#include "core/angles.hpp"
+#include "kinematics/diff_drive.hpp"
+#include "kinematics/pose2.hpp"
+#include "simulation/commanded_square.hpp"
+
+namespace umbmark {
+
+/// Index of each unknown in theta.
+enum RefineIndex : int { kIndexEb = 0, kIndexEd = 1, kIndexEs = 2, kNumRefineParameters = 3 };
+
+/// Wheel factors from theta (eqs. 4.31, 4.32, scaled by E_s).
+template <typename T>
+void WheelFactors(const T* theta, T* c_L, T* c_R) {
+  const T& E_d = theta[kIndexEd];
+  const T& E_s = theta[kIndexEs];
+  *c_L = T(2.0) * E_s / (E_d + T(1.0));
+  *c_R = T(2.0) * E_s * E_d / (E_d + T(1.0));
+}
+
+/// The double part of a scalar (for branch decisions that must not be
+/// differentiated, such as choosing a 2*pi branch).
+inline double ScalarPart(double v) { return v; }
+template <typename T, int N>
+double ScalarPart(const ceres::Jet<T, N>& v) {
+  return ScalarPart(v.a);
+}
+
+/// Robust losses applied per sampled pose of a trajectory (see below).
+enum class RobustLoss { kNone, kHuber, kCauchy };
+const char* RobustLossToString(RobustLoss l);
+std::optional<RobustLoss> RobustLossFromString(std::string_view s);
+
+/// Per-sample robust reweighting. Ceres applies a LossFunction to a whole
+/// residual block, but one trajectory block holds every sampled pose of a
+/// run (integrating the run once is what keeps the fit O(samples)). So the
+/// loss is applied inside the block, per pose: the pose residual r (3-vector,
+/// metres) becomes r * sqrt(rho(s) / s) with s = |r|^2, whose squared norm is
+/// exactly rho(s). The objective is therefore exactly the robust one,
+/// sum rho(|r_k|^2) / 2; only the Gauss-Newton curvature differs from Ceres'
+/// Triggs correction (same minimum). rho as in ceres/loss_function.h, with
+/// scale a [m]:  Huber  rho = s (s <= a^2), 2 a sqrt(s) - a^2 (s > a^2);
+///               Cauchy rho = a^2 log(1 + s / a^2).
+template <typename T>
+T RobustFactor(const T& s, RobustLoss loss, double a) {
+  using std::log1p;
+  using std::sqrt;
+  const double a2 = a * a;
+  switch (loss) {
+    case RobustLoss::kNone: return T(1.0);
+    case RobustLoss::kHuber: {
+      if (ScalarPart(s) <= a2) return T(1.0);
+      const T root = sqrt(s);
+      return sqrt(T(2.0 * a) / root - T(a2) / s);
+    }
+    case RobustLoss::kCauchy: {
+      const T x = s / T(a2);
+      if (ScalarPart(x) < 1e-8) return sqrt(T(1.0) - x / T(2.0) + x * x / T(3.0));  // log1p(x)/x series
+      return sqrt(log1p(x) / x);
+    }
+  }
+  return T(1.0);
+}
+
+/// Endpoint residual of one square run:
+///   r = sqrt_information * (e_measured - e_model(theta))
+/// e_model = exact return error of the commanded square (commanded_square.hpp)
+/// on the run's own recorded robot, whose true factors are the reference's
+/// times ref/recorded (so sets recorded with different parameters share one
+/// true robot). e = [ex_m, ey_m] or [ex_m, ey_m, etheta_rad]; the measured
+/// heading error is taken on the 2 pi branch nearest the model's.
+class SquareReturnErrorResidual {
+ public:
+  /// to_set = {b_ref/b_rec, D_L,ref/D_L,rec, D_R,ref/D_R,rec} of the run's set.
+  SquareReturnErrorResidual(std::vector<CommandedMotion> motions, double recorded_wheelbase_m,
+                            Eigen::Vector3d to_set, Eigen::VectorXd measured, Eigen::MatrixXd sqrt_information)
+      : motions_(std::move(motions)),
+        recorded_wheelbase_m_(recorded_wheelbase_m),
+        odometry_final_(OdometryOfCommanded(motions_, recorded_wheelbase_m)),
+        to_set_(std::move(to_set)),
+        measured_(std::move(measured)),
+        sqrt_information_(std::move(sqrt_information)) {}
+
+  int num_residuals() const { return static_cast<int>(measured_.size()); }
+
+  template <typename T>
+  bool operator()(const T* theta, T* residuals) const {
+    T c_L, c_R;
+    WheelFactors(theta, &c_L, &c_R);
+    const Pose2T<T> e = PredictReturnError(motions_, recorded_wheelbase_m_, odometry_final_,
+                                           theta[kIndexEb] * T(to_set_[0]), c_L * T(to_set_[1]),
+                                           c_R * T(to_set_[2]));
+    T diff[3] = {T(measured_[0]) - e.x, T(measured_[1]) - e.y, T(0.0)};
+    const int n = num_residuals();
+    if (n == 3) {
+      T d = T(measured_[2]) - e.theta;
+      d -= T(2.0 * kPi * std::round(ScalarPart(d) / (2.0 * kPi)));
+      diff[2] = d;
+    }
+    for (int i = 0; i < n; ++i) {
+      residuals[i] = T(0.0);
+      for (int j = 0; j < n; ++j) residuals[i] += T(sqrt_information_(i, j)) * diff[j];
+    }
+    return true;
+  }
+
+  static ceres::CostFunction* Create(std::vector<CommandedMotion> motions, double recorded_wheelbase_m,
+                                     Eigen::Vector3d to_set, Eigen::VectorXd measured,
+                                     Eigen::MatrixXd sqrt_information) {
+    auto* functor = new SquareReturnErrorResidual(std::move(motions), recorded_wheelbase_m, std::move(to_set),
+                                                  std::move(measured), std::move(sqrt_information));
+    return new ceres::AutoDiffCostFunction<SquareReturnErrorResidual, ceres::DYNAMIC, kNumRefineParameters>(
+        functor, functor->num_residuals());
+  }
+
+ private:
+  const std::vector<CommandedMotion> motions_;
+  const double recorded_wheelbase_m_;
+  const Pose2 odometry_final_;
+  const Eigen::Vector3d to_set_;
+  const Eigen::VectorXd measured_;
+  const Eigen::MatrixXd sqrt_information_;
+};
+
+/// Trajectory residual of one run: the odometry from the encoder samples
+/// under theta, integrated from (0, 0, 0) at the first sample, against the
+/// ground truth in the run's start frame, at the sampled indices:
+///   r_k = f(s_k) * [x_odo - x_gt, y_odo - y_gt, h (theta_odo - theta_gt)]
+/// with h = heading_length_m (metres per radian, so a heading error counts
+/// like the position error it causes over h metres) and f the per-sample
+/// robust factor (RobustFactor). One block per run: the run is integrated
+/// once per evaluation, O(samples).
+class TrajectoryRunResidual {
+ public:
+  struct Sample {
+    std::size_t index = 0;  ///< sample index in the run (>= 1), strictly increasing
+    Pose2 ground_truth;     ///< start frame, continuous heading
+  };
+
+  /// d_left_m[i], d_right_m[i]: wheel travel from sample i to i + 1 under the
+  /// reference robot (true travel = c * these).
+  TrajectoryRunResidual(std::vector<double> d_left_m, std::vector<double> d_right_m, double reference_wheelbase_m,
+                        std::vector<Sample> samples, double heading_length_m, RobustLoss loss, double loss_scale_m,
+                        Integrator integrator)
+      : d_left_m_(std::move(d_left_m)),
+        d_right_m_(std::move(d_right_m)),
+        reference_wheelbase_m_(reference_wheelbase_m),
+        samples_(std::move(samples)),
+        heading_length_m_(heading_length_m),
+        loss_(loss),
+        loss_scale_m_(loss_scale_m),
+        integrator_(integrator) {}
+
+  int num_residuals() const { return static_cast<int>(3 * samples_.size()); }
+
+  template <typename T>
+  bool operator()(const T* theta, T* residuals) const {
+    T c_L, c_R;
+    WheelFactors(theta, &c_L, &c_R);
+    const T wheelbase = theta[kIndexEb] * T(reference_wheelbase_m_);
+    Pose2T<T> pose{T(0.0), T(0.0), T(0.0)};
+    std::size_t at = 0;  // pose is the odometry at sample `at`
+    for (std::size_t k = 0; k < samples_.size(); ++k) {
+      const Sample& s = samples_[k];
+      for (; at < s.index; ++at) {
+        pose = DiffDriveStep(pose, c_L * d_left_m_[at], c_R * d_right_m_[at], wheelbase, integrator_);
+      }
+      T r[3] = {pose.x - T(s.ground_truth.x), pose.y - T(s.ground_truth.y),
+                T(heading_length_m_) * (pose.theta - T(s.ground_truth.theta))};
+      const T f = RobustFactor(r[0] * r[0] + r[1] * r[1] + r[2] * r[2], loss_, loss_scale_m_);
+      for (int i = 0; i < 3; ++i) residuals[3 * k + static_cast<std::size_t>(i)] = f * r[i];
+    }
+    return true;
+  }
+
+  static ceres::CostFunction* Create(std::vector<double> d_left_m, std::vector<double> d_right_m,
+                                     double reference_wheelbase_m, std::vector<Sample> samples,
+                                     double heading_length_m, RobustLoss loss, double loss_scale_m,
+                                     Integrator integrator) {
+    auto* functor = new TrajectoryRunResidual(std::move(d_left_m), std::move(d_right_m), reference_wheelbase_m,
+                                              std::move(samples), heading_length_m, loss, loss_scale_m, integrator);
+    return new ceres::AutoDiffCostFunction<TrajectoryRunResidual, ceres::DYNAMIC, kNumRefineParameters>(
+        functor, functor->num_residuals());
+  }
+
+ private:
+  const std::vector<double> d_left_m_, d_right_m_;
+  const double reference_wheelbase_m_;
+  const std::vector<Sample> samples_;
+  const double heading_length_m_;
+  const RobustLoss loss_;
+  const double loss_scale_m_;
+  const Integrator integrator_;
+};
+
+}  // namespace umbmark

@@ -1,0 +1,163 @@
+// Refined calibration from trajectories with ground truth (see refine.hpp):
+// odometry from the encoder samples under theta vs ground truth in each
+// run's start frame, at sampled poses.
+//
+// Sampling: options.samples_per_run poses per run, at equal steps of the
+// run's travelled distance sum (|dL| + |dR|) / 2 (so a spot turn, where the
+// centre does not move, is still sampled, and a standstill is not), each
+// snapped forward to the next sample with ground truth; the last sample with
+// ground truth is always included. A fixed count per run makes every run
+// weigh the same, however long.
+//
+// Wheel travel is converted with the reference diameters (and each set's
+// ticks_per_rev), so sets recorded with different parameters share one
+// true robot: true travel = c * travel under the reference.
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "calibration/refine.hpp"
+#include "calibration/refine_internal.hpp"
+#include "evaluation/run_track.hpp"
+#include "kinematics/odometry.hpp"
+
+namespace umbmark {
+
+namespace {
+
+struct PreparedRun {
+  std::vector<double> d_left_m, d_right_m;
+  std::vector<TrajectoryRunResidual::Sample> samples;
+};
+
+PreparedRun PrepareRun(const TrajectoryRun& run, const std::string& path, const RobotParams& conversion,
+                       const RobotParams& recorded, const RefineOptions& options) {
+  RunTrack track;
+  try {
+    track = TrackRun(run, conversion, recorded, options.integrator);
+  } catch (const InputError& err) {
+    throw InputError(path, err.line(), err.column(), err.message());
+  }
+  const WheelTravel travel = ComputeWheelTravel(run, conversion, recorded);
+  for (std::size_t i = 0; i < run.size(); ++i) {
+    if (!std::isfinite(travel.left_m[i]) || !std::isfinite(travel.right_m[i])) {
+      throw InputError(path, run.lines.empty() ? 0 : run.lines[i], 0,
+                       fmt::format("run {}: wheel travel is not finite", run.run));
+    }
+  }
+  PreparedRun out;
+  const std::size_t last = track.last_gt;
+  if (last == 0) return out;
+  // Cumulative travelled distance per sample.
+  std::vector<double> s(last + 1, 0.0);
+  for (std::size_t i = 1; i <= last; ++i) {
+    s[i] = s[i - 1] + 0.5 * (std::abs(travel.left_m[i] - travel.left_m[i - 1]) +
+                             std::abs(travel.right_m[i] - travel.right_m[i - 1]));
+  }
+  std::vector<std::size_t> picks;
+  const int n = options.samples_per_run;
+  std::size_t i = 1;
+  for (int j = 1; j <= n && s[last] > 0.0; ++j) {
+    const double target = s[last] * j / n;
+    while (i < last && (s[i] < target || !track.has_ground_truth[i])) ++i;
+    if (picks.empty() || picks.back() < i) picks.push_back(i);
+  }
+  if (picks.empty() || picks.back() != last) picks.push_back(last);
+  for (std::size_t k : picks) out.samples.push_back({k, track.ground_truth[k]});
+  out.d_left_m.resize(last);
+  out.d_right_m.resize(last);
+  for (std::size_t k = 0; k < last; ++k) {
+    out.d_left_m[k] = travel.left_m[k + 1] - travel.left_m[k];
+    out.d_right_m[k] = travel.right_m[k + 1] - travel.right_m[k];
+  }
+  return out;
+}
+
+}  // namespace
+
+RefineSummary RefineFromTrajectories(const std::vector<TrajectoryRunSet>& sets, const RobotParams& reference,
+                                     const RefineOptions& options) {
+  using refine_detail::CovarianceKind;
+  using refine_detail::FitProblem;
+  if (auto e = options.Check(); !e.empty()) throw InvalidOptions(e);
+  if (auto e = reference.Check(); !e.empty()) throw InvalidOptions("reference robot: " + e);
+
+  // ---- step 1: wheel travel and sampled ground truth per run ----
+  std::vector<PreparedRun> prepared;
+  RefineSummary summary;
+  summary.input = RefineInputKind::kTrajectories;
+  summary.reference = reference;
+  for (const TrajectoryRunSet& set : sets) {
+    if (set.data == nullptr) throw InvalidOptions("TrajectoryRunSet::data is null");
+    const std::string& path = set.data->path;
+    if (auto e = set.recorded.Check(); !e.empty()) throw InputError(path, "recorded robot: " + e);
+    RobotParams conversion = set.recorded;  // its ticks_per_rev, the reference diameters
+    conversion.wheel_diameter_left_m = reference.wheel_diameter_left_m;
+    conversion.wheel_diameter_right_m = reference.wheel_diameter_right_m;
+    for (const TrajectoryRun& run : set.data->runs) {
+      PreparedRun p = PrepareRun(run, path, conversion, set.recorded, options);
+      if (p.samples.empty()) {
+        summary.notes.push_back(fmt::format("{}: run {} skipped (ground truth at its first sample only)", path,
+                                            run.run));
+        continue;
+      }
+      summary.sampled_poses += static_cast<int>(p.samples.size());
+      prepared.push_back(std::move(p));
+    }
+  }
+  if (prepared.empty()) {
+    throw InputError(sets.empty() || !sets.front().data ? "" : sets.front().data->path,
+                     "no trajectory run with ground truth beyond its first sample to refine");
+  }
+  summary.runs = static_cast<int>(prepared.size());
+  const double heading_length = options.heading_length_m > 0.0 ? options.heading_length_m : reference.wheelbase_m;
+
+  // ---- step 2: build, solve and assess (E_s free unless fixed) ----
+  auto attempt = [&](bool scale_free) {
+    FitProblem fit;
+    fit.theta[kIndexEb] = options.start.E_b;
+    fit.theta[kIndexEd] = options.start.E_d;
+    fit.theta[kIndexEs] = options.start.E_s;
+    fit.scale_free = scale_free;
+    for (const PreparedRun& p : prepared) {
+      ceres::CostFunction* cost =
+          TrajectoryRunResidual::Create(p.d_left_m, p.d_right_m, reference.wheelbase_m, p.samples, heading_length,
+                                        options.loss, options.loss_scale_m, options.integrator);
+      fit.problem->AddResidualBlock(cost, nullptr, fit.theta);
+      fit.blocks.push_back(cost);
+    }
+    const int p = scale_free ? 3 : 2;
+    RefineSummary s = summary;
+    CovarianceKind kind = CovarianceKind::kSolverScaled;
+    std::optional<double> dof;
+    if (options.covariance == TrajectoryCovariance::kRunClustered) {
+      if (summary.runs >= p + 2) {
+        kind = CovarianceKind::kRunClustered;
+        dof = summary.runs - 1;
+      } else {
+        s.notes.push_back(fmt::format(
+            "only {} runs: the run-clustered covariance needs at least {}, so the solver covariance scaled by the "
+            "residual variance is reported (optimistic: poses along a run are correlated)",
+            summary.runs, p + 2));
+      }
+    }
+    refine_detail::SolveAndAssess(fit, options, kind, dof, &s);
+    return s;
+  };
+
+  if (options.scale == ScaleMode::kFixed) return attempt(false);
+  if (options.scale == ScaleMode::kFree) return attempt(true);
+  try {
+    return attempt(true);
+  } catch (const RefineError& err) {
+    const auto& und = err.summary().identifiability.undetermined;
+    const bool scale_weak = std::find(und.begin(), und.end(), "E_s") != und.end();
+    if (!scale_weak) throw;
+    summary.notes.push_back(fmt::format(
+        "overall scale E_s held at {} (scale auto): with it free the fit reported: {}", options.start.E_s,
+        err.summary().identifiability.message));
+    return attempt(false);
+  }
+}
+
+}  // namespace umbmark
