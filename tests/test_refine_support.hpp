@@ -1,15 +1,12 @@
 // Test helpers for the refined calibration: a seeded simulator of commanded
 // UMBmark squares (return errors and full trajectories) with white wheel
 // noise of variance k^2 |travel| per wheel (Chong & Kleeman), built on the
-// exact commanded-square model, and a small loader of OptiOdom run files.
+// exact commanded-square model.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <filesystem>
-#include <fstream>
 #include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -119,76 +116,6 @@ inline TrajectoryRun SimulateSquareTrajectory(SquareDirection dir, double side_m
     }
   }
   return run;
-}
-
-/// Loads one OptiOdom dataset folder with a minimal local reader (no header;
-/// time, x_gt, y_gt, theta_gt, right tick increment, left tick increment; the
-/// first row's increments belong to before the run). Direction from the
-/// ground-truth total rotation.
-struct OptiOdomSet {
-  RobotParams robot;
-  double side_m = 0.0;
-  TrajectoryData data;
-};
-
-inline std::vector<std::string> SplitCsv(const std::string& line) {
-  std::vector<std::string> f;
-  std::stringstream ss(line);
-  std::string cell;
-  while (std::getline(ss, cell, ',')) f.push_back(cell);
-  return f;
-}
-
-inline OptiOdomSet LoadOptiOdom(const std::filesystem::path& dir) {
-  namespace fs = std::filesystem;
-  OptiOdomSet out;
-  const std::string id = dir.filename().string();
-  out.data.path = dir.string();
-  double ngear = 0.0, enc = 0.0;
-  std::ifstream meta(dir / (id + "_metadata.csv"));
-  for (std::string line; std::getline(meta, line);) {
-    const auto f = SplitCsv(line);
-    if (f.size() < 2 || f[1].empty()) continue;
-    if (f[0] == "ngear") ngear = std::stod(f[1]);
-    if (f[0] == "encRes") enc = std::stod(f[1]);
-    if (f[0] == "Li") out.robot.wheelbase_m = std::stod(f[1]);
-    if (f[0] == "Di") {
-      out.robot.wheel_diameter_right_m = std::stod(f[1]);
-      out.robot.wheel_diameter_left_m = std::stod(f[2]);
-    }
-    if (f[0] == "L") out.side_m = std::stod(f[1]);
-  }
-  out.robot.ticks_per_rev = ngear * enc;
-  std::vector<fs::path> files;
-  for (const auto& e : fs::directory_iterator(dir)) {
-    if (e.path().filename().string().find("_run-") != std::string::npos) files.push_back(e.path());
-  }
-  std::sort(files.begin(), files.end());
-  for (const auto& file : files) {
-    TrajectoryRun run;
-    run.run = file.stem().string();
-    std::ifstream in(file);
-    std::int64_t tl = 0, tr = 0;
-    for (std::string line; std::getline(in, line);) {
-      const auto f = SplitCsv(line);
-      if (f.size() < 6) continue;
-      if (!run.t_s.empty()) {
-        tr += static_cast<std::int64_t>(std::llround(std::stod(f[4])));
-        tl += static_cast<std::int64_t>(std::llround(std::stod(f[5])));
-      }
-      run.t_s.push_back(std::stod(f[0]));
-      run.gt_x_m.push_back(std::stod(f[1]));
-      run.gt_y_m.push_back(std::stod(f[2]));
-      run.gt_theta_rad.push_back(std::stod(f[3]));
-      run.ticks_left.push_back(tl);
-      run.ticks_right.push_back(tr);
-      run.lines.push_back(run.t_s.size());
-    }
-    const double total = run.gt_theta_rad.back() - run.gt_theta_rad.front();
-    run.direction = total < 0.0 ? "cw" : "ccw";
-    out.data.runs.push_back(std::move(run));
-  }
-  return out;
 }
 
 }  // namespace umbmark::test
