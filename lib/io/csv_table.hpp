@@ -183,13 +183,14 @@ inline bool ParseSimpleCount(const char* p, const char* end, std::int64_t& out) 
   const bool negative = p < end && *p == '-';
   if (negative) ++p;
   const char* const first = p;
-  std::int64_t v = 0;
+  std::uint64_t v = 0;  // unsigned: wraps harmlessly past 18 digits, then rejected
   while (p < end && IsDigit(*p)) {
-    v = v * 10 + (*p - '0');
+    v = v * 10 + static_cast<std::uint64_t>(*p - '0');
     ++p;
   }
   if (p != end || p == first || p - first > 18) return false;
-  out = negative ? -v : v;
+  const auto s = static_cast<std::int64_t>(v);
+  out = negative ? -s : s;
   return true;
 }
 

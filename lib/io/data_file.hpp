@@ -1,6 +1,7 @@
-// Loads a run file of either contract format, deciding by its header:
-// a trajectory CSV has t_s (or t_*) and ticks_*/dist_* columns; otherwise it
-// is an endpoint CSV.
+// Loads a run file of either contract format, deciding by its header: a
+// header with any ticks_*, dist_* or t_* (t_s) column is a trajectory CSV
+// (so a file with a wrong time unit or a missing wheel column gets the
+// trajectory reader's message); otherwise it is an endpoint CSV.
 #pragma once
 
 #include <string>

@@ -1,0 +1,102 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (fuzz/*.cpp) with clang++ and runs each for
+# FUZZ_SECONDS (default 60), seeded from the test data (tests/data/good,
+# tests/data/bad, the shipped example data). Fails on any crash, sanitizer
+# report, timeout or out-of-memory; the reproducer is left in
+# $FUZZ_BUILD_DIR/artifacts/.
+#   env: FUZZ_SECONDS (60), FUZZ_BUILD_DIR (build-fuzz), FUZZ_CXX (clang++)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+seconds=${FUZZ_SECONDS:-60}
+build=${FUZZ_BUILD_DIR:-build-fuzz}
+cxx=${FUZZ_CXX:-clang++}
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+
+CXX=$cxx cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DUMBMARK_BUILD_FUZZ=ON -DUMBMARK_BUILD_TESTS=OFF -DUMBMARK_BUILD_BENCH=OFF
+targets=()
+for src in fuzz/*.cpp; do targets+=("$(basename "$src" .cpp)"); done
+cmake --build "$build" --target "${targets[@]}" -j"${FUZZ_JOBS:-2}"
+
+# Dictionaries: the tokens a mutator would take long to find by itself.
+cat > "$build/csv.dict" <<'DICT'
+"run"
+"direction"
+"t_s"
+"ticks_left"
+"ticks_right"
+"dist_left_m"
+"dist_right_m"
+"x_gt_m"
+"y_gt_m"
+"theta_gt_rad"
+"ex_m"
+"ey_m"
+"etheta_rad"
+"x_abs_m"
+"theta_odo_rad"
+"_mm"
+"_deg"
+","
+",,,"
+"\x0d\x0a"
+"\x0a"
+"#"
+"\xef\xbb\xbf"
+"nan"
+"inf"
+"e308"
+"-9223372036854775808"
+"1073741824"
+"\""
+DICT
+cat > "$build/toml.dict" <<'DICT'
+"wheelbase_m"
+"wheel_diameter_left_m"
+"wheel_diameter_right_m"
+"ticks_per_rev"
+"[robot]"
+"[[experiment]]"
+"[ground_truth]"
+"kind"
+"\"square\""
+"\"back_and_forth\""
+"\"free\""
+"side_m"
+"distance_m"
+"file"
+"sigma_xy_m"
+"sigma_theta_rad"
+" = "
+"nan"
+"inf"
+DICT
+
+status=0
+for target in "${targets[@]}"; do
+  seeds="$build/seeds/$target"
+  corpus="$build/corpus/$target"
+  mkdir -p "$seeds" "$corpus" "$build/artifacts"
+  case $target in
+    fuzz_csv)
+      dict=csv.dict
+      find tests/data data -maxdepth 3 -type f \( -name '*.csv' -o -name '*.bin' \) -size -64k \
+        -exec cp {} "$seeds/" \; ;;
+    fuzz_toml)
+      dict=toml.dict
+      find tests/data data -maxdepth 3 -type f -name '*.toml' -exec cp {} "$seeds/" \; ;;
+    *) dict="" ;;
+  esac
+  echo "== $target: $(ls "$seeds" | wc -l) seed files, ${seconds} s"
+  args=(-max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=16384 -print_final_stats=1
+        -artifact_prefix="$build/artifacts/$target-")
+  if [[ -n $dict ]]; then args+=(-dict="$build/$dict"); fi
+  if ! "$build/$target" "${args[@]}" "$corpus" "$seeds" 2>&1 | tail -n 40; then
+    echo "FUZZ FAILURE in $target; reproducers:" >&2
+    ls -l "$build/artifacts" >&2 || true
+    status=1
+  fi
+done
+exit $status
