@@ -20,5 +20,6 @@ struct Command {
 Command SetupCalibrate(CLI::App& parent);
 Command SetupEvaluate(CLI::App& parent);
 Command SetupImport(CLI::App& parent);
+Command SetupSimulate(CLI::App& parent);
 
 }  // namespace umbmark::cli

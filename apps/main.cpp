@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   commands.push_back(cli::SetupCalibrate(app));
   commands.push_back(cli::SetupEvaluate(app));
   commands.push_back(cli::SetupImport(app));
+  commands.push_back(cli::SetupSimulate(app));
 
   try {
     app.parse(argc, argv);

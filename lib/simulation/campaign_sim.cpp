@@ -1,0 +1,376 @@
+// Campaign simulator (see campaign_sim.hpp): plans per experiment kind, the
+// true robot per run, and the writers.
+#include "simulation/campaign_sim.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <set>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/angles.hpp"
+#include "core/errors.hpp"
+#include "evaluation/return_error.hpp"
+#include "io/atomic_write.hpp"
+#include "io/campaign_writer.hpp"
+#include "kinematics/odometry.hpp"
+#include "simulation/campaign_run.hpp"
+#include "simulation/effects_motion.hpp"
+
+namespace umbmark::sim {
+
+namespace {
+
+PlannedMotion Pause(double seconds) {
+  PlannedMotion m;
+  m.pause = true;
+  m.duration_s = seconds;
+  return m;
+}
+
+PlannedMotion Move(MotionClass cls, double left_m, double right_m, double duration_s) {
+  PlannedMotion m;
+  m.cls = cls;
+  m.left_m = left_m;
+  m.right_m = right_m;
+  m.duration_s = duration_s;
+  m.from_standstill = true;
+  return m;
+}
+
+RunPlan SquarePlan(bool clockwise, double side_m, double wheelbase_m, const CampaignSimOptions& o) {
+  RunPlan plan;
+  plan.sample_rate_hz = o.sample_rate_hz;
+  const double phi = clockwise ? -kPi / 2.0 : kPi / 2.0;
+  const double wheel = 0.5 * wheelbase_m * phi;  // right wheel travel of the spot turn
+  plan.motions.push_back(Pause(o.pause_s));
+  for (int leg = 0; leg < 4; ++leg) {
+    plan.motions.push_back(Move(MotionClass::kStraight, side_m, side_m, side_m / o.speed_m_s));
+    plan.motions.push_back(Pause(o.pause_s));
+    plan.motions.push_back(Move(MotionClass::kTurn, -wheel, wheel, std::abs(phi) / o.turn_rate_rad_s));
+    plan.motions.push_back(Pause(o.pause_s));
+  }
+  return plan;
+}
+
+RunPlan BackAndForthPlan(double distance_m, const CampaignSimOptions& o) {
+  RunPlan plan;
+  plan.sample_rate_hz = o.sample_rate_hz;
+  plan.motions.push_back(Pause(o.pause_s));
+  plan.motions.push_back(Move(MotionClass::kStraight, distance_m, distance_m, distance_m / o.speed_m_s));
+  plan.motions.push_back(Pause(o.pause_s));
+  plan.motions.push_back(Move(MotionClass::kStraight, -distance_m, -distance_m, distance_m / o.speed_m_s));
+  plan.motions.push_back(Pause(o.pause_s));
+  return plan;
+}
+
+RunPlan FigureEightPlan(double radius_m, double wheelbase_m, const CampaignSimOptions& o) {
+  RunPlan plan;
+  plan.sample_rate_hz = o.sample_rate_hz;
+  const double inner = 2.0 * kPi * (radius_m - 0.5 * wheelbase_m);
+  const double outer = 2.0 * kPi * (radius_m + 0.5 * wheelbase_m);
+  const double duration = outer / o.speed_m_s;
+  const MotionClass cls = ClassifyMotion(inner, outer, wheelbase_m);
+  plan.motions.push_back(Pause(o.pause_s));
+  plan.motions.push_back(Move(cls, inner, outer, duration));
+  plan.motions.push_back(Pause(o.pause_s));
+  plan.motions.push_back(Move(cls, outer, inner, duration));
+  plan.motions.push_back(Pause(o.pause_s));
+  return plan;
+}
+
+/// Replays a recorded run: one planned step per sample interval with the
+/// recorded nominal wheel travel and timing; motions and standstill as
+/// SegmentMotions finds them.
+RunPlan ReplayPlan(const TrajectoryRun& run, const RobotParams& robot) {
+  const WheelTravel travel = ComputeWheelTravel(run, robot, robot);
+  MotionOptions mo;
+  if (run.has_ticks()) mo.stand_eps_m = 0.5 * std::min(robot.MetresPerTickLeft(), robot.MetresPerTickRight());
+  const std::vector<MotionSegment> motions = SegmentMotions(travel.left_m, travel.right_m, robot.wheelbase_m, mo);
+  RunPlan plan;
+  const std::size_t n = run.size();
+  plan.sample_times.resize(n);
+  for (std::size_t j = 0; j < n; ++j) plan.sample_times[j] = run.t_s[j] - run.t_s[0];
+  std::size_t next_motion = 0;
+  for (std::size_t i = 0; i + 1 < n; ++i) {
+    const double dt = plan.sample_times[i + 1] - plan.sample_times[i];
+    while (next_motion < motions.size() && motions[next_motion].last_interval < i) ++next_motion;
+    const bool inside = next_motion < motions.size() && motions[next_motion].first_interval <= i;
+    if (!inside) {
+      plan.motions.push_back(Pause(dt));
+      continue;
+    }
+    const MotionSegment& m = motions[next_motion];
+    PlannedMotion step = Move(m.cls, travel.left_m[i + 1] - travel.left_m[i], travel.right_m[i + 1] - travel.right_m[i], dt);
+    step.from_standstill = i == m.first_interval;
+    if (step.from_standstill && m.cls != MotionClass::kTurn) {
+      // The kick's direction is the motion's, not this first step's.
+      const double sgn = m.left_m + m.right_m >= 0.0 ? 1.0 : -1.0;
+      if ((step.left_m + step.right_m) * sgn < 0.0) step.from_standstill = false;
+    }
+    plan.motions.push_back(step);
+  }
+  return plan;
+}
+
+}  // namespace
+
+std::string CampaignTruth::Check() const {
+  if (!(E_d > 0.0) || !std::isfinite(E_d)) return fmt::format("E_d = {} must be a finite number > 0", E_d);
+  if (!(E_b > 0.0) || !std::isfinite(E_b)) return fmt::format("E_b = {} must be a finite number > 0", E_b);
+  if (!(k_L >= 0.0) || !std::isfinite(k_L)) return fmt::format("k_L = {} must be a finite number >= 0", k_L);
+  if (!(k_R >= 0.0) || !std::isfinite(k_R)) return fmt::format("k_R = {} must be a finite number >= 0", k_R);
+  return {};
+}
+
+std::string CampaignSimOptions::Check() const {
+  if (auto e = truth.Check(); !e.empty()) return "truth: " + e;
+  if (auto e = effects.Check(); !e.empty()) return e;
+  if (square_runs_per_direction < 1)
+    return fmt::format("square_runs_per_direction = {} must be >= 1", square_runs_per_direction);
+  if (back_and_forth_runs < 1) return fmt::format("back_and_forth_runs = {} must be >= 1", back_and_forth_runs);
+  if (free_runs < 1) return fmt::format("free_runs = {} must be >= 1", free_runs);
+  auto positive = [](const char* name, double v) -> std::string {
+    if (!(v > 0.0) || !std::isfinite(v)) return fmt::format("{} = {} must be a finite number > 0", name, v);
+    return {};
+  };
+  if (auto e = positive("sample_rate_hz", sample_rate_hz); !e.empty()) return e;
+  if (auto e = positive("speed_m_s", speed_m_s); !e.empty()) return e;
+  if (auto e = positive("turn_rate_rad_s", turn_rate_rad_s); !e.empty()) return e;
+  if (auto e = positive("free_radius_m", free_radius_m); !e.empty()) return e;
+  if (!(pause_s >= 0.0) || !std::isfinite(pause_s)) return fmt::format("pause_s = {} must be >= 0", pause_s);
+  if (ground_truth) {
+    if (!(ground_truth->sigma_xy_m >= 0.0) || !std::isfinite(ground_truth->sigma_xy_m))
+      return fmt::format("ground_truth.sigma_xy_m = {} must be >= 0", ground_truth->sigma_xy_m);
+    if (!(ground_truth->sigma_theta_rad >= 0.0) || !std::isfinite(ground_truth->sigma_theta_rad))
+      return fmt::format("ground_truth.sigma_theta_rad = {} must be >= 0", ground_truth->sigma_theta_rad);
+  }
+  return {};
+}
+
+SimulatedCampaign SimulateCampaign(const Manifest& manifest, const CampaignSimOptions& options,
+                                   const std::vector<std::optional<TrajectoryData>>& free_templates) {
+  if (auto e = options.Check(); !e.empty()) throw InvalidOptions("simulate: " + e);
+  const RobotParams& robot = manifest.robot;
+  if (auto e = robot.Check(); !e.empty()) throw InvalidOptions("simulate: robot: " + e);
+  const bool ticks = robot.ticks_per_rev.has_value();
+
+  // Run plans per experiment, then the campaign's run count (drift check).
+  struct PlannedRun {
+    RunPlan plan;
+    std::string id, direction;
+  };
+  std::vector<std::vector<PlannedRun>> plans(manifest.experiments.size());
+  for (std::size_t e = 0; e < manifest.experiments.size(); ++e) {
+    const Experiment& ex = manifest.experiments[e];
+    auto& list = plans[e];
+    switch (ex.kind) {
+      case ExperimentKind::kSquare:
+        for (int i = 0; i < 2 * options.square_runs_per_direction; ++i) {
+          const bool cw = i % 2 == 0;
+          list.push_back({SquarePlan(cw, ex.side_m, robot.wheelbase_m, options), std::to_string(i + 1),
+                          cw ? "cw" : "ccw"});
+        }
+        break;
+      case ExperimentKind::kBackAndForth:
+        for (int i = 0; i < options.back_and_forth_runs; ++i)
+          list.push_back({BackAndForthPlan(ex.distance_m, options), std::to_string(i + 1), "fwd_back"});
+        break;
+      case ExperimentKind::kFree:
+        if (e < free_templates.size() && free_templates[e]) {
+          for (const TrajectoryRun& r : free_templates[e]->runs) {
+            if (r.size() < 2) continue;
+            list.push_back({ReplayPlan(r, robot), r.run, r.direction});
+          }
+          if (list.empty()) throw InvalidOptions(fmt::format("simulate: free experiment {} template has no runs", e + 1));
+        } else {
+          if (!(options.free_radius_m > 0.5 * robot.wheelbase_m))
+            throw InvalidOptions(fmt::format("simulate: free_radius_m = {} must exceed half the wheelbase ({})",
+                                             options.free_radius_m, 0.5 * robot.wheelbase_m));
+          for (int i = 0; i < options.free_runs; ++i)
+            list.push_back({FigureEightPlan(options.free_radius_m, robot.wheelbase_m, options), std::to_string(i + 1),
+                            "figure_eight"});
+        }
+        break;
+    }
+  }
+  int total = 0;
+  for (const auto& l : plans) total += static_cast<int>(l.size());
+  const double last_drift = 1.0 + options.effects.drift_r * static_cast<double>(std::max(0, total - 1));
+  if (!(last_drift > 0.0))
+    throw InvalidOptions(fmt::format("simulate: parameter_drift.r = {} makes the right wheel diameter <= 0 by run {}",
+                                     options.effects.drift_r, total - 1));
+
+  const CampaignTruth& tr = options.truth;
+  const double c_L = 2.0 / (tr.E_d + 1.0), c_R = 2.0 / (1.0 / tr.E_d + 1.0);
+  const double scale = 1.0 + options.effects.scale_s;
+  GroundTruthNoise gt;
+  if (options.ground_truth)
+    gt = *options.ground_truth;
+  else if (manifest.ground_truth)
+    gt = *manifest.ground_truth;
+
+  SimulatedCampaign out;
+  out.manifest = manifest;
+  out.manifest.ground_truth = options.state_ground_truth ? std::optional<GroundTruthNoise>(gt) : std::nullopt;
+  out.ground_truth_noise = gt;
+  out.total_runs = total;
+  out.seed = options.seed;
+  out.bumps.resize(manifest.experiments.size());
+
+  RunTruth truth;
+  truth.ticks = ticks;
+  truth.nominal_per_tick_left = ticks ? robot.MetresPerTickLeft() : 1.0;
+  truth.nominal_per_tick_right = ticks ? robot.MetresPerTickRight() : 1.0;
+  truth.true_wheelbase_m = tr.E_b * robot.wheelbase_m;
+  truth.k_L = tr.k_L;
+  truth.k_R = tr.k_R;
+  truth.effects = options.effects;
+  truth.gt_sigma_xy_m = gt.sigma_xy_m;
+  truth.gt_sigma_theta_rad = gt.sigma_theta_rad;
+
+  std::uint64_t run_index = 0;
+  for (std::size_t e = 0; e < manifest.experiments.size(); ++e) {
+    const Experiment& ex = manifest.experiments[e];
+    TrajectoryData data;
+    data.path = ex.file;
+    for (const PlannedRun& pr : plans[e]) {
+      const double drift = 1.0 + options.effects.drift_r * static_cast<double>(run_index);
+      truth.true_per_tick_left = truth.nominal_per_tick_left * c_L * scale;
+      truth.true_per_tick_right = truth.nominal_per_tick_right * c_R * scale * drift;
+      SimulatedRun sr = SimulateRun(pr.plan, truth, options.seed, run_index, pr.id, pr.direction);
+      out.bumps[e].push_back(sr.bumps_left + sr.bumps_right);
+      data.runs.push_back(std::move(sr.run));
+      ++run_index;
+    }
+    if (ex.kind == ExperimentKind::kSquare && options.endpoint_squares) {
+      EndpointData ep;
+      ep.path = ex.file;
+      for (const ReturnError& r : ReturnErrorsFromTrajectories(data, robot, robot, Integrator::kArc)) {
+        EndpointRun er;
+        er.run = r.run;
+        er.direction = r.direction;
+        er.ex_m = r.ex_m;
+        er.ey_m = r.ey_m;
+        er.etheta_rad = r.etheta_rad;
+        ep.runs.push_back(er);
+      }
+      out.data.emplace_back(std::move(ep));
+    } else {
+      out.data.emplace_back(std::move(data));
+    }
+  }
+  return out;
+}
+
+std::string FormatEndpointCsv(const EndpointData& data, const std::vector<std::string>& comment) {
+  std::string out;
+  for (const auto& line : comment) out += "# " + line + "\n";
+  out += "run,direction,ex_m,ey_m,etheta_rad\n";
+  for (const auto& r : data.runs) {
+    out += fmt::format("{},{},{},{},", r.run, r.direction, r.ex_m, r.ey_m);
+    if (r.etheta_rad) out += fmt::format("{}", *r.etheta_rad);
+    out += "\n";
+  }
+  return out;
+}
+
+std::string WriteCampaign(const SimulatedCampaign& campaign, const std::string& dir,
+                          const std::vector<std::string>& comment) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) throw InputError(dir, "cannot create output directory: " + ec.message());
+  std::set<std::string> names = {"campaign.toml"};
+  for (std::size_t e = 0; e < campaign.manifest.experiments.size(); ++e) {
+    const std::string& file = campaign.manifest.experiments[e].file;
+    const fs::path rel = fs::path(file).lexically_normal();
+    if (rel.is_absolute() || rel.empty() || *rel.begin() == "..")
+      throw InputError(campaign.manifest.path,
+                       fmt::format("experiment {}: file '{}' must be a relative path inside the output directory",
+                                   e + 1, file));
+    if (!names.insert(rel.string()).second)
+      throw InputError(campaign.manifest.path,
+                       fmt::format("experiment {}: file '{}' is used twice (or is campaign.toml)", e + 1, file));
+  }
+  for (std::size_t e = 0; e < campaign.manifest.experiments.size(); ++e) {
+    const fs::path target = fs::path(dir) / campaign.manifest.experiments[e].file;
+    fs::create_directories(target.parent_path(), ec);
+    const auto& d = campaign.data[e];
+    if (const auto* t = std::get_if<TrajectoryData>(&d))
+      io::WriteFileAtomically(target.string(), io::FormatTrajectoryCsv(*t, comment));
+    else
+      io::WriteFileAtomically(target.string(), FormatEndpointCsv(std::get<EndpointData>(d), comment));
+  }
+  const std::string manifest_path = (fs::path(dir) / "campaign.toml").string();
+  io::WriteFileAtomically(manifest_path, io::FormatManifest(campaign.manifest, comment));
+  return manifest_path;
+}
+
+nlohmann::json CampaignTruthJson(const SimulatedCampaign& campaign, const CampaignSimOptions& options) {
+  const CampaignTruth& tr = options.truth;
+  const RobotParams& robot = campaign.manifest.robot;
+  const double c_L = 2.0 / (tr.E_d + 1.0), c_R = 2.0 / (1.0 / tr.E_d + 1.0);
+  const double scale = 1.0 + options.effects.scale_s;
+  nlohmann::json effects = nlohmann::json::array();
+  for (EffectKind k : options.effects.ActiveKinds()) {
+    const EffectDescriptor& d = Describe(k);
+    nlohmann::json params = nlohmann::json::object();
+    for (const auto& p : d.parameters) params[std::string(p.name)] = options.effects.*(p.field);
+    effects.push_back({{"effect", std::string(d.name)}, {"params", params}, {"in_contract", d.in_contract}});
+  }
+  nlohmann::json experiments = nlohmann::json::array();
+  for (std::size_t e = 0; e < campaign.manifest.experiments.size(); ++e) {
+    const auto& d = campaign.data[e];
+    const std::size_t runs = std::holds_alternative<TrajectoryData>(d) ? std::get<TrajectoryData>(d).runs.size()
+                                                                       : std::get<EndpointData>(d).runs.size();
+    experiments.push_back({{"kind", ExperimentKindToString(campaign.manifest.experiments[e].kind)},
+                           {"file", campaign.manifest.experiments[e].file},
+                           {"runs", runs}});
+  }
+  return {{"seed", campaign.seed},
+          {"truth",
+           {{"E_d", tr.E_d},
+            {"E_b", tr.E_b},
+            {"k_L", tr.k_L},
+            {"k_R", tr.k_R},
+            {"c_L", c_L},
+            {"c_R", c_R},
+            {"true_robot_run0",
+             {{"wheelbase_m", tr.E_b * robot.wheelbase_m},
+              {"wheel_diameter_left_m", c_L * scale * robot.wheel_diameter_left_m},
+              {"wheel_diameter_right_m", c_R * scale * robot.wheel_diameter_right_m}}}}},
+          {"effects", effects},
+          {"ground_truth",
+           {{"sigma_xy_m", campaign.ground_truth_noise.sigma_xy_m},
+            {"sigma_theta_rad", campaign.ground_truth_noise.sigma_theta_rad},
+            {"stated_in_manifest", campaign.manifest.ground_truth.has_value()}}},
+          {"total_runs", campaign.total_runs},
+          {"experiments", experiments},
+          {"motion",
+           {{"sample_rate_hz", options.sample_rate_hz},
+            {"speed_m_s", options.speed_m_s},
+            {"turn_rate_rad_s", options.turn_rate_rad_s},
+            {"pause_s", options.pause_s},
+            {"free_radius_m", options.free_radius_m}}}};
+}
+
+Manifest StandardCampaignManifest(const RobotParams& robot, double side_m, double distance_m,
+                                  const std::optional<GroundTruthNoise>& ground_truth) {
+  Manifest m;
+  m.robot = robot;
+  Experiment sq;
+  sq.kind = ExperimentKind::kSquare;
+  sq.side_m = side_m;
+  sq.file = sq.resolved_file = "square.csv";
+  Experiment bf;
+  bf.kind = ExperimentKind::kBackAndForth;
+  bf.distance_m = distance_m;
+  bf.file = bf.resolved_file = "fwd_back.csv";
+  m.experiments = {sq, bf};
+  m.ground_truth = ground_truth;
+  return m;
+}
+
+}  // namespace umbmark::sim

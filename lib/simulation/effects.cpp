@@ -1,0 +1,173 @@
+// Effect catalogue, checks and "NAME:k=v,..." parsing (see effects.hpp).
+#include "simulation/effects.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "core/errors.hpp"
+
+namespace umbmark::sim {
+
+const std::vector<EffectDescriptor>& EffectCatalogue() {
+  static const std::vector<EffectDescriptor> catalogue = {
+      {EffectKind::kScaleError, "scale_error", {{"s", &Effects::scale_s, ""}}, true,
+       "both true wheel diameters are (1 + s) times the model's"},
+      {EffectKind::kTurnScrub, "turn_scrub", {{"k", &Effects::scrub_k, ""}}, true,
+       "in on-the-spot turns the true heading change is (1 - k) times what the true wheel travel implies"},
+      {EffectKind::kDirectionAsymmetry, "direction_asymmetry", {{"a", &Effects::asymmetry_a, ""}}, true,
+       "a wheel turning backwards has (1 + a) times its forward effective diameter"},
+      {EffectKind::kCastorKick, "castor_kick", {{"kappa", &Effects::castor_kappa, "rad"}}, true,
+       "at every start from standstill the true heading jumps by kappa (forward) or -kappa (backward); spot "
+       "turns excluded"},
+      {EffectKind::kBumpOutliers,
+       "bump_outliers",
+       {{"rate", &Effects::bump_rate, "1/m"}, {"sigma", &Effects::bump_sigma, "m"}},
+       true,
+       "per wheel, Poisson bumps with `rate` per metre of travel, each adding N(0, sigma^2) m of travel"},
+      {EffectKind::kCorrelatedNoise, "correlated_noise", {{"rho", &Effects::noise_rho, ""}}, true,
+       "left and right random wheel errors have correlation rho"},
+      {EffectKind::kParameterDrift, "parameter_drift", {{"r", &Effects::drift_r, "1/run"}}, true,
+       "in run i of the campaign the true right wheel diameter is (1 + r i) times run 0's"},
+      {EffectKind::kGtOffset,
+       "gt_offset",
+       {{"dx", &Effects::gt_dx, "m"}, {"dy", &Effects::gt_dy, "m"}},
+       true,
+       "ground truth reports the point (dx, dy) of the robot frame instead of the axle midpoint"},
+      {EffectKind::kTimeOffset, "time_offset", {{"tau", &Effects::time_tau, "s"}}, true,
+       "a ground-truth sample stamped t shows the true pose at t - tau"},
+      {EffectKind::kGtYawMisalignment, "gt_yaw_misalignment", {{"delta", &Effects::yaw_delta, "rad"}}, false,
+       "(outside the contract) ground-truth heading = true heading + delta; position right"},
+      {EffectKind::kFloorSlope,
+       "floor_slope",
+       {{"g", &Effects::slope_g, "m/m"}, {"dir", &Effects::slope_dir, "rad"}},
+       false,
+       "(outside the contract) the robot slides g metres per metre of wheel travel towards direction dir of "
+       "its start frame"},
+  };
+  return catalogue;
+}
+
+std::vector<EffectKind> ContractEffects() {
+  std::vector<EffectKind> out;
+  for (const auto& d : EffectCatalogue())
+    if (d.in_contract) out.push_back(d.kind);
+  return out;
+}
+
+const EffectDescriptor& Describe(EffectKind kind) {
+  for (const auto& d : EffectCatalogue())
+    if (d.kind == kind) return d;
+  return EffectCatalogue().front();  // unreachable: every kind is catalogued
+}
+
+const char* EffectToString(EffectKind kind) { return Describe(kind).name.data(); }
+
+std::optional<EffectKind> EffectFromString(std::string_view name) {
+  for (const auto& d : EffectCatalogue())
+    if (d.name == name) return d.kind;
+  return std::nullopt;
+}
+
+std::string Effects::Check() const {
+  auto finite = [](const char* name, double v) -> std::string {
+    if (!std::isfinite(v)) return fmt::format("{} = {} must be finite", name, v);
+    return {};
+  };
+  for (const auto& d : EffectCatalogue()) {
+    for (const auto& p : d.parameters) {
+      const std::string full = fmt::format("{}.{}", d.name, p.name);
+      if (auto e = finite(full.c_str(), this->*p.field); !e.empty()) return e;
+    }
+  }
+  if (!(scale_s > -0.5 && scale_s < 0.5)) return fmt::format("scale_error.s = {} must be in (-0.5, 0.5)", scale_s);
+  if (!(scrub_k > -0.5 && scrub_k < 0.5)) return fmt::format("turn_scrub.k = {} must be in (-0.5, 0.5)", scrub_k);
+  if (!(asymmetry_a > -0.5 && asymmetry_a < 0.5))
+    return fmt::format("direction_asymmetry.a = {} must be in (-0.5, 0.5)", asymmetry_a);
+  if (!(std::abs(castor_kappa) < 0.5)) return fmt::format("castor_kick.kappa = {} must be in (-0.5, 0.5) rad", castor_kappa);
+  if (bump_rate < 0.0) return fmt::format("bump_outliers.rate = {} must be >= 0", bump_rate);
+  if (bump_sigma < 0.0) return fmt::format("bump_outliers.sigma = {} must be >= 0", bump_sigma);
+  if (bump_rate > 1000.0) return fmt::format("bump_outliers.rate = {} must be <= 1000 per metre", bump_rate);
+  if (!(std::abs(noise_rho) <= 1.0)) return fmt::format("correlated_noise.rho = {} must be in [-1, 1]", noise_rho);
+  if (!(std::abs(drift_r) < 0.1)) return fmt::format("parameter_drift.r = {} must be in (-0.1, 0.1)", drift_r);
+  if (!(std::abs(gt_dx) < 10.0 && std::abs(gt_dy) < 10.0))
+    return fmt::format("gt_offset (dx, dy) = ({}, {}) must be within 10 m", gt_dx, gt_dy);
+  if (!(std::abs(time_tau) < 10.0)) return fmt::format("time_offset.tau = {} must be in (-10, 10) s", time_tau);
+  if (!(std::abs(yaw_delta) < 1.0))
+    return fmt::format("gt_yaw_misalignment.delta = {} must be in (-1, 1) rad", yaw_delta);
+  if (!(slope_g >= 0.0 && slope_g < 0.5)) return fmt::format("floor_slope.g = {} must be in [0, 0.5)", slope_g);
+  return {};
+}
+
+bool Effects::Active(EffectKind kind) const {
+  const EffectDescriptor& d = Describe(kind);
+  if (kind == EffectKind::kBumpOutliers) return bump_rate > 0.0 && bump_sigma > 0.0;
+  if (kind == EffectKind::kFloorSlope) return slope_g > 0.0;
+  for (const auto& p : d.parameters)
+    if (this->*p.field != 0.0) return true;
+  return false;
+}
+
+std::vector<EffectKind> Effects::ActiveKinds() const {
+  std::vector<EffectKind> out;
+  for (const auto& d : EffectCatalogue())
+    if (Active(d.kind)) out.push_back(d.kind);
+  return out;
+}
+
+void ParseEffectSpec(std::string_view spec, Effects& effects) {
+  const auto fail = [&](const std::string& what) {
+    throw InvalidOptions(fmt::format("--effect '{}': {}", spec, what));
+  };
+  const std::size_t colon = spec.find(':');
+  const std::string_view name = spec.substr(0, colon);
+  const auto kind = EffectFromString(name);
+  if (!kind) {
+    std::string known;
+    for (const auto& d : EffectCatalogue()) known += (known.empty() ? "" : ", ") + std::string(d.name);
+    fail(fmt::format("unknown effect '{}' (known: {})", name, known));
+  }
+  const EffectDescriptor& d = Describe(*kind);
+  if (colon == std::string_view::npos || colon + 1 >= spec.size())
+    fail(fmt::format("no parameters; expected {}:{}=VALUE,...", d.name, d.parameters.front().name));
+  std::string_view rest = spec.substr(colon + 1);
+  std::set<std::string_view> seen;
+  while (!rest.empty()) {
+    const std::size_t comma = rest.find(',');
+    const std::string_view item = rest.substr(0, comma);
+    rest = comma == std::string_view::npos ? std::string_view{} : rest.substr(comma + 1);
+    const std::size_t eq = item.find('=');
+    if (eq == std::string_view::npos) fail(fmt::format("'{}' is not KEY=VALUE", item));
+    const std::string_view key = item.substr(0, eq), value = item.substr(eq + 1);
+    const EffectParameter* param = nullptr;
+    for (const auto& p : d.parameters)
+      if (p.name == key) param = &p;
+    if (param == nullptr) {
+      std::string known;
+      for (const auto& p : d.parameters) known += (known.empty() ? "" : ", ") + std::string(p.name);
+      fail(fmt::format("{} has no parameter '{}' (its parameters: {})", d.name, key, known));
+    }
+    if (!seen.insert(key).second) fail(fmt::format("parameter '{}' given twice", key));
+    double v = 0.0;
+    const auto [ptr, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
+    if (ec != std::errc() || ptr != value.data() + value.size() || !std::isfinite(v))
+      fail(fmt::format("{} = '{}' is not a finite number", key, value));
+    effects.*(param->field) = v;
+  }
+  if (seen.empty()) fail("no parameters");
+}
+
+std::string EffectSpecString(EffectKind kind, const Effects& effects) {
+  const EffectDescriptor& d = Describe(kind);
+  std::string out(d.name);
+  char sep = ':';
+  for (const auto& p : d.parameters) {
+    out += fmt::format("{}{}={}", sep, p.name, effects.*(p.field));
+    sep = ',';
+  }
+  return out;
+}
+
+}  // namespace umbmark::sim

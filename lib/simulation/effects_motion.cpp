@@ -1,0 +1,88 @@
+// Motion segmentation (see effects_motion.hpp).
+#include "simulation/effects_motion.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/errors.hpp"
+
+namespace umbmark::sim {
+
+const char* MotionClassToString(MotionClass c) {
+  switch (c) {
+    case MotionClass::kStraight: return "straight";
+    case MotionClass::kTurn: return "turn";
+    case MotionClass::kArc: return "arc";
+  }
+  return "?";
+}
+
+std::string MotionOptions::Check() const {
+  if (!(stand_eps_m >= 0.0) || !std::isfinite(stand_eps_m))
+    return fmt::format("stand_eps_m = {} must be a finite number >= 0", stand_eps_m);
+  if (min_stand_intervals < 1) return fmt::format("min_stand_intervals = {} must be >= 1", min_stand_intervals);
+  if (!(straight_max_rad > 0.0)) return fmt::format("straight_max_rad = {} must be > 0", straight_max_rad);
+  if (!(turn_max_ratio > 0.0 && turn_max_ratio < 1.0))
+    return fmt::format("turn_max_ratio = {} must be in (0, 1)", turn_max_ratio);
+  return {};
+}
+
+MotionClass ClassifyMotion(double left_m, double right_m, double wheelbase_m, const MotionOptions& options) {
+  const double ds = 0.5 * (left_m + right_m);
+  const double dw = 0.5 * (right_m - left_m);
+  if (std::abs(right_m - left_m) / wheelbase_m <= options.straight_max_rad) return MotionClass::kStraight;
+  if (std::abs(ds) <= options.turn_max_ratio * std::abs(dw)) return MotionClass::kTurn;
+  return MotionClass::kArc;
+}
+
+std::vector<MotionSegment> SegmentMotions(const std::vector<double>& cum_left, const std::vector<double>& cum_right,
+                                          double wheelbase_m, const MotionOptions& options) {
+  if (auto e = options.Check(); !e.empty()) throw InvalidOptions("MotionOptions: " + e);
+  if (cum_left.size() != cum_right.size())
+    throw InvalidOptions("SegmentMotions: cum_left and cum_right differ in length");
+  std::vector<MotionSegment> out;
+  const std::size_t n = cum_left.size();
+  if (n < 2) return out;
+  const std::size_t intervals = n - 1;
+  auto moving = [&](std::size_t i) {
+    return std::abs(cum_left[i + 1] - cum_left[i]) > options.stand_eps_m ||
+           std::abs(cum_right[i + 1] - cum_right[i]) > options.stand_eps_m;
+  };
+  std::size_t i = 0;
+  while (i < intervals) {
+    if (!moving(i)) {
+      ++i;
+      continue;
+    }
+    MotionSegment m;
+    m.first_interval = i;
+    std::size_t last = i;
+    std::size_t j = i + 1;
+    while (j < intervals) {
+      if (moving(j)) {
+        last = j;
+        ++j;
+        continue;
+      }
+      // A still stretch: long enough to end the motion?
+      std::size_t k = j;
+      while (k < intervals && !moving(k)) ++k;
+      if (k - j >= static_cast<std::size_t>(options.min_stand_intervals) || k == intervals) break;
+      j = k;  // short gap: the motion continues
+    }
+    m.last_interval = last;
+    m.left_m = cum_left[last + 1] - cum_left[m.first_interval];
+    m.right_m = cum_right[last + 1] - cum_right[m.first_interval];
+    m.cls = ClassifyMotion(m.left_m, m.right_m, wheelbase_m, options);
+    if (m.cls == MotionClass::kTurn)
+      m.sign = m.right_m - m.left_m >= 0.0 ? 1 : -1;
+    else
+      m.sign = m.right_m + m.left_m >= 0.0 ? 1 : -1;
+    out.push_back(m);
+    i = last + 1;
+  }
+  return out;
+}
+
+}  // namespace umbmark::sim
