@@ -4,6 +4,14 @@
 // UMBmark code), the residuals' automatic Jacobians (central differences),
 // the per-pose robust reweighting (Ceres' own loss functions) and the t and
 // normal quantiles (closed forms and tables).
+//
+// Ceres' autodiff and loss headers pull in glog, whose CHECK macro would
+// replace Catch's: include them first and drop glog's CHECK.
+#include <ceres/loss_function.h>
+
+#include "calibration/refine_residuals.hpp"
+#undef CHECK
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -12,9 +20,6 @@
 #include <random>
 #include <vector>
 
-#include <ceres/loss_function.h>
-
-#include "calibration/refine_residuals.hpp"
 #include "calibration/refine_stats.hpp"
 #include "calibration/umbmark.hpp"
 #include "core/angles.hpp"

@@ -6,9 +6,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
+#include <Eigen/Cholesky>
 #include <Eigen/SVD>
+#include <ceres/cost_function.h>
 #include <ceres/covariance.h>
+#include <ceres/loss_function.h>
 #include <ceres/manifold.h>
 #include <ceres/solver.h>
 #include <fmt/format.h>
@@ -205,7 +209,9 @@ void SolveAndAssess(FitProblem& fit, const RefineOptions& options, CovarianceKin
   for (const auto* cost : fit.blocks) m += cost->num_residuals();
   summary->residuals = m;
   Eigen::MatrixXd J(m, kNumRefineParameters);
-  std::vector<Eigen::Vector3d> block_gradients;
+  using BlockJacobian = Eigen::Matrix<double, Eigen::Dynamic, kNumRefineParameters, Eigen::RowMajor>;
+  std::vector<BlockJacobian> block_jacobians;
+  std::vector<Eigen::VectorXd> block_residuals;
   Eigen::Matrix3d omega_meat = Eigen::Matrix3d::Zero();  // sum J_i^T Omega_i J_i
   bool any_omega = false;
   {
@@ -213,21 +219,22 @@ void SolveAndAssess(FitProblem& fit, const RefineOptions& options, CovarianceKin
     const double* params[] = {fit.theta};
     for (const auto* cost : fit.blocks) {
       const int nb = cost->num_residuals();
-      Eigen::Matrix<double, Eigen::Dynamic, kNumRefineParameters, Eigen::RowMajor> jb(nb, kNumRefineParameters);
+      BlockJacobian jb(nb, kNumRefineParameters);
       Eigen::VectorXd rb(nb);
       double* jacobians[] = {jb.data()};
       if (!cost->Evaluate(params, rb.data(), jacobians)) {
         Fail("refine: a residual could not be evaluated at the solution", summary);
       }
       J.middleRows(row, nb) = jb;
-      block_gradients.emplace_back(jb.transpose() * rb);
-      const std::size_t bi = block_gradients.size() - 1;
+      const std::size_t bi = block_jacobians.size();
       if (bi < fit.block_residual_covariance.size() && fit.block_residual_covariance[bi]) {
         omega_meat += jb.transpose() * (*fit.block_residual_covariance[bi]) * jb;
         any_omega = true;
       } else {
         omega_meat += jb.transpose() * jb;
       }
+      block_jacobians.push_back(std::move(jb));
+      block_residuals.push_back(std::move(rb));
       row += nb;
     }
   }
@@ -311,15 +318,74 @@ void SolveAndAssess(FitProblem& fit, const RefineOptions& options, CovarianceKin
       if (summary->covariance_method.empty()) summary->covariance_method = "solver_scaled";
       break;
     case CovarianceKind::kRunClustered: {
+      // Cluster-robust sandwich over runs g (runs are independent, poses
+      // within a run are not): A^-1 (sum_g g_g g_g^T) A^-1 * R / (R - p),
+      // g_g the gradient of run g's cost, A the Hessian of the objective.
+      // Without a loss A^-1 is the Ceres covariance C. With a loss applied
+      // per pose k inside the block, C would be the Gauss-Newton matrix of
+      // the reweighted residual, which is not the M-estimator's Hessian, so
+      // A is formed per pose from the plain residual r_k, its Jacobian J_k
+      // and Ceres' rho', rho'' at s_k = |r_k|^2:
+      //   A = sum_k rho'_k J_k^T J_k + 2 rho''_k (J_k^T r_k)(r_k^T J_k)
+      // (the Hessian Ceres' Triggs correction models; PSD for Huber).
+      Eigen::Matrix3d bread_inv = C;
       Eigen::Matrix3d meat = Eigen::Matrix3d::Zero();
-      Eigen::Vector3d mask = Eigen::Vector3d::Zero();
-      for (int i : free) mask(i) = 1.0;
-      for (const auto& g : block_gradients) {
-        const Eigen::Vector3d gm = g.cwiseProduct(mask);
-        meat += gm * gm.transpose();
+      Eigen::Matrix3d mask = Eigen::Matrix3d::Zero();
+      for (int i : free) mask(i, i) = 1.0;
+      if (!fit.plain_blocks.empty()) {
+        std::unique_ptr<ceres::LossFunction> loss;
+        if (fit.loss == RobustLoss::kHuber) loss = std::make_unique<ceres::HuberLoss>(fit.loss_scale_m);
+        if (fit.loss == RobustLoss::kCauchy) loss = std::make_unique<ceres::CauchyLoss>(fit.loss_scale_m);
+        Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+        const double* params[] = {fit.theta};
+        for (const auto& plain : fit.plain_blocks) {
+          const int nb = plain->num_residuals();
+          BlockJacobian jb(nb, kNumRefineParameters);
+          Eigen::VectorXd rb(nb);
+          double* jacobians[] = {jb.data()};
+          if (!plain->Evaluate(params, rb.data(), jacobians)) {
+            Fail("refine: a residual could not be evaluated at the solution", summary);
+          }
+          Eigen::Vector3d g = Eigen::Vector3d::Zero();
+          for (int k = 0; k + 3 <= nb; k += 3) {
+            const Eigen::Vector3d rk = rb.segment<3>(k);
+            const Eigen::Matrix<double, 3, kNumRefineParameters> Jk = jb.middleRows<3>(k);
+            double rho[3] = {rk.squaredNorm(), 1.0, 0.0};
+            if (loss) loss->Evaluate(rk.squaredNorm(), rho);
+            const Eigen::Vector3d Jr = Jk.transpose() * rk;
+            A += rho[1] * Jk.transpose() * Jk + 2.0 * rho[2] * Jr * Jr.transpose();
+            g += rho[1] * Jr;
+          }
+          meat += g * g.transpose();
+        }
+        // Invert A on the free parameters.
+        std::vector<int> idx(free.begin(), free.end());
+        Eigen::MatrixXd Af(p, p);
+        for (int a = 0; a < p; ++a) {
+          for (int b = 0; b < p; ++b) Af(a, b) = A(idx[static_cast<std::size_t>(a)], idx[static_cast<std::size_t>(b)]);
+        }
+        Eigen::LLT<Eigen::MatrixXd> llt(Af);
+        if (llt.info() == Eigen::Success) {
+          const Eigen::MatrixXd Ai = llt.solve(Eigen::MatrixXd::Identity(p, p));
+          bread_inv.setZero();
+          for (int a = 0; a < p; ++a) {
+            for (int b = 0; b < p; ++b) {
+              bread_inv(idx[static_cast<std::size_t>(a)], idx[static_cast<std::size_t>(b)]) = Ai(a, b);
+            }
+          }
+        } else {
+          summary->notes.push_back(
+              "the robust objective's Hessian is not positive definite at the solution; the run-clustered "
+              "covariance uses the Gauss-Newton matrix instead");
+        }
+      } else {
+        for (std::size_t g = 0; g < block_jacobians.size(); ++g) {
+          const Eigen::Vector3d gg = block_jacobians[g].transpose() * block_residuals[g];
+          meat += gg * gg.transpose();
+        }
       }
       const double R = static_cast<double>(fit.blocks.size());
-      cov = C * meat * C * (R / (R - p));  // small-sample factor R / (R - p)
+      cov = bread_inv * (mask * meat * mask) * bread_inv * (R / (R - 1.0));  // CR1 factor R / (R - 1)
       if (summary->covariance_method.empty()) summary->covariance_method = "run_clustered";
       break;
     }

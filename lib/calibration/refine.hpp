@@ -14,7 +14,7 @@
 //    does not swamp a short one), with a robust loss per pose.
 //
 // Unknowns theta = [E_b, E_d, E_s] relative to a reference robot (see
-// refine_residuals.hpp); reported as RobotParams, a covariance over
+// refine_params.hpp); reported as RobotParams, a covariance over
 // [wheelbase_m, wheel_diameter_left_m, wheel_diameter_right_m] (the
 // contract's refined.covariance) and intervals for wheelbase, D_R, D_L, E_d,
 // E_b (and E_s when it is free).
@@ -41,7 +41,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json_fwd.hpp>
 
-#include "calibration/refine_residuals.hpp"
+#include "calibration/refine_params.hpp"
 #include "core/errors.hpp"
 #include "core/robot.hpp"
 #include "core/runs.hpp"
@@ -61,12 +61,14 @@ std::optional<ScaleMode> ScaleModeFromString(std::string_view s);
 
 /// How the trajectory fit's parameter covariance is formed.
 enum class TrajectoryCovariance {
-  /// H^-1 (sum over runs g_r g_r^T) H^-1 * R / (R - p) with H^-1 the Ceres
-  /// covariance, g_r the gradient of run r's cost, R runs, p free
-  /// parameters; intervals with Student t, R - 1 degrees of freedom.
-  /// Honest when poses of a run are correlated (they are: odometry error
-  /// accumulates) and runs independent. Needs at least p + 2 runs, else
-  /// falls back to kSolverScaled with a note.
+  /// Cluster-robust sandwich over runs: A^-1 (sum_r g_r g_r^T) A^-1 R/(R-1)
+  /// (CR1), g_r the gradient of run r's cost, A the Hessian of the
+  /// objective (the Ceres covariance without a loss; formed per pose with
+  /// Ceres' rho', rho'' with one), R runs; intervals with Student t, R - 1
+  /// degrees of freedom. Honest when poses of a run are correlated (they
+  /// are: odometry error accumulates) and runs are independent. Needs at
+  /// least p + 1 runs (p free parameters), else falls back to kSolverScaled
+  /// with a note.
   kRunClustered,
   /// Ceres covariance times the residual variance 2 cost / (m - p): assumes
   /// independent poses, so it is optimistic along a trajectory.

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <ceres/cost_function.h>
 #include <ceres/problem.h>
 
 #include "calibration/refine.hpp"
@@ -26,6 +27,12 @@ struct FitProblem {
   /// (identity when absent). kDirect then forms the sandwich
   /// C (sum J_i^T Omega_i J_i) C instead of C.
   std::vector<std::optional<Eigen::MatrixXd>> block_residual_covariance;
+  /// Robust fits only (trajectories): per block the same residual without
+  /// the loss, 3 residuals per pose, and the loss applied per pose. With
+  /// them kRunClustered uses the Hessian of the robust objective as bread.
+  std::vector<std::unique_ptr<ceres::CostFunction>> plain_blocks;
+  RobustLoss loss = RobustLoss::kNone;
+  double loss_scale_m = 0.0;
   bool scale_free = false;
 };
 

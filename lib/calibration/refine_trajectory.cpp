@@ -12,12 +12,14 @@
 // Wheel travel is converted with the reference diameters (and each set's
 // ticks_per_rev), so sets recorded with different parameters share one
 // true robot: true travel = c * travel under the reference.
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
 
 #include "calibration/refine.hpp"
 #include "calibration/refine_internal.hpp"
+#include "calibration/refine_residuals.hpp"
 #include "evaluation/run_track.hpp"
 #include "kinematics/odometry.hpp"
 
@@ -125,20 +127,27 @@ RefineSummary RefineFromTrajectories(const std::vector<TrajectoryRunSet>& sets, 
                                         options.loss, options.loss_scale_m, options.integrator);
       fit.problem->AddResidualBlock(cost, nullptr, fit.theta);
       fit.blocks.push_back(cost);
+      if (options.loss != RobustLoss::kNone) {
+        fit.plain_blocks.emplace_back(TrajectoryRunResidual::Create(p.d_left_m, p.d_right_m, reference.wheelbase_m,
+                                                                    p.samples, heading_length, RobustLoss::kNone,
+                                                                    options.loss_scale_m, options.integrator));
+      }
     }
+    fit.loss = options.loss;
+    fit.loss_scale_m = options.loss_scale_m;
     const int p = scale_free ? 3 : 2;
     RefineSummary s = summary;
     CovarianceKind kind = CovarianceKind::kSolverScaled;
     std::optional<double> dof;
     if (options.covariance == TrajectoryCovariance::kRunClustered) {
-      if (summary.runs >= p + 2) {
+      if (summary.runs >= p + 1) {
         kind = CovarianceKind::kRunClustered;
         dof = summary.runs - 1;
       } else {
         s.notes.push_back(fmt::format(
             "only {} runs: the run-clustered covariance needs at least {}, so the solver covariance scaled by the "
-            "residual variance is reported (optimistic: poses along a run are correlated)",
-            summary.runs, p + 2));
+            "residual variance is reported; it is OPTIMISTIC (poses along a run are correlated): record more runs",
+            summary.runs, p + 1));
       }
     }
     refine_detail::SolveAndAssess(fit, options, kind, dof, &s);
