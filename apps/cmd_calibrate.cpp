@@ -2,6 +2,7 @@
 // classic UMBmark (Borenstein & Feng) from CW/CCW square runs, endpoint or
 // trajectory CSV, or campaign manifests (their square experiments). Several
 // inputs give one result each plus a summary table (factory batch use).
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -36,6 +37,11 @@ struct CalibrateOptions {
   JsonFlag json;
   std::string ros2;
   std::string plot;
+  bool refine = false;
+  std::vector<std::string> fix, free;
+  std::string loss = "huber";
+  double loss_scale_m = 0.02;
+  int samples_per_run = 100;
 };
 
 // Turns one command-line input into calibration inputs (a manifest may hold
@@ -109,6 +115,13 @@ nlohmann::json JsonResult(const CalibrateInput& in, const CalibrateJobResult& r,
     runs.push_back(jr);
   }
   j["runs"] = runs;
+  if (r.refined) {
+    j["refined"] = RefinedToJson(*r.refined);
+    if (r.refined_evaluation) {
+      j["refined"]["evaluation"] = {{"summary", JsonEvaluationSummary(*r.refined_evaluation)},
+                                    {"runs", JsonEvaluationRuns(*r.refined_evaluation)}};
+    }
+  }
   if (r.evaluation) {
     const auto& a = *r.evaluation;
     j["evaluation"] = {{"before", JsonEvaluationSummary(a.before)},
@@ -165,12 +178,22 @@ void PrintResult(const CalibrateJobResult& r) {
                a.second_pass_worthwhile ? "a second compensation pass is indicated"
                                         : "a second compensation pass is unlikely to help");
   }
+  if (r.refined) {
+    fmt::print("Refined calibration (Ceres, {}):\n", RefineInputKindToString(r.refined->input));
+    fmt::print("{}", RefineReport(*r.refined));
+    if (r.refined_evaluation) PrintEvaluation("refined", *r.refined_evaluation);
+  }
 }
 
 std::string Ros2Snippet(const CalibrateJobResult& r) {
   const UmbmarkSummary& s = r.umbmark;
+  // Refined multipliers when --refine ran: wheelbase and each radius
+  // relative to the recorded ones.
+  const double sep = r.refined ? r.refined->refined.wheelbase_m / s.recorded.wheelbase_m : s.selected.E_b;
+  const double left = r.refined ? r.refined->refined.wheel_diameter_left_m / s.recorded.wheel_diameter_left_m : s.c_L;
+  const double right = r.refined ? r.refined->refined.wheel_diameter_right_m / s.recorded.wheel_diameter_right_m : s.c_R;
   return fmt::format(
-      "# ros2_control diff_drive_controller parameters from umbmark calibrate ({})\n"
+      "# ros2_control diff_drive_controller parameters from umbmark calibrate{} ({})\n"
       "# Multipliers are relative to the parameters the runs were recorded with:\n"
       "#   wheel_separation = {} m, left/right wheel diameter = {} / {} m.\n"
       "diff_drive_controller:\n"
@@ -178,8 +201,8 @@ std::string Ros2Snippet(const CalibrateJobResult& r) {
       "    wheel_separation_multiplier: {}\n"
       "    left_wheel_radius_multiplier: {}\n"
       "    right_wheel_radius_multiplier: {}\n",
-      r.label, s.recorded.wheelbase_m, s.recorded.wheel_diameter_left_m, s.recorded.wheel_diameter_right_m,
-      s.selected.E_b, s.c_L, s.c_R);
+      r.refined ? " --refine" : "", r.label, s.recorded.wheelbase_m, s.recorded.wheel_diameter_left_m,
+      s.recorded.wheel_diameter_right_m, sep, left, right);
 }
 
 int RunCalibrate(const CalibrateOptions& o) {
@@ -190,6 +213,20 @@ int RunCalibrate(const CalibrateOptions& o) {
   jo.umbmark.reject_outliers = o.reject_outliers;
   jo.umbmark.outlier_threshold = o.outlier_threshold;
   jo.integrator = *IntegratorFromString(o.integrator);
+  if (o.refine) {
+    RefineOptions ro;
+    auto has = [](const std::vector<std::string>& v, const char* name) {
+      return std::find(v.begin(), v.end(), name) != v.end();
+    };
+    if (has(o.fix, "scale") && has(o.free, "scale")) throw InvalidOptions("--fix scale and --free scale contradict each other");
+    if (has(o.fix, "scale")) ro.scale = ScaleMode::kFixed;
+    if (has(o.free, "scale")) ro.scale = ScaleMode::kFree;
+    ro.loss = *RobustLossFromString(o.loss);
+    ro.loss_scale_m = o.loss_scale_m;
+    ro.samples_per_run = o.samples_per_run;
+    if (auto err = ro.Check(); !err.empty()) throw InvalidOptions(err);
+    jo.refine = ro;
+  }
 
   // Collect every calibration unit first; with one input, errors propagate
   // (exit 1). With several, a failing input is reported and skipped, and the
@@ -212,19 +249,28 @@ int RunCalibrate(const CalibrateOptions& o) {
       fmt::print(stderr, "{}\n", e.what());
       rows.push_back({path, std::nullopt, e.what()});
       results.push_back({{"input", path}, {"error", e.what()}});
-      status = 1;
+      status = std::max(status, 1);
       continue;
     }
     for (const auto& in : inputs) {
       CalibrateJobResult r;
       try {
         r = RunCalibrateJob(in, jo);
+      } catch (const RefineError& e) {
+        // Print what is known (solver report, identifiability), then fail
+        // the quality gate: exit 3, never numbers from a failed fit.
+        fmt::print(stderr, "{}: refined calibration failed: {}\n{}", in.label, e.what(), RefineReport(e.summary()));
+        if (!batch) throw;
+        rows.push_back({in.label, std::nullopt, e.what()});
+        results.push_back({{"input", in.label}, {"error", e.what()}});
+        status = std::max(status, 3);
+        continue;
       } catch (const InputError& e) {
         if (!batch) throw;
         fmt::print(stderr, "{}\n", e.what());
         rows.push_back({in.label, std::nullopt, e.what()});
         results.push_back({{"input", in.label}, {"error", e.what()}});
-        status = 1;
+        status = std::max(status, 1);
         continue;
       }
       const std::string tag = std::filesystem::path(in.path).stem().string() + "-" + std::to_string(rows.size() + 1);
@@ -292,6 +338,21 @@ Command SetupCalibrate(CLI::App& parent) {
   opts->json.Bind(*app);
   app->add_option("--ros2", opts->ros2, "Write a ros2_control diff_drive_controller parameter snippet (YAML)");
   app->add_option("--plot", opts->plot, "Write an SVG of the return errors, centres of gravity and E_max,syst");
+  app->add_flag("--refine", opts->refine,
+                "Add the exact Ceres fit (every run, full path geometry for trajectories) with covariance and 95% intervals");
+  app->add_option("--fix", opts->fix, "With --refine: hold these parameters at their recorded values (scale)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"scale"}));
+  app->add_option("--free", opts->free, "With --refine: estimate these parameters (scale); fails if the data do not determine them")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"scale"}));
+  app->add_option("--loss", opts->loss, "With --refine on trajectories: robust loss per sampled pose")
+      ->check(CLI::IsMember({"huber", "cauchy", "none"}))
+      ->capture_default_str();
+  app->add_option("--loss-scale", opts->loss_scale_m, "Robust loss scale [m]")->check(CLI::PositiveNumber)->capture_default_str();
+  app->add_option("--samples-per-run", opts->samples_per_run, "Poses sampled per trajectory run (evenly in travel)")
+      ->check(CLI::Range(2, 100000))
+      ->capture_default_str();
   return {app, [opts] { return RunCalibrate(*opts); }};
 }
 

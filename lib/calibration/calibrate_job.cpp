@@ -87,6 +87,31 @@ CalibrateJobResult RunCalibrateJob(const CalibrateInput& input, const CalibrateJ
     a.second_pass_worthwhile = a.E_max_syst_m > 3.0 * a.sem_m;
     r.evaluation = std::move(a);
   }
+  if (options.refine) {
+    RefineOptions ro = *options.refine;
+    ro.integrator = options.integrator;
+    ro.start.E_b = r.umbmark.selected.E_b;
+    ro.start.E_d = r.umbmark.selected.E_d;
+    // Only the runs UMBmark used (excluded and rejected runs stay out).
+    auto used = [&](std::size_t i) { return r.umbmark.runs[i].used(); };
+    if (input.trajectories) {
+      TrajectoryData kept;
+      kept.path = input.trajectories->path;
+      for (std::size_t i = 0; i < input.trajectories->runs.size(); ++i)
+        if (used(i)) kept.runs.push_back(input.trajectories->runs[i]);
+      r.refined = RefineFromTrajectories({{input.recorded, &kept}}, input.recorded, ro);
+      r.refined_evaluation =
+          Summarise(EvaluateRuns(kept, input.label, r.refined->refined, input.recorded, options.integrator));
+    } else {
+      SquareRunSet set;
+      set.side_m = input.side_m;
+      set.recorded = input.recorded;
+      set.source = input.path;
+      for (std::size_t i = 0; i < input.errors.size(); ++i)
+        if (used(i)) set.errors.push_back(input.errors[i]);
+      r.refined = RefineFromReturnErrors({set}, input.recorded, ro);
+    }
+  }
   return r;
 }
 

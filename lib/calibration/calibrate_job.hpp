@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "calibration/refine.hpp"
 #include "calibration/umbmark.hpp"
 #include "core/runs.hpp"
 #include "evaluation/return_error.hpp"
@@ -29,6 +30,10 @@ struct CalibrateJobOptions {
   UmbmarkOptions umbmark;
   /// Integrator for odometry from ticks (trajectory input). Default kArc.
   Integrator integrator = Integrator::kArc;
+  /// When set, also run the refined (Ceres) calibration on the runs UMBmark
+  /// used, started from the classic solution; its integrator and start are
+  /// overwritten from the fields above and the UMBmark result.
+  std::optional<RefineOptions> refine;
 };
 
 /// What the corrected parameters do on the same runs (trajectory input).
@@ -45,6 +50,9 @@ struct CalibrateJobResult {
   std::string label, path;
   UmbmarkSummary umbmark;
   std::optional<AfterCorrection> evaluation;
+  std::optional<RefineSummary> refined;
+  /// Evaluation measures with the refined parameters (trajectory input).
+  std::optional<EvaluationSummary> refined_evaluation;
 };
 
 /// Builds the input from trajectories: return errors with the recorded
@@ -55,7 +63,9 @@ CalibrateInput InputFromTrajectories(const TrajectoryData& data, const RobotPara
 CalibrateInput InputFromEndpoints(const EndpointData& data, const RobotParams& recorded, double side_m,
                                   const std::string& label);
 
-/// Runs UMBmark (and the after-correction evaluation when trajectories are present).
+/// Runs UMBmark (and the after-correction evaluation when trajectories are
+/// present, and the refined fit when asked). Throws RefineError (exit 3)
+/// when the refined fit fails its quality gates.
 CalibrateJobResult RunCalibrateJob(const CalibrateInput& input, const CalibrateJobOptions& options);
 
 }  // namespace umbmark

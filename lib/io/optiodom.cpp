@@ -6,7 +6,6 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
-#include <regex>
 #include <vector>
 
 #include <fmt/format.h>
@@ -147,14 +146,17 @@ OptiOdomDataset ImportOptiOdom(const std::string& dir, const std::optional<std::
 
   std::string meta_path;
   std::vector<std::pair<int, std::string>> run_files;
-  const std::regex run_re(R"((.*)_run-(\d+)\.csv)");
   for (const auto& entry : fs::directory_iterator(folder)) {
     const std::string name = entry.path().filename().string();
-    std::smatch m;
     if (name.size() > 13 && name.ends_with("_metadata.csv")) {
       meta_path = entry.path().string();
-    } else if (std::regex_match(name, m, run_re)) {
-      run_files.emplace_back(std::stoi(m[2].str()), entry.path().string());
+    } else if (const auto pos = name.rfind("_run-"); pos != std::string::npos && name.ends_with(".csv")) {
+      // <id>_run-NN.csv
+      const std::string digits = name.substr(pos + 5, name.size() - pos - 9);
+      int number = 0;
+      auto [ptr, err] = std::from_chars(digits.data(), digits.data() + digits.size(), number);
+      if (!digits.empty() && err == std::errc() && ptr == digits.data() + digits.size())
+        run_files.emplace_back(number, entry.path().string());
     }
   }
   if (meta_path.empty()) throw InputError(dir, "no <id>_metadata.csv in the folder");
