@@ -121,6 +121,18 @@ TrajectoryData ParseTrajectoryCsv(std::string_view text, const std::string& name
     }
     finished.emplace(run->run, last_line);
     previous_size = run->size();
+    // Give back a reserve that was far too generous (the first run's guess
+    // from the file size); a close fit is kept, so a single big run is never
+    // copied.
+    if (run->t_s.capacity() > 2 * run->size() + 1024) {
+      for (auto* v : {&run->t_s, &run->dist_left_m, &run->dist_right_m, &run->gt_x_m, &run->gt_y_m,
+                      &run->gt_theta_rad}) {
+        v->shrink_to_fit();
+      }
+      run->ticks_left.shrink_to_fit();
+      run->ticks_right.shrink_to_fit();
+      run->lines.shrink_to_fit();
+    }
   };
 
   while (csv.Next()) {
