@@ -269,3 +269,16 @@ TEST_CASE("IsManifestPath", "[io][manifest]") {
   CHECK_FALSE(io::IsManifestPath("toml"));
   CHECK_FALSE(io::IsManifestPath("x.toml.csv"));
 }
+
+TEST_CASE("column names: unit on a count, unknown suffix on text, case matters", "[io][csv]") {
+  const std::string rest = ",ticks_right,x_gt_m,y_gt_m,theta_gt_rad\n1,cw,0,0,0,0,0,0\n";
+  const InputError unit = Thrown([&] { (void)io::ParseTrajectoryCsv("run,direction,t_s,ticks_left_deg" + rest, "u"); });
+  CHECK(unit.column() == 19);
+  CHECK(unit.message() == "column 'ticks_left_deg': ticks_left takes no unit suffix (expected 'ticks_left')");
+  const InputError raw = Thrown([&] { (void)io::ParseTrajectoryCsv("run,direction,t_s,ticks_left_raw" + rest, "r"); });
+  CHECK(raw.column() == 19);
+  CHECK_THAT(raw.message(), Catch::StartsWith("unknown column 'ticks_left_raw' (expected columns: run, direction, t_s,"));
+  const InputError caps = Thrown([&] { (void)io::ParseEndpointCsv("Run,direction,ex_m,ey_m\n1,cw,0,0\n", "c"); });
+  CHECK(caps.column() == 1);
+  CHECK_THAT(caps.message(), Catch::StartsWith("unknown column 'Run'"));
+}

@@ -47,6 +47,15 @@ std::span<const UnitSuffix> SuffixesOf(Quantity q) {
   return {};
 }
 
+bool IsUnitSuffix(std::string_view suffix) {
+  for (const Quantity q : {Quantity::kLength, Quantity::kAngle, Quantity::kTime}) {
+    for (const auto& u : SuffixesOf(q)) {
+      if (u.suffix == suffix) return true;
+    }
+  }
+  return false;
+}
+
 /// "ex_m or ex_mm" for messages.
 std::string AcceptedNames(const ColumnSpec& spec) {
   std::string out;
@@ -138,6 +147,12 @@ std::vector<ResolvedColumn> CsvReader::Resolve(std::span<const ColumnSpec> specs
       const bool match = name == base || (name.size() > base.size() + 1 && name.substr(0, base.size()) == base &&
                                           name[base.size()] == '_');
       if (match && (best == specs.size() || base.size() > specs[best].base.size())) best = s;
+    }
+    // A text or count column followed by something other than a unit
+    // (run_id, ticks_left_raw) is just an unknown column.
+    if (best < specs.size() && SuffixesOf(specs[best].quantity).empty() && name != specs[best].base &&
+        !IsUnitSuffix(name.substr(specs[best].base.size() + 1))) {
+      best = specs.size();
     }
     if (best == specs.size()) {
       std::string expected;
