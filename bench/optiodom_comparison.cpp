@@ -86,12 +86,17 @@ int main(int argc, char** argv) {
 
   fmt::print("Held-out evaluation on {} circular + ivanjko runs ({} datasets), odometry with the exact arc.\n\n",
              held_runs, held.sets.size());
-  fmt::print("| square dataset | method | wheelbase [m] | D_R [m] | D_L [m] | mean final [mm] | mean max [mm] | worst final [mm] |\n");
-  fmt::print("|---|---|---|---|---|---|---|---|\n");
+  fmt::print("| square dataset | method | wheelbase [m] | D_R [m] | D_L [m] | mean final [mm] | (its SE) | mean max [mm] | worst final [mm] |\n");
+  fmt::print("|---|---|---|---|---|---|---|---|---|\n");
   auto row = [&](const std::string& ds, const std::string& method, const RobotParams& p) {
     const auto s = EvaluateOn(held, p);
-    fmt::print("| {} | {} | {:.6f} | {:.6f} | {:.6f} | {:.2f} | {:.2f} | {:.2f} |\n", ds, method, p.wheelbase_m,
-               p.wheel_diameter_right_m, p.wheel_diameter_left_m, s.mean_final_position_error_m * 1e3,
+    // Standard error of the mean final error over the held-out runs.
+    double ss = 0.0;
+    for (const auto& r : s.runs) ss += std::pow(r.final_position_error_m - s.mean_final_position_error_m, 2);
+    const double n = static_cast<double>(s.runs.size());
+    const double se = std::sqrt(ss / (n - 1.0) / n);
+    fmt::print("| {} | {} | {:.6f} | {:.6f} | {:.6f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} |\n", ds, method, p.wheelbase_m,
+               p.wheel_diameter_right_m, p.wheel_diameter_left_m, s.mean_final_position_error_m * 1e3, se * 1e3,
                s.mean_max_position_error_m * 1e3, s.max_final_position_error_m * 1e3);
     return s;
   };
