@@ -21,5 +21,7 @@ Command SetupCalibrate(CLI::App& parent);
 Command SetupEvaluate(CLI::App& parent);
 Command SetupImport(CLI::App& parent);
 Command SetupSimulate(CLI::App& parent);
+Command SetupDiagnose(CLI::App& parent);
+Command SetupPredict(CLI::App& parent);
 
 }  // namespace umbmark::cli

@@ -1,0 +1,82 @@
+// `umbmark diagnose MANIFEST.toml`: where a campaign leaves the baseline
+// model (E_d, E_b, k_L, k_R), which contract effect causes the gap, and how
+// far it shrinks once that effect is modelled (lib/diagnosis/diagnose.hpp).
+// Readable report on stdout, contract JSON with --json, gap bars with --plot.
+#include <memory>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "core/errors.hpp"
+#include "diagnosis/campaign.hpp"
+#include "diagnosis/diagnose.hpp"
+#include "io/atomic_write.hpp"
+#include "io/svg_plot.hpp"
+
+namespace umbmark::cli {
+
+namespace {
+
+struct DiagnoseCliOptions {
+  std::string manifest;
+  diag::DiagnoseOptions diag;
+  std::vector<std::string> effects;
+  std::string plot;
+  bool quality_gate = false;
+  JsonFlag json;
+};
+
+int RunDiagnose(DiagnoseCliOptions o) {
+  for (const auto& name : o.effects) {
+    const auto k = sim::EffectFromString(name);
+    if (!k) throw InvalidOptions(fmt::format("--effects: unknown effect '{}'", name));
+    o.diag.effects.push_back(*k);
+  }
+  const diag::CampaignData campaign = diag::LoadCampaign(o.manifest, o.diag.pieces);
+  const diag::DiagnoseSummary s = diag::Diagnose(campaign, o.diag);
+  if (o.json.PrintText()) fmt::print("{}", diag::DiagnoseReport(s));
+  if (!o.plot.empty()) {
+    io::WriteFileAtomically(o.plot, diag::DiagnosePlotSvg(s));
+    if (o.json.PrintText()) fmt::print("wrote {}\n", o.plot);
+  }
+  nlohmann::json j = diag::DiagnoseToJson(s);
+  j["manifest"] = o.manifest;
+  o.json.Emit(j);
+  if (o.quality_gate && s.verdict == "unexplained") {
+    throw QualityGateError("the campaign leaves the model and no known effect explains the gap");
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command SetupDiagnose(CLI::App& parent) {
+  auto opts = std::make_shared<DiagnoseCliOptions>();
+  auto* app = parent.add_subcommand("diagnose", "Sim-to-real gap: where it lies, which effect causes it, how far it shrinks");
+  app->add_option("MANIFEST", opts->manifest, "Campaign manifest (TOML)")->required()->check(CLI::ExistingFile);
+  auto& d = opts->diag;
+  app->add_option("--null-sims", d.null_simulations, "Simulated baseline campaigns for the p-value (default 500)")
+      ->check(CLI::Range(20, 1000000));
+  app->add_option("--alpha", d.alpha, "False-alarm rate of the gap test (default 0.01)")->check(CLI::Range(1e-6, 0.5));
+  app->add_option("--min-heldout-shrink", d.min_heldout_shrink,
+                  "Held-out shrink a winning effect needs (default 0.5)")
+      ->check(CLI::Range(0.01, 1.0));
+  app->add_option("--penalty", d.complexity_penalty_nats, "Held-out nats an effect must gain per parameter (default 2)")
+      ->check(CLI::NonNegativeNumber);
+  app->add_option("--folds", d.pieces.folds, "Cross-validation folds over runs (default 5)")->check(CLI::Range(2, 100));
+  app->add_option("--piece-length", d.pieces.max_piece_length_m,
+                  "Longest piece of a leg or arc compared with the model [m] (default 1)")
+      ->check(CLI::PositiveNumber);
+  app->add_option("--seed", d.seed, "Seed of the null simulations (default 1)");
+  app->add_option("--threads", d.threads, "Threads (default 2)")->check(CLI::Range(1, 256));
+  app->add_option("--where", d.where_top, "Discrepancies listed under 'where' (default 12)")->check(CLI::NonNegativeNumber);
+  app->add_option("--effects", opts->effects, "Effects to try (default: the contract's nine)")->delimiter(',');
+  app->add_option("--plot", opts->plot, "SVG bars of the gap per statistic before/after the winning effect");
+  app->add_flag("--fail-unexplained", opts->quality_gate, "Exit 3 when the verdict is 'unexplained'");
+  opts->json.Bind(*app);
+  return {app, [opts] { return RunDiagnose(*opts); }};
+}
+
+}  // namespace umbmark::cli

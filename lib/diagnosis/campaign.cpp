@@ -1,0 +1,349 @@
+// The diagnosis' view of a campaign: runs, motions, pieces (see campaign.hpp).
+#include "diagnosis/campaign.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include <fmt/format.h>
+
+#include "core/angles.hpp"
+#include "core/errors.hpp"
+#include "io/data_file.hpp"
+#include "io/manifest.hpp"
+#include "kinematics/diff_drive.hpp"
+#include "kinematics/odometry.hpp"
+#include "simulation/commanded_square.hpp"
+
+namespace umbmark::diag {
+
+const char* PieceTypeToString(PieceType t) {
+  switch (t) {
+    case PieceType::kStraight: return "straight";
+    case PieceType::kTurn: return "spot turn";
+    case PieceType::kArc: return "arc";
+    case PieceType::kStand: return "standstill";
+    case PieceType::kReturn: return "return error";
+  }
+  return "?";
+}
+
+std::string PieceOptions::Check() const {
+  if (!(max_piece_length_m > 0.0)) return fmt::format("max_piece_length_m = {} must be > 0", max_piece_length_m);
+  if (!(max_piece_angle_rad > 0.0)) return fmt::format("max_piece_angle_rad = {} must be > 0", max_piece_angle_rad);
+  if (folds < 2) return fmt::format("folds = {} must be >= 2", folds);
+  if (auto e = motion.Check(); !e.empty()) return "motion: " + e;
+  return {};
+}
+
+namespace {
+
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+
+double IntervalTravel(const DiagRun& r, std::size_t i) {
+  return std::max(std::abs(r.left[i + 1] - r.left[i]), std::abs(r.right[i + 1] - r.right[i]));
+}
+
+/// Interval classes, castor kicks and active windows from the motions.
+void AnnotateIntervals(DiagRun& r) {
+  const std::size_t intervals = r.t.empty() ? 0 : r.t.size() - 1;
+  r.interval_class.assign(intervals, -1);
+  r.kick.assign(intervals, 0);
+  r.window_start.assign(intervals, 0.0f);
+  r.window_end.assign(intervals, 1.0f);
+  for (const auto& m : r.motions) {
+    for (std::size_t i = m.first_interval; i <= m.last_interval; ++i)
+      r.interval_class[i] = static_cast<signed char>(m.cls);
+    if (m.cls != sim::MotionClass::kTurn) r.kick[m.first_interval] = static_cast<signed char>(m.sign);
+    if (m.last_interval > m.first_interval) {
+      const double t0 = IntervalTravel(r, m.first_interval), t1 = IntervalTravel(r, m.first_interval + 1);
+      if (t1 > 0.0) r.window_start[m.first_interval] = static_cast<float>(1.0 - std::min(1.0, t0 / t1));
+      const double tl = IntervalTravel(r, m.last_interval), tp = IntervalTravel(r, m.last_interval - 1);
+      if (tp > 0.0) r.window_end[m.last_interval] = static_cast<float>(std::min(1.0, tl / tp));
+    }
+  }
+}
+
+/// The sample with ground truth in [lo, hi] nearest to `want`; nullopt when
+/// there is none.
+std::optional<std::size_t> NearestWithGt(const DiagRun& r, std::size_t want, std::size_t lo, std::size_t hi) {
+  if (hi >= r.has_gt.size()) hi = r.has_gt.size() - 1;
+  if (lo > hi) return std::nullopt;
+  want = std::clamp(want, lo, hi);
+  for (std::size_t d = 0;; ++d) {
+    bool inside = false;
+    if (want >= lo + d) {
+      inside = true;
+      if (r.has_gt[want - d]) return want - d;
+    }
+    if (want + d <= hi) {
+      inside = true;
+      if (r.has_gt[want + d]) return want + d;
+    }
+    if (!inside) return std::nullopt;
+  }
+}
+
+struct SubsetTable {
+  std::map<std::pair<int, std::string>, int> index;
+  std::vector<SubsetInfo>* list;
+  int Get(int experiment, const std::string& name) {
+    auto [it, inserted] = index.emplace(std::make_pair(experiment, name), static_cast<int>(list->size()));
+    if (inserted) list->push_back({experiment, name});
+    return it->second;
+  }
+};
+
+std::string SubsetName(ExperimentKind kind, const DiagRun& run, PieceType type, int sign, bool first) {
+  std::string group;
+  if (kind == ExperimentKind::kBackAndForth) {
+    if (type == PieceType::kStraight || type == PieceType::kArc) group = sign > 0 ? "forward leg" : "backward leg";
+  } else {
+    group = run.direction;
+  }
+  std::string what = PieceTypeToString(type);
+  if (type == PieceType::kStraight || type == PieceType::kArc) what += first ? " (first piece)" : " (later pieces)";
+  return group.empty() ? what : group + ", " + what;
+}
+
+void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, const PieceOptions& o,
+                         SubsetTable& subsets) {
+  const DiagRun& r = c.runs[run_index];
+  const std::size_t n = r.t.size();
+  std::size_t g0 = n, g1 = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (r.has_gt[i]) {
+      g0 = std::min(g0, i);
+      g1 = i;
+    }
+  if (g0 >= g1) return;
+  auto add = [&](std::size_t a, std::size_t b, PieceType type, int sign, bool first) {
+    if (b <= a) return;
+    Piece p;
+    p.run = run_index;
+    p.a = a;
+    p.b = b;
+    p.type = type;
+    p.sign = sign;
+    p.motion_first = first;
+    double travel = 0.0;
+    for (std::size_t i = a; i < b; ++i)
+      travel += 0.5 * (std::abs(r.left[i + 1] - r.left[i]) + std::abs(r.right[i + 1] - r.right[i]));
+    p.travel_m = travel;
+    p.subset = subsets.Get(r.experiment, SubsetName(kind, r, type, sign, first));
+    c.pieces.push_back(p);
+  };
+  std::size_t cur = g0;
+  for (const auto& m : r.motions) {
+    const std::size_t s0 = m.FirstSample(), s1 = m.EndSample();
+    if (s1 <= cur || s0 >= g1) continue;
+    const auto start = s0 <= cur ? std::optional<std::size_t>(cur) : NearestWithGt(r, s0, cur, s1 - 1);
+    if (!start) continue;
+    if (*start > cur) add(cur, *start, PieceType::kStand, 0, false);
+    const PieceType type = m.cls == sim::MotionClass::kStraight ? PieceType::kStraight
+                           : m.cls == sim::MotionClass::kTurn   ? PieceType::kTurn
+                                                                : PieceType::kArc;
+    // Split points by travelled distance (or heading for turns).
+    int parts = 1;
+    if (type == PieceType::kTurn) {
+      const double angle = std::abs(m.right_m - m.left_m) / c.robot.wheelbase_m;
+      parts = std::max(1, static_cast<int>(std::ceil(angle / o.max_piece_angle_rad)));
+    } else {
+      const double len = 0.5 * (std::abs(m.left_m) + std::abs(m.right_m));
+      parts = std::max(1, static_cast<int>(std::ceil(len / o.max_piece_length_m)));
+    }
+    std::vector<std::size_t> cuts;
+    if (parts > 1) {
+      double total = 0.0;
+      std::vector<double> cum(s1 - s0 + 1, 0.0);
+      for (std::size_t i = s0; i < s1; ++i) {
+        total += IntervalTravel(r, i);
+        cum[i - s0 + 1] = total;
+      }
+      for (int k = 1; k < parts; ++k) {
+        const double want = total * k / parts;
+        std::size_t j = s0;
+        while (j < s1 && cum[j - s0] < want) ++j;
+        cuts.push_back(j);
+      }
+    }
+    std::size_t prev = *start;
+    bool first = true;
+    for (std::size_t cut : cuts) {
+      const auto at = NearestWithGt(r, cut, prev + 1, std::min(s1, g1) - 1);
+      if (!at) continue;
+      add(prev, *at, type, m.sign, first);
+      first = false;
+      prev = *at;
+    }
+    // End of the motion: its first still sample (or the nearest with ground truth).
+    const auto end = NearestWithGt(r, std::min(s1, g1), prev + 1, g1);
+    if (!end) {
+      cur = prev;
+      continue;
+    }
+    add(prev, *end, type, m.sign, first);
+    cur = *end;
+  }
+  if (g1 > cur) add(cur, g1, PieceType::kStand, 0, false);
+}
+
+struct ReturnErrorRow {
+  double ex = 0, ey = 0;
+  std::optional<double> etheta;
+};
+
+/// Synthetic commanded square for an endpoint run: still, motion, still, ...
+void BuildEndpointRun(DiagRun& r, const ReturnErrorRow& e, double side_m, const RobotParams& robot) {
+  const auto dir = SquareDirectionFromString(r.direction);
+  const auto motions = CommandedSquare(*dir, side_m, robot.wheelbase_m, true);
+  double t = 0.0, L = 0.0, R = 0.0;
+  auto push = [&]() {
+    r.t.push_back(t);
+    r.left.push_back(L);
+    r.right.push_back(R);
+    t += 10.0;
+  };
+  push();
+  for (const auto& m : motions) {
+    push();  // two still intervals before each motion
+    push();
+    L += m.nominal_left_m;
+    R += m.nominal_right_m;
+  }
+  push();
+  push();
+  push();
+  const std::size_t n = r.t.size();
+  Pose2 odo;
+  for (std::size_t i = 1; i < n; ++i)
+    odo = DiffDriveStep(odo, r.left[i] - r.left[i - 1], r.right[i] - r.right[i - 1], robot.wheelbase_m);
+  r.gt.assign(n, Pose2{kNan, kNan, kNan});
+  r.has_gt.assign(n, false);
+  r.gt[0] = Pose2{};
+  r.has_gt[0] = true;
+  r.gt[n - 1] = Pose2{odo.x + e.ex, odo.y + e.ey, odo.theta + e.etheta.value_or(0.0)};
+  r.has_gt[n - 1] = true;
+  r.has_heading = e.etheta.has_value();
+}
+
+}  // namespace
+
+CampaignData BuildCampaign(const Manifest& manifest, const std::vector<std::variant<EndpointData, TrajectoryData>>& files,
+                           const PieceOptions& options) {
+  if (auto e = options.Check(); !e.empty()) throw InvalidOptions("PieceOptions: " + e);
+  if (files.size() != manifest.experiments.size())
+    throw InvalidOptions("BuildCampaign: one data file per experiment is needed");
+  CampaignData c;
+  c.path = manifest.path;
+  c.robot = manifest.robot;
+  c.ground_truth = manifest.ground_truth;
+  c.folds = options.folds;
+  SubsetTable subsets{{}, &c.subsets};
+  bool any_ticks = false;
+  int campaign_index = 0;
+  for (std::size_t e = 0; e < manifest.experiments.size(); ++e) {
+    const Experiment& ex = manifest.experiments[e];
+    ExperimentInfo info;
+    info.kind = ex.kind;
+    info.file = ex.file;
+    info.side_m = ex.side_m;
+    info.distance_m = ex.distance_m;
+    const std::string& fname = ex.resolved_file.empty() ? ex.file : ex.resolved_file;
+    std::map<std::string, int> per_direction;
+    auto fold_of = [&](const std::string& direction) { return per_direction[direction]++ % options.folds; };
+    if (const auto* ep = std::get_if<EndpointData>(&files[e])) {
+      if (ex.kind != ExperimentKind::kSquare)
+        throw InputError(fname, fmt::format("experiment {} ({}): endpoint data is only usable for squares", e + 1,
+                                            ExperimentKindToString(ex.kind)));
+      info.endpoint = true;
+      for (const EndpointRun& er : ep->runs) {
+        if (!SquareDirectionFromString(er.direction))
+          throw InputError(fname, er.line, 0, fmt::format("run {}: direction '{}' must be cw or ccw", er.run, er.direction));
+        DiagRun r;
+        r.experiment = static_cast<int>(e);
+        r.index_in_experiment = info.runs++;
+        r.campaign_index = campaign_index++;
+        r.id = er.run;
+        r.direction = er.direction;
+        r.endpoint = true;
+        BuildEndpointRun(r, ReturnErrorRow{er.ex_m, er.ey_m, er.etheta_rad}, ex.side_m, manifest.robot);
+        sim::MotionOptions mo = options.motion;
+        mo.min_stand_intervals = 2;
+        r.motions = sim::SegmentMotions(r.left, r.right, manifest.robot.wheelbase_m, mo);
+        AnnotateIntervals(r);
+        const int fold = fold_of(r.direction);
+        c.runs.push_back(std::move(r));
+        Piece p;
+        p.run = static_cast<int>(c.runs.size()) - 1;
+        p.a = 0;
+        p.b = c.runs.back().t.size() - 1;
+        p.type = PieceType::kReturn;
+        p.components = c.runs.back().has_heading ? 3 : 2;
+        p.subset = subsets.Get(static_cast<int>(e), c.runs.back().direction + ", return error");
+        p.fold = fold;
+        p.travel_m = 4.0 * ex.side_m;
+        c.pieces.push_back(p);
+      }
+    } else {
+      const TrajectoryData& td = std::get<TrajectoryData>(files[e]);
+      for (const TrajectoryRun& tr : td.runs) {
+        if (tr.size() < 2) continue;
+        if (!tr.HasGroundTruth(0) || !tr.HasGroundTruth(tr.size() - 1))
+          throw InputError(fname, tr.lines.empty() ? 0 : tr.lines.front(), 0,
+                           fmt::format("run {}: ground truth is needed at its first and last sample", tr.run));
+        DiagRun r;
+        r.experiment = static_cast<int>(e);
+        r.index_in_experiment = info.runs++;
+        r.campaign_index = campaign_index++;
+        r.id = tr.run;
+        r.direction = tr.direction;
+        const WheelTravel w = ComputeWheelTravel(tr, manifest.robot, manifest.robot);
+        any_ticks = any_ticks || tr.has_ticks();
+        r.t = tr.t_s;
+        r.left = w.left_m;
+        r.right = w.right_m;
+        r.gt.resize(tr.size());
+        r.has_gt.resize(tr.size());
+        for (std::size_t i = 0; i < tr.size(); ++i) {
+          r.has_gt[i] = tr.HasGroundTruth(i);
+          r.gt[i] = r.has_gt[i] ? tr.GroundTruth(i) : Pose2{kNan, kNan, kNan};
+        }
+        sim::MotionOptions mo = options.motion;
+        if (tr.has_ticks())
+          mo.stand_eps_m = 0.5 * std::min(manifest.robot.MetresPerTickLeft(), manifest.robot.MetresPerTickRight());
+        r.motions = sim::SegmentMotions(r.left, r.right, manifest.robot.wheelbase_m, mo);
+        AnnotateIntervals(r);
+        const int fold = fold_of(r.direction);
+        c.runs.push_back(std::move(r));
+        const std::size_t before = c.pieces.size();
+        AddTrajectoryPieces(c, static_cast<int>(c.runs.size()) - 1, ex.kind, options, subsets);
+        for (std::size_t k = before; k < c.pieces.size(); ++k) c.pieces[k].fold = fold;
+      }
+    }
+    c.experiments.push_back(info);
+  }
+  if (any_ticks) {
+    c.tick_left_m = manifest.robot.MetresPerTickLeft();
+    c.tick_right_m = manifest.robot.MetresPerTickRight();
+  }
+  if (c.pieces.empty()) throw InputError(manifest.path, "no run of the campaign gives a piece to compare with the model");
+  c.files = files;
+  return c;
+}
+
+CampaignData LoadCampaign(const std::string& manifest_path, const PieceOptions& options) {
+  const Manifest m = io::ReadManifest(manifest_path);
+  std::vector<std::variant<EndpointData, TrajectoryData>> files;
+  for (const auto& e : m.experiments) {
+    io::RunFile rf = io::ReadRunFile(e.resolved_file);
+    if (auto* t = std::get_if<TrajectoryData>(&rf))
+      files.emplace_back(std::move(*t));
+    else
+      files.emplace_back(std::move(std::get<EndpointData>(rf)));
+  }
+  return BuildCampaign(m, files, options);
+}
+
+}  // namespace umbmark::diag

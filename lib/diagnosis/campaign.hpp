@@ -1,0 +1,127 @@
+// The campaign as the diagnosis sees it: every run of every experiment with
+// its cumulative nominal wheel travel (from ticks or dist_*_m with the
+// manifest's [robot]), its ground truth, its motions (effects_motion.hpp),
+// and the PIECES the diagnosis compares with the model.
+//
+// A piece is a stretch of one run between two samples with ground truth:
+// a standstill between motions, or a motion (straight leg, spot turn, arc),
+// long motions split into pieces of at most max_piece_length_m of travel
+// (max_piece_angle_rad of heading for turns). For each piece the observed
+// relative motion Rel(GT_a, GT_b) = GT_a^-1 GT_b is compared with the
+// model's prediction Rel(P_a, P_b): frame-free (no start-frame
+// re-expression needed) and, under the baseline model, nearly independent
+// from piece to piece (wheel noise of disjoint stretches; only the ground
+// truth's noise at a shared boundary sample couples neighbours).
+//
+// Endpoint runs (return errors of squares) become one piece each: a
+// synthetic commanded square (commanded_square.hpp motions, one exact arc
+// per motion, standstill between) whose "ground truth" is the odometry's
+// final pose plus the measured return error (eq. 3.1).
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "core/runs.hpp"
+#include "kinematics/pose2.hpp"
+#include "simulation/effects_motion.hpp"
+
+namespace umbmark::diag {
+
+enum class PieceType { kStraight, kTurn, kArc, kStand, kReturn };
+const char* PieceTypeToString(PieceType t);
+
+struct Piece {
+  int run = 0;            ///< index into CampaignData::runs
+  std::size_t a = 0, b = 0;  ///< sample indices (ground truth at both)
+  PieceType type = PieceType::kStand;
+  /// straight / arc: +1 forward, -1 backward; turn: +1 ccw, -1 cw; else 0.
+  int sign = 0;
+  bool motion_first = false;  ///< first piece of its motion
+  int components = 3;         ///< 2 for return errors without heading
+  double travel_m = 0.0;      ///< nominal (|dL| + |dR|) / 2 over the piece
+  /// Subset within its experiment (CampaignData::subsets), e.g. "cw,
+  /// straight (first piece)".
+  int subset = 0;
+  int fold = 0;  ///< cross-validation fold (by run)
+};
+
+struct DiagRun {
+  int experiment = 0;           ///< 0-based manifest index
+  int index_in_experiment = 0;  ///< file order
+  int campaign_index = 0;       ///< experiments in manifest order, runs in file order (parameter_drift)
+  std::string id, direction;
+  bool endpoint = false;
+  /// Samples: time, cumulative nominal wheel travel, raw ground truth (NaN
+  /// where not measured).
+  std::vector<double> t, left, right;
+  std::vector<Pose2> gt;
+  std::vector<bool> has_gt;
+  std::vector<sim::MotionSegment> motions;
+  /// Per interval (sample i -> i+1): class index (-1 still, else
+  /// MotionClass), castor kick sign (+1 / -1 / 0), and the active window
+  /// [u0, u1] (fractions of the interval) in which the wheels turned: a
+  /// motion's first interval moves late, its last one early, at the speed of
+  /// the neighbouring interval (constant-speed motion, as commanded).
+  std::vector<signed char> interval_class;
+  std::vector<signed char> kick;
+  std::vector<float> window_start, window_end;
+  bool has_heading = true;  ///< endpoint runs: etheta_rad measured
+};
+
+struct ExperimentInfo {
+  ExperimentKind kind = ExperimentKind::kFree;
+  std::string file;
+  double side_m = 0.0, distance_m = 0.0;
+  bool endpoint = false;
+  int runs = 0;
+};
+
+struct SubsetInfo {
+  int experiment = 0;
+  std::string name;  ///< e.g. "cw, straight (first piece)"
+};
+
+struct PieceOptions {
+  /// Longest piece of a straight leg or arc [m of travel] (> 0). Default 1.0.
+  double max_piece_length_m = 1.0;
+  /// Largest heading change of a spot-turn piece [rad] (> 0). Default 1.8
+  /// (a 90 deg turn stays one piece, a 180 deg spin becomes two).
+  double max_piece_angle_rad = 1.8;
+  /// Cross-validation folds over runs (>= 2). Default 5.
+  int folds = 5;
+  sim::MotionOptions motion;  ///< stand_eps_m is set from the encoder tick
+
+  std::string Check() const;
+};
+
+struct CampaignData {
+  std::string path;  ///< manifest (for messages)
+  RobotParams robot;
+  std::optional<GroundTruthNoise> ground_truth;
+  /// Nominal metres per tick (0 when the runs give distances): quantisation.
+  double tick_left_m = 0.0, tick_right_m = 0.0;
+  std::vector<ExperimentInfo> experiments;
+  std::vector<DiagRun> runs;
+  std::vector<Piece> pieces;
+  std::vector<SubsetInfo> subsets;
+  int folds = 5;
+  /// The experiments' data as read (the refined calibration works on them).
+  std::vector<std::variant<EndpointData, TrajectoryData>> files;
+};
+
+/// Builds the diagnosis' view of a loaded campaign. `files[i]` is experiment
+/// i's data (io::ReadRunFile). Throws InputError when a run cannot be used
+/// (a free experiment given as endpoint CSV, a square endpoint run whose
+/// direction is not cw/ccw, a trajectory run without ground truth at its
+/// first and last sample, or no piece at all).
+CampaignData BuildCampaign(const Manifest& manifest, const std::vector<std::variant<EndpointData, TrajectoryData>>& files,
+                           const PieceOptions& options = {});
+
+/// Reads the manifest and every experiment file, then BuildCampaign.
+CampaignData LoadCampaign(const std::string& manifest_path, const PieceOptions& options = {});
+
+}  // namespace umbmark::diag

@@ -1,0 +1,172 @@
+// `umbmark diagnose`: where a campaign leaves the baseline model, which of
+// the contract's effects causes it, and how far the gap shrinks once that
+// effect is modelled.
+//
+// Steps (each timed in DiagnoseSummary::timings):
+//  1. Baseline: E_d, E_b from the refined calibration (refine.hpp, scale
+//     fixed) polished by Gauss-Newton on the piece residuals (model.hpp);
+//     k_L, k_R (and the ground truth's sigmas when the manifest does not
+//     state them) by maximum likelihood (noise_fit.hpp). Predicted return
+//     errors (mean, covariance) per experiment and direction, and residual
+//     growth per segment type.
+//  2. Where: the gap statistics (gap_stats.hpp), ranked by |z|; the gap
+//     score G and its p-value from a parametric bootstrap of the fitted
+//     baseline itself (null_simulations campaigns of piece residuals drawn
+//     from the baseline's noise model -- wheel noise per piece, ground-truth
+//     noise per boundary sample, encoder quantisation -- each refitted like
+//     the data), so data from the baseline raise a false alarm at rate
+//     alpha.
+//  3. Which: every contract effect fitted on top of the baseline (mean
+//     effects: their parameters with E_d, E_b by Gauss-Newton; correlated
+//     noise and bumps: maximum likelihood), with gap after, shrink and
+//     heldout_shrink from k-fold cross-validation over runs. Candidates are
+//     ranked by held-out log-likelihood gain minus complexity_penalty_nats
+//     per parameter.
+//  4. Verdict: `none` when p >= alpha; else the top candidate if its
+//     heldout_shrink >= min_heldout_shrink; else `unexplained`. Effects the
+//     data cannot tell apart (from the baseline, or from each other) are
+//     listed.
+//
+// Gap sizes: gap = max(0, G - G0) with G0 the median of G over the null
+// simulations (what the model's own noise produces), so shrink =
+// 1 - gap_after / gap_before is 1 when an effect brings the data back to
+// noise level.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json_fwd.hpp>
+
+#include "diagnosis/campaign.hpp"
+#include "diagnosis/gap_stats.hpp"
+#include "diagnosis/model.hpp"
+#include "diagnosis/noise_fit.hpp"
+#include "simulation/effects.hpp"
+
+namespace umbmark::diag {
+
+struct DiagnoseOptions {
+  /// Bootstrap campaigns for the gap's p-value (>= 20). Default 500.
+  int null_simulations = 500;
+  /// False-alarm rate: the gap is significant when p < alpha. Default 0.01.
+  double alpha = 0.01;
+  /// A winning effect must close at least this fraction of the gap on
+  /// held-out runs. Default 0.5 ("most of it").
+  double min_heldout_shrink = 0.5;
+  /// Held-out log-likelihood an effect must gain per parameter. Default 2 nats.
+  double complexity_penalty_nats = 2.0;
+  /// Seed of the bootstrap. Default 1.
+  std::uint64_t seed = 1;
+  /// Threads for the bootstrap and the candidate fits (>= 1). Default 2.
+  int threads = 2;
+  /// Ranked discrepancies listed under "where". Default 12.
+  int where_top = 12;
+  /// Use the refined calibration (refine.hpp) for the starting E_d, E_b.
+  /// Default true.
+  bool use_refine = true;
+  /// Effects to try (empty: the contract's nine).
+  std::vector<sim::EffectKind> effects;
+  PieceOptions pieces;
+  GapOptions gap;
+
+  std::string Check() const;
+};
+
+/// One localised discrepancy.
+struct WhereItem {
+  int experiment = 0;  ///< 0-based
+  std::string subset;
+  StatKind statistic = StatKind::kMean;
+  std::string component;  ///< heading, along-track, lateral, or "a x b" for correlations
+  double z = 0.0;
+  int n = 0;
+};
+
+/// Predicted vs observed return errors of one experiment and direction.
+struct ReturnPrediction {
+  int experiment = 0;
+  std::string direction;
+  int runs = 0;
+  Eigen::Vector3d observed_mean = Eigen::Vector3d::Zero(), predicted_mean = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d observed_cov = Eigen::Matrix3d::Zero(), predicted_cov = Eigen::Matrix3d::Zero();
+};
+
+/// Residual growth per segment type: RMS of the piece residuals, observed
+/// and predicted by the baseline.
+struct GrowthRow {
+  PieceType type = PieceType::kStraight;
+  int pieces = 0;
+  double mean_travel_m = 0.0;
+  Eigen::Vector3d observed_rms = Eigen::Vector3d::Zero(), predicted_rms = Eigen::Vector3d::Zero();
+};
+
+struct BaselineSummary {
+  double E_d = 1.0, E_b = 1.0;
+  double k_L = 0.0, k_R = 0.0;
+  double sigma_xy_m = 0.0, sigma_theta_rad = 0.0;
+  bool ground_truth_estimated = false;
+  std::string start;  ///< where E_d, E_b started (refine or nominal)
+  std::vector<ReturnPrediction> returns;
+  std::vector<GrowthRow> growth;
+  int pieces = 0, runs = 0;
+};
+
+struct Candidate {
+  sim::EffectKind effect = sim::EffectKind::kScaleError;
+  std::map<std::string, double> params;
+  std::map<std::string, double> param_se;  ///< standard errors (mean effects)
+  double E_d = 1.0, E_b = 1.0;             ///< refitted with the effect
+  bool identifiable = true;
+  double gap_after = 0.0;  ///< G after (raw score)
+  double shrink = 0.0;
+  double heldout_shrink = 0.0;
+  double heldout_loglik_gain = 0.0;  ///< nats over the baseline, held out
+  double evidence = 0.0;             ///< gain minus the complexity penalty
+  int parameters = 0;
+  std::array<double, kNumStatKinds> gap_by_kind{};
+  std::string note;
+};
+
+struct DiagnoseSummary {
+  BaselineSummary baseline;
+  double gap_score = 0.0;       ///< G of the baseline
+  double null_median = 0.0;     ///< G0
+  double null_quantile_alpha = 0.0;  ///< G at the 1 - alpha quantile of the null
+  double p_value = 1.0;
+  double alpha = 0.01;
+  int null_simulations = 0;
+  bool significant = false;
+  std::array<double, kNumStatKinds> gap_by_kind{};
+  std::vector<WhereItem> where;
+  std::vector<Candidate> candidates;  ///< best first
+  std::string verdict;                ///< effect name | none | unexplained
+  std::string verdict_reason;
+  std::vector<std::string> indistinguishable;
+  std::vector<std::pair<std::string, double>> timings;  ///< stage, seconds
+  std::vector<std::string> experiment_labels;
+  std::vector<std::string> notes;
+  std::uint64_t seed = 0;
+};
+
+/// Runs the diagnosis. Throws InvalidOptions for bad options; the campaign
+/// is already validated by BuildCampaign.
+DiagnoseSummary Diagnose(const CampaignData& campaign, const DiagnoseOptions& options);
+
+/// The contract's JSON ("gap", "candidates", "verdict") plus "baseline",
+/// "indistinguishable", "timing_s".
+nlohmann::json DiagnoseToJson(const DiagnoseSummary& summary);
+
+/// A readable report (the app prints it).
+std::string DiagnoseReport(const DiagnoseSummary& summary);
+
+/// SVG bars of the gap per statistic kind before and after the winning
+/// effect (or the best candidate).
+std::string DiagnosePlotSvg(const DiagnoseSummary& summary);
+
+}  // namespace umbmark::diag

@@ -1,0 +1,206 @@
+// Output of the diagnosis: contract JSON, readable report, gap bar chart
+// (see diagnose.hpp).
+#include <cmath>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/angles.hpp"
+#include "diagnosis/diagnose.hpp"
+#include "io/svg_plot.hpp"
+
+namespace umbmark::diag {
+
+namespace {
+
+nlohmann::json Num(double v) {
+  if (!std::isfinite(v)) return nullptr;
+  return v;
+}
+
+nlohmann::json Vec(const Eigen::Vector3d& v) { return {Num(v[0]), Num(v[1]), Num(v[2])}; }
+
+nlohmann::json Mat(const Eigen::Matrix3d& m) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int i = 0; i < 3; ++i) rows.push_back({Num(m(i, 0)), Num(m(i, 1)), Num(m(i, 2))});
+  return rows;
+}
+
+nlohmann::json ByKind(const std::array<double, kNumStatKinds>& a) {
+  nlohmann::json j = nlohmann::json::object();
+  for (int k = 0; k < kNumStatKinds; ++k) j[StatKindToString(static_cast<StatKind>(k))] = Num(a[k]);
+  return j;
+}
+
+const Candidate* Winner(const DiagnoseSummary& s) {
+  for (const auto& c : s.candidates)
+    if (s.verdict == sim::EffectToString(c.effect)) return &c;
+  return s.candidates.empty() || !s.candidates.front().identifiable ? nullptr : &s.candidates.front();
+}
+
+}  // namespace
+
+nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
+  nlohmann::json where = nlohmann::json::array();
+  for (const auto& w : s.where) {
+    where.push_back({{"experiment", w.experiment + 1},
+                     {"experiment_label", s.experiment_labels[w.experiment]},
+                     {"subset", w.subset},
+                     {"statistic", StatKindToString(w.statistic)},
+                     {"component", w.component},
+                     {"size_se", Num(w.z)},
+                     {"n", w.n}});
+  }
+  nlohmann::json cands = nlohmann::json::array();
+  for (const auto& c : s.candidates) {
+    nlohmann::json params = nlohmann::json::object(), se = nlohmann::json::object();
+    for (const auto& [k, v] : c.params) params[k] = Num(v);
+    for (const auto& [k, v] : c.param_se) se[k] = Num(v);
+    cands.push_back({{"effect", sim::EffectToString(c.effect)},
+                     {"params", params},
+                     {"shrink", Num(c.shrink)},
+                     {"heldout_shrink", Num(c.heldout_shrink)},
+                     {"params_se", se},
+                     {"identifiable", c.identifiable},
+                     {"gap_after", Num(c.gap_after)},
+                     {"heldout_loglik_gain_nats", Num(c.heldout_loglik_gain)},
+                     {"evidence_nats", Num(c.evidence)},
+                     {"parameters", c.parameters},
+                     {"E_d", Num(c.E_d)},
+                     {"E_b", Num(c.E_b)},
+                     {"gap_after_by_statistic", ByKind(c.gap_by_kind)},
+                     {"note", c.note}});
+  }
+  const BaselineSummary& b = s.baseline;
+  nlohmann::json returns = nlohmann::json::array();
+  for (const auto& r : b.returns) {
+    returns.push_back({{"experiment", r.experiment + 1},
+                       {"direction", r.direction},
+                       {"runs", r.runs},
+                       {"observed_mean", Vec(r.observed_mean)},
+                       {"predicted_mean", Vec(r.predicted_mean)},
+                       {"observed_covariance", Mat(r.observed_cov)},
+                       {"predicted_covariance", Mat(r.predicted_cov)}});
+  }
+  nlohmann::json growth = nlohmann::json::array();
+  for (const auto& g : b.growth) {
+    growth.push_back({{"segment", PieceTypeToString(g.type)},
+                      {"pieces", g.pieces},
+                      {"mean_travel_m", Num(g.mean_travel_m)},
+                      {"observed_rms", Vec(g.observed_rms)},
+                      {"predicted_rms", Vec(g.predicted_rms)}});
+  }
+  nlohmann::json timing = nlohmann::json::object();
+  for (const auto& [k, v] : s.timings) timing[k] = Num(v);
+  return {{"gap",
+           {{"score", Num(s.gap_score)},
+            {"p_value", Num(s.p_value)},
+            {"where", where},
+            {"alpha", s.alpha},
+            {"significant", s.significant},
+            {"null_simulations", s.null_simulations},
+            {"null_median", Num(s.null_median)},
+            {"null_quantile_1_minus_alpha", Num(s.null_quantile_alpha)},
+            {"by_statistic", ByKind(s.gap_by_kind)},
+            {"seed", s.seed}}},
+          {"candidates", cands},
+          {"verdict", {{"effect", s.verdict}, {"reason", s.verdict_reason}}},
+          {"indistinguishable", s.indistinguishable},
+          {"baseline",
+           {{"E_d", Num(b.E_d)},
+            {"E_b", Num(b.E_b)},
+            {"k_L", Num(b.k_L)},
+            {"k_R", Num(b.k_R)},
+            {"sigma_xy_m", Num(b.sigma_xy_m)},
+            {"sigma_theta_rad", Num(b.sigma_theta_rad)},
+            {"ground_truth_noise_estimated", b.ground_truth_estimated},
+            {"start", b.start},
+            {"runs", b.runs},
+            {"pieces", b.pieces},
+            {"return_errors", returns},
+            {"residual_growth", growth}}},
+          {"experiments", s.experiment_labels},
+          {"notes", s.notes},
+          {"timing_s", timing}};
+}
+
+std::string DiagnoseReport(const DiagnoseSummary& s) {
+  std::string out;
+  auto line = [&](const std::string& t) { out += t + "\n"; };
+  const BaselineSummary& b = s.baseline;
+  line("Diagnosis of the sim-to-real gap");
+  for (const auto& l : s.experiment_labels) line("  experiment " + l);
+  line("");
+  line("1. Baseline (E_d, E_b, k_L, k_R; ground-truth noise " +
+       std::string(b.ground_truth_estimated ? "estimated" : "as stated in the manifest") + ")");
+  line(fmt::format("  E_d = {:.6f}   E_b = {:.6f}   k_L = {:.3g} m^1/2   k_R = {:.3g} m^1/2", b.E_d, b.E_b, b.k_L, b.k_R));
+  line(fmt::format("  ground truth: sigma_xy = {:.3g} m, sigma_theta = {:.3g} rad; start: {}", b.sigma_xy_m,
+                   b.sigma_theta_rad, b.start));
+  line(fmt::format("  {} runs, {} pieces", b.runs, b.pieces));
+  line("  return errors per experiment and direction (mean x, y [mm], theta [mrad]; sd from the covariance):");
+  for (const auto& r : b.returns) {
+    line(fmt::format("    exp {} {:<10} {:>3} runs  observed ({:+8.2f}, {:+8.2f}, {:+8.2f}) sd ({:6.2f}, {:6.2f}, {:6.2f})",
+                     r.experiment + 1, r.direction, r.runs, 1e3 * r.observed_mean[0], 1e3 * r.observed_mean[1],
+                     1e3 * r.observed_mean[2], 1e3 * std::sqrt(r.observed_cov(0, 0)),
+                     1e3 * std::sqrt(r.observed_cov(1, 1)), 1e3 * std::sqrt(r.observed_cov(2, 2))));
+    line(fmt::format("    {:<24}  predicted ({:+8.2f}, {:+8.2f}, {:+8.2f}) sd ({:6.2f}, {:6.2f}, {:6.2f})", "",
+                     1e3 * r.predicted_mean[0], 1e3 * r.predicted_mean[1], 1e3 * r.predicted_mean[2],
+                     1e3 * std::sqrt(r.predicted_cov(0, 0)), 1e3 * std::sqrt(r.predicted_cov(1, 1)),
+                     1e3 * std::sqrt(r.predicted_cov(2, 2))));
+  }
+  line("  residual growth per segment type (RMS per piece x [mm], y [mm], theta [mrad]: observed / predicted):");
+  for (const auto& g : b.growth) {
+    line(fmt::format("    {:<13} {:>5} pieces, {:6.3f} m each: x {:6.2f}/{:6.2f}  y {:6.2f}/{:6.2f}  theta {:6.2f}/{:6.2f}",
+                     PieceTypeToString(g.type), g.pieces, g.mean_travel_m, 1e3 * g.observed_rms[0],
+                     1e3 * g.predicted_rms[0], 1e3 * g.observed_rms[1], 1e3 * g.predicted_rms[1],
+                     1e3 * g.observed_rms[2], 1e3 * g.predicted_rms[2]));
+  }
+  line("");
+  line(fmt::format("2. Where: gap score G = {:.2f} (null median {:.2f}, {:.0f}% quantile {:.2f}); p = {:.4f} from {} "
+                   "simulations of the baseline -> {}",
+                   s.gap_score, s.null_median, 100.0 * (1.0 - s.alpha), s.null_quantile_alpha, s.p_value,
+                   s.null_simulations, s.significant ? "significant" : "not significant"));
+  for (const auto& w : s.where) {
+    line(fmt::format("    {:+7.2f} SE  exp {}  {:<38} {:<11} {}", w.z, w.experiment + 1, w.subset,
+                     StatKindToString(w.statistic), w.component));
+  }
+  line("");
+  line("3. Which: candidate effects (best first; shrink = 1 - gap after / gap before)");
+  line(fmt::format("    {:<20} {:>8} {:>9} {:>11}  {}", "effect", "shrink", "held-out", "evidence", "parameters"));
+  for (const auto& c : s.candidates) {
+    std::string params;
+    for (const auto& [k, v] : c.params) {
+      const auto se = c.param_se.find(k);
+      params += se != c.param_se.end() ? fmt::format("{} = {:.4g} +- {:.2g}  ", k, v, se->second)
+                                       : fmt::format("{} = {:.4g}  ", k, v);
+    }
+    if (!c.identifiable) params += "(" + c.note + ")";
+    line(fmt::format("    {:<20} {:>8.3f} {:>9.3f} {:>9.1f} n  {}", sim::EffectToString(c.effect), c.shrink,
+                     c.heldout_shrink, c.evidence, params));
+  }
+  line("");
+  line("4. Verdict: " + s.verdict);
+  line("  " + s.verdict_reason);
+  for (const auto& i : s.indistinguishable) line("  cannot tell apart: " + i);
+  for (const auto& n : s.notes) line("  note: " + n);
+  line("");
+  line("Time per stage:");
+  for (const auto& [k, v] : s.timings) line(fmt::format("  {:<42} {:8.3f} s", k, v));
+  return out;
+}
+
+std::string DiagnosePlotSvg(const DiagnoseSummary& s) {
+  std::vector<std::string> labels;
+  std::vector<double> before, after;
+  const Candidate* w = Winner(s);
+  for (int k = 0; k < kNumStatKinds; ++k) {
+    labels.push_back(StatKindToString(static_cast<StatKind>(k)));
+    before.push_back(s.gap_by_kind[k]);
+    after.push_back(w ? w->gap_by_kind[k] : s.gap_by_kind[k]);
+  }
+  const std::string name = w ? fmt::format("with {}", sim::EffectToString(w->effect)) : "no candidate";
+  return io::SvgBarChart(fmt::format("Gap per statistic (sum of (|z| - 2)^2), verdict: {}", s.verdict), labels,
+                         {before, after}, {"baseline", name}, {"#d62728", "#2ca02c"});
+}
+
+}  // namespace umbmark::diag

@@ -1,0 +1,231 @@
+// Piece scores and gap statistics (see gap_stats.hpp).
+#include "diagnosis/gap_stats.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Dense>
+
+namespace umbmark::diag {
+
+const char* StatKindToString(StatKind k) {
+  switch (k) {
+    case StatKind::kMean: return "mean";
+    case StatKind::kVariance: return "variance";
+    case StatKind::kCorrelation: return "correlation";
+    case StatKind::kTail: return "tail";
+    case StatKind::kTrend: return "trend";
+  }
+  return "?";
+}
+
+const char* ComponentName(int c) {
+  static const char* names[3] = {"heading", "along-track", "lateral"};
+  return c >= 0 && c < 3 ? names[c] : "?";
+}
+
+double NormalCdf(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
+
+double NormalInverse(double p) {
+  // Acklam's rational approximation (relative error 1.15e-9) refined by one
+  // Halley step on erfc, which brings it to full double precision.
+  if (!(p > 0.0)) return -38.0;
+  if (!(p < 1.0)) return 38.0;
+  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02,
+                             1.383577518672690e+02,  -3.066479806614716e+01, 2.506628277459239e+00};
+  static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
+                             6.680131188771972e+01,  -1.328068155288572e+01};
+  static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
+                             -2.549732539343734e+00, 4.374664141464968e+00,  2.938163982698783e+00};
+  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
+                             3.754408661907416e+00};
+  const double plow = 0.02425;
+  double x;
+  if (p < plow) {
+    const double q = std::sqrt(-2.0 * std::log(p));
+    x = (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+        ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
+  } else if (p <= 1.0 - plow) {
+    const double q = p - 0.5, r = q * q;
+    x = (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
+        (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0);
+  } else {
+    const double q = std::sqrt(-2.0 * std::log(1.0 - p));
+    x = -(((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+        ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
+  }
+  const double e = NormalCdf(x) - p;
+  const double u = e * std::sqrt(2.0 * M_PI) * std::exp(x * x / 2.0);
+  x = x - u / (1.0 + x * u / 2.0);
+  return std::clamp(x, -38.0, 38.0);
+}
+
+namespace {
+
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+
+/// Permutation (x, y, theta) -> (theta, x, y) of a covariance.
+Eigen::Matrix3d Permute(const Eigen::Matrix3d& C) {
+  static const int idx[3] = {2, 0, 1};
+  Eigen::Matrix3d P;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) P(i, j) = C(idx[i], idx[j]);
+  return P;
+}
+
+/// log P(X >= k) for X ~ Binomial(n, p).
+double BinomialUpperTail(int n, int k, double p) {
+  if (k <= 0) return 1.0;
+  if (k > n) return 0.0;
+  const double lp = std::log(p), lq = std::log1p(-p);
+  double sum = 0.0;
+  for (int i = k; i <= n && i < k + 200; ++i) {
+    const double lt = std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) + i * lp + (n - i) * lq;
+    const double t = std::exp(lt);
+    sum += t;
+    if (t < 1e-18 * sum) break;
+  }
+  return std::min(1.0, sum);
+}
+
+}  // namespace
+
+std::vector<Scores> PieceScores(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
+                                const std::vector<Piece>& pieces, const NoiseParams& noise) {
+  std::vector<Scores> out(pieces.size());
+  const bool bumps = noise.bump_rate > 0.0 && noise.bump_s2 > 0.0;
+  for (std::size_t j = 0; j < pieces.size(); ++j) {
+    const double* e = &eps[3 * j];
+    if (pieces[j].components == 2) {
+      const Eigen::Matrix2d C = PieceCovariance(bases[j], noise).topLeftCorner<2, 2>();
+      Eigen::LLT<Eigen::Matrix2d> llt(C);
+      const Eigen::Vector2d w = llt.matrixL().solve(Eigen::Vector2d(e[0], e[1]));
+      out[j] = {kNan, w[0], w[1]};
+      continue;
+    }
+    const Eigen::Vector3d ep(e[2], e[0], e[1]);
+    if (!bumps) {
+      Eigen::LLT<Eigen::Matrix3d> llt(Permute(PieceCovariance(bases[j], noise)));
+      const Eigen::Vector3d w = llt.matrixL().solve(ep);
+      out[j] = {w[0], w[1], w[2]};
+      continue;
+    }
+    const BumpMixture m = PieceMixture(bases[j], noise);
+    Eigen::Matrix3d mean = Eigen::Matrix3d::Zero();
+    for (int k = 0; k < m.components; ++k) mean += m.weight[k] * m.cov[k];
+    Eigen::LLT<Eigen::Matrix3d> llt(Permute(mean));
+    const Eigen::Matrix3d Linv = llt.matrixL().solve(Eigen::Matrix3d::Identity());
+    const Eigen::Vector3d w = Linv * ep;
+    double sd[4][3];
+    for (int k = 0; k < m.components; ++k) {
+      const Eigen::Matrix3d S = Linv * Permute(m.cov[k]) * Linv.transpose();
+      for (int c = 0; c < 3; ++c) sd[k][c] = std::sqrt(std::max(S(c, c), 1e-300));
+    }
+    for (int c = 0; c < 3; ++c) {
+      // Smaller tail for precision: z = -Phi^-1(P(W beyond |w|, same side)).
+      double tail = 0.0;
+      for (int k = 0; k < m.components; ++k) tail += m.weight[k] * NormalCdf(-std::abs(w[c]) / sd[k][c]);
+      const double z = -NormalInverse(std::max(tail, 1e-300));
+      out[j][c] = w[c] >= 0.0 ? z : -z;
+    }
+  }
+  return out;
+}
+
+GapSummary ComputeGap(const CampaignData& campaign, const std::vector<Scores>& scores, const GapOptions& options,
+                      const std::vector<char>* use) {
+  const std::size_t S = campaign.subsets.size();
+  struct Acc {
+    int n[3] = {0, 0, 0};
+    double sum[3] = {0, 0, 0}, sq[3] = {0, 0, 0};
+    int tail[3] = {0, 0, 0};
+    double prod[3] = {0, 0, 0};  // (0,1), (0,2), (1,2)
+    int nprod[3] = {0, 0, 0};
+    std::vector<std::array<double, 6>> per_run;  // sum[3], count[3] by run index in experiment
+  };
+  std::vector<Acc> acc(S);
+  for (std::size_t s = 0; s < S; ++s)
+    acc[s].per_run.assign(campaign.experiments[campaign.subsets[s].experiment].runs, {0, 0, 0, 0, 0, 0});
+  static const int pa[3] = {0, 0, 1}, pb[3] = {1, 2, 2};
+  for (std::size_t j = 0; j < campaign.pieces.size(); ++j) {
+    if (use && !(*use)[j]) continue;
+    const Piece& p = campaign.pieces[j];
+    Acc& a = acc[p.subset];
+    const Scores& z = scores[j];
+    const int ri = campaign.runs[p.run].index_in_experiment;
+    for (int c = 0; c < 3; ++c) {
+      if (std::isnan(z[c])) continue;
+      a.n[c] += 1;
+      a.sum[c] += z[c];
+      a.sq[c] += z[c] * z[c];
+      if (std::abs(z[c]) > options.tail_z) a.tail[c] += 1;
+      a.per_run[ri][c] += z[c];
+      a.per_run[ri][3 + c] += 1.0;
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (std::isnan(z[pa[k]]) || std::isnan(z[pb[k]])) continue;
+      a.prod[k] += z[pa[k]] * z[pb[k]];
+      a.nprod[k] += 1;
+    }
+  }
+  GapSummary g;
+  const double p_tail = 2.0 * NormalCdf(-options.tail_z);
+  auto add = [&](int subset, StatKind kind, int ca, int cb, double z, int n) {
+    GapStatistic st;
+    st.subset = subset;
+    st.kind = kind;
+    st.comp_a = ca;
+    st.comp_b = cb;
+    st.z = z;
+    st.n = n;
+    g.stats.push_back(st);
+    const double excess = std::max(0.0, std::abs(z) - options.threshold_se);
+    g.score += excess * excess;
+    g.by_kind[static_cast<int>(kind)] += excess * excess;
+  };
+  for (std::size_t s = 0; s < S; ++s) {
+    const Acc& a = acc[s];
+    const int subset = static_cast<int>(s);
+    for (int c = 0; c < 3; ++c) {
+      const int n = a.n[c];
+      if (n < options.min_pieces) continue;
+      add(subset, StatKind::kMean, c, -1, a.sum[c] / std::sqrt(n), n);
+      add(subset, StatKind::kVariance, c, -1, (a.sq[c] / n - 1.0) / std::sqrt(2.0 / n), n);
+      const double tail = BinomialUpperTail(n, a.tail[c], p_tail);
+      add(subset, StatKind::kTail, c, -1, tail < 0.5 ? -NormalInverse(tail) : 0.0, n);
+      // Trend over runs: weighted least squares of the run means on the run index.
+      double W = 0.0, Wi = 0.0, Wm = 0.0;
+      int runs = 0;
+      for (std::size_t r = 0; r < a.per_run.size(); ++r) {
+        const double cnt = a.per_run[r][3 + c];
+        if (cnt <= 0.0) continue;
+        ++runs;
+        W += cnt;
+        Wi += cnt * static_cast<double>(r);
+        Wm += a.per_run[r][c];
+      }
+      if (runs >= 3) {
+        const double ibar = Wi / W, mbar = Wm / W;
+        double sxx = 0.0, sxy = 0.0;
+        for (std::size_t r = 0; r < a.per_run.size(); ++r) {
+          const double cnt = a.per_run[r][3 + c];
+          if (cnt <= 0.0) continue;
+          const double di = static_cast<double>(r) - ibar;
+          sxx += cnt * di * di;
+          sxy += di * (a.per_run[r][c] - cnt * mbar);
+        }
+        // Run means have variance 1/cnt: slope SE = 1/sqrt(sxx).
+        if (sxx > 0.0) add(subset, StatKind::kTrend, c, -1, sxy / std::sqrt(sxx), runs);
+      }
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (a.nprod[k] < options.min_pieces) continue;
+      add(subset, StatKind::kCorrelation, pa[k], pb[k], a.prod[k] / std::sqrt(a.nprod[k]), a.nprod[k]);
+    }
+  }
+  return g;
+}
+
+}  // namespace umbmark::diag

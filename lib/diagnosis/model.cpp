@@ -1,0 +1,241 @@
+// Mean model and covariance bases of the diagnosis (see model.hpp).
+#include "diagnosis/model.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/angles.hpp"
+#include "kinematics/diff_drive.hpp"
+
+namespace umbmark::diag {
+
+ParamVector NominalParams() {
+  ParamVector p{};
+  p[kParamEd] = 1.0;
+  p[kParamEb] = 1.0;
+  return p;
+}
+
+const char* ParamName(int index) {
+  static const char* names[kNumParams] = {"E_d", "E_b", "s", "k", "a", "kappa", "r", "dx", "dy", "tau"};
+  return index >= 0 && index < kNumParams ? names[index] : "?";
+}
+
+namespace {
+
+/// Exact constant-curvature step with a heading factor (turn_scrub).
+inline Pose2 Advance(const Pose2& q, double l, double r, double wheelbase, double heading_factor) {
+  const double ds = 0.5 * (l + r);
+  const double dtheta = (r - l) / wheelbase * heading_factor;
+  const double half = 0.5 * dtheta;
+  const double chord = ds * Sinc(half);
+  const double heading = q.theta + half;
+  return {q.x + chord * std::cos(heading), q.y + chord * std::sin(heading), q.theta + dtheta};
+}
+
+inline Pose2 Relative(const Pose2& a, const Pose2& b) {
+  const double c = std::cos(a.theta), s = std::sin(a.theta);
+  const double dx = b.x - a.x, dy = b.y - a.y;
+  return {c * dx + s * dy, -s * dx + c * dy, b.theta - a.theta};
+}
+
+struct TrueFactors {
+  double c_L, c_R, scale, back, wheelbase, scrub;
+};
+
+TrueFactors Factors(const ParamVector& p, double wheelbase) {
+  const double E_d = p[kParamEd];
+  return {2.0 / (E_d + 1.0), 2.0 * E_d / (E_d + 1.0), 1.0 + p[kParamScale], 1.0 + p[kParamAsym],
+          p[kParamEb] * wheelbase, 1.0 - p[kParamScrub]};
+}
+
+}  // namespace
+
+MeanModel::MeanModel(const CampaignData& campaign) : campaign_(campaign) {
+  observed_.resize(campaign.pieces.size());
+  pieces_of_run_.resize(campaign.runs.size());
+  for (std::size_t j = 0; j < campaign.pieces.size(); ++j) {
+    const Piece& pc = campaign.pieces[j];
+    const DiagRun& r = campaign.runs[pc.run];
+    observed_[j] = Relative(r.gt[pc.a], r.gt[pc.b]);
+    pieces_of_run_[pc.run].push_back(static_cast<int>(j));
+  }
+}
+
+void MeanModel::ReplayRun(int run, const ParamVector& p, std::vector<Pose2>& poses) const {
+  const DiagRun& r = campaign_.runs[run];
+  const TrueFactors f = Factors(p, campaign_.robot.wheelbase_m);
+  const double drift = 1.0 + p[kParamDrift] * r.campaign_index;
+  const double kappa = p[kParamKappa];
+  const std::size_t n = r.t.size();
+  poses.resize(n);
+  Pose2 q;
+  poses[0] = q;
+  for (std::size_t i = 0; i + 1 < n; ++i) {
+    const double dl = r.left[i + 1] - r.left[i], dr = r.right[i + 1] - r.right[i];
+    const double l = dl * f.c_L * f.scale * (dl < 0.0 ? f.back : 1.0);
+    const double rr = dr * f.c_R * f.scale * drift * (dr < 0.0 ? f.back : 1.0);
+    if (r.kick[i] != 0) q.theta += kappa * r.kick[i];
+    const double hf = r.interval_class[i] == static_cast<signed char>(sim::MotionClass::kTurn) ? f.scrub : 1.0;
+    q = Advance(q, l, rr, f.wheelbase, hf);
+    poses[i + 1] = q;
+  }
+}
+
+Pose2 MeanModel::PoseAt(int run, const ParamVector& p, const std::vector<Pose2>& poses, double t) const {
+  const DiagRun& r = campaign_.runs[run];
+  const std::size_t n = r.t.size();
+  if (t <= r.t.front()) return poses.front();
+  if (t >= r.t.back()) return poses.back();
+  const std::size_t i = static_cast<std::size_t>(std::upper_bound(r.t.begin(), r.t.end(), t) - r.t.begin()) - 1;
+  if (i + 1 >= n) return poses.back();
+  const double u = (t - r.t[i]) / (r.t[i + 1] - r.t[i]);
+  const double w0 = r.window_start[i], w1 = r.window_end[i];
+  if (u <= w0 || w1 <= w0) return poses[i];
+  if (u >= w1) return poses[i + 1];
+  const double frac = (u - w0) / (w1 - w0);
+  const TrueFactors f = Factors(p, campaign_.robot.wheelbase_m);
+  const double drift = 1.0 + p[kParamDrift] * r.campaign_index;
+  const double dl = r.left[i + 1] - r.left[i], dr = r.right[i + 1] - r.right[i];
+  const double l = dl * f.c_L * f.scale * (dl < 0.0 ? f.back : 1.0);
+  const double rr = dr * f.c_R * f.scale * drift * (dr < 0.0 ? f.back : 1.0);
+  Pose2 q = poses[i];
+  if (r.kick[i] != 0) q.theta += p[kParamKappa] * r.kick[i];
+  const double hf = r.interval_class[i] == static_cast<signed char>(sim::MotionClass::kTurn) ? f.scrub : 1.0;
+  return Advance(q, frac * l, frac * rr, f.wheelbase, hf);
+}
+
+std::vector<Pose2> MeanModel::PredictRun(int run, const ParamVector& p) const {
+  std::vector<Pose2> poses;
+  ReplayRun(run, p, poses);
+  const DiagRun& r = campaign_.runs[run];
+  std::vector<Pose2> out(poses.size());
+  const double dx = p[kParamDx], dy = p[kParamDy], tau = p[kParamTau];
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const Pose2 q = tau != 0.0 ? PoseAt(run, p, poses, r.t[i] - tau) : poses[i];
+    const double c = std::cos(q.theta), s = std::sin(q.theta);
+    out[i] = {q.x + c * dx - s * dy, q.y + s * dx + c * dy, q.theta};
+  }
+  return out;
+}
+
+std::vector<Pose2> MeanModel::PredictedPieceMotion(const ParamVector& p) const {
+  std::vector<Pose2> out(campaign_.pieces.size());
+  std::vector<Pose2> poses;
+  const double dx = p[kParamDx], dy = p[kParamDy], tau = p[kParamTau];
+  for (std::size_t run = 0; run < campaign_.runs.size(); ++run) {
+    if (pieces_of_run_[run].empty()) continue;
+    ReplayRun(static_cast<int>(run), p, poses);
+    const DiagRun& r = campaign_.runs[run];
+    auto predicted = [&](std::size_t i) {
+      const Pose2 q = tau != 0.0 ? PoseAt(static_cast<int>(run), p, poses, r.t[i] - tau) : poses[i];
+      const double c = std::cos(q.theta), s = std::sin(q.theta);
+      return Pose2{q.x + c * dx - s * dy, q.y + s * dx + c * dy, q.theta};
+    };
+    for (int j : pieces_of_run_[run]) {
+      const Piece& pc = campaign_.pieces[j];
+      out[j] = Relative(predicted(pc.a), predicted(pc.b));
+    }
+  }
+  return out;
+}
+
+void MeanModel::Residuals(const ParamVector& p, std::vector<double>& eps) const {
+  const std::vector<Pose2> pred = PredictedPieceMotion(p);
+  eps.resize(3 * pred.size());
+  for (std::size_t j = 0; j < pred.size(); ++j) {
+    eps[3 * j] = observed_[j].x - pred[j].x;
+    eps[3 * j + 1] = observed_[j].y - pred[j].y;
+    eps[3 * j + 2] = WrapAngle(observed_[j].theta - pred[j].theta);
+  }
+}
+
+Eigen::MatrixXd MeanModel::Jacobian(const ParamVector& p, const std::vector<int>& params,
+                                    const std::vector<double>& eps0) const {
+  static const double kStep[kNumParams] = {1e-6, 1e-6, 1e-6, 1e-6, 1e-6, 1e-7, 1e-8, 1e-6, 1e-6, 1e-5};
+  Eigen::MatrixXd J(eps0.size(), params.size());
+  std::vector<double> eps;
+  for (std::size_t k = 0; k < params.size(); ++k) {
+    ParamVector q = p;
+    const double h = kStep[params[k]];
+    q[params[k]] += h;
+    Residuals(q, eps);
+    for (std::size_t i = 0; i < eps.size(); ++i) J(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(k)) = (eps[i] - eps0[i]) / h;
+  }
+  return J;
+}
+
+std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanModel& model, const ParamVector& p) {
+  std::vector<PieceBases> out(campaign.pieces.size());
+  const std::vector<Pose2> motion = model.PredictedPieceMotion(p);
+  const double b = campaign.robot.wheelbase_m * p[kParamEb];
+  const double E_d = p[kParamEd];
+  const double c_L = 2.0 / (E_d + 1.0), c_R = 2.0 * E_d / (E_d + 1.0);
+  const double q_L = campaign.tick_left_m * campaign.tick_left_m / 12.0;
+  const double q_R = campaign.tick_right_m * campaign.tick_right_m / 12.0;
+  for (std::size_t j = 0; j < campaign.pieces.size(); ++j) {
+    const Piece& pc = campaign.pieces[j];
+    const DiagRun& r = campaign.runs[pc.run];
+    PieceBases& B = out[j];
+    Pose2 q;  // local frame of the piece start
+    Eigen::Matrix3d P_L = Eigen::Matrix3d::Zero(), P_R = P_L, P_LR = P_L;
+    Eigen::Matrix<double, 3, 2> M_start = Eigen::Matrix<double, 3, 2>::Zero();
+    bool first_moving = true;
+    Eigen::Matrix<double, 3, 2> G_last = Eigen::Matrix<double, 3, 2>::Zero();
+    for (std::size_t i = pc.a; i < pc.b; ++i) {
+      const double l = (r.left[i + 1] - r.left[i]) * c_L, rr = (r.right[i + 1] - r.right[i]) * c_R;
+      const double ds = 0.5 * (l + rr), dtheta = (rr - l) / b, h = 0.5 * dtheta;
+      const double sinc = Sinc(h);
+      // d sinc / d h, stable near 0 (-h/3 + h^3/30).
+      const double dsinc = std::abs(h) < 1e-4 ? -h / 3.0 + h * h * h / 30.0 : (h * std::cos(h) - std::sin(h)) / (h * h);
+      const double chord = ds * sinc;
+      const double hd = q.theta + h, ch = std::cos(hd), sh = std::sin(hd);
+      // d(chord)/dl, d(chord)/dr and d(heading)/dl, dr (heading = theta + h).
+      const double dchord_dl = 0.5 * sinc - ds * dsinc / (2.0 * b);
+      const double dchord_dr = 0.5 * sinc + ds * dsinc / (2.0 * b);
+      const double dh_dl = -1.0 / (2.0 * b), dh_dr = 1.0 / (2.0 * b);
+      Eigen::Matrix<double, 3, 2> G;
+      G << dchord_dl * ch - chord * sh * dh_dl, dchord_dr * ch - chord * sh * dh_dr,  //
+          dchord_dl * sh + chord * ch * dh_dl, dchord_dr * sh + chord * ch * dh_dr,   //
+          -1.0 / b, 1.0 / b;
+      const Pose2 next = {q.x + chord * ch, q.y + chord * sh, q.theta + dtheta};
+      Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+      F(0, 2) = -(next.y - q.y);
+      F(1, 2) = next.x - q.x;
+      const double al = std::abs(l), ar = std::abs(rr);
+      P_L = F * P_L * F.transpose() + al * G.col(0) * G.col(0).transpose();
+      P_R = F * P_R * F.transpose() + ar * G.col(1) * G.col(1).transpose();
+      P_LR = F * P_LR * F.transpose() +
+             std::sqrt(al * ar) * (G.col(0) * G.col(1).transpose() + G.col(1) * G.col(0).transpose());
+      M_start = F * M_start;
+      if (al + ar > 0.0) {
+        if (first_moving) {
+          M_start = G;
+          first_moving = false;
+        }
+        G_last = G;
+      }
+      B.travel_left_m += al;
+      B.travel_right_m += ar;
+      q = next;
+    }
+    Eigen::Matrix3d P_Q = Eigen::Matrix3d::Zero();
+    if (!first_moving && !r.endpoint) {
+      B.quant_start = M_start;
+      B.quant_end = G_last;
+      P_Q = q_L * (M_start.col(0) * M_start.col(0).transpose() + G_last.col(0) * G_last.col(0).transpose()) +
+            q_R * (M_start.col(1) * M_start.col(1).transpose() + G_last.col(1) * G_last.col(1).transpose());
+    }
+    B.A_L = P_L;
+    B.A_R = P_R;
+    B.A_LR = P_LR;
+    B.Q = P_Q;
+    B.G_xy = Eigen::Vector3d(2.0, 2.0, 0.0).asDiagonal();
+    const Eigen::Vector3d jv(motion[j].y, -motion[j].x, -1.0);
+    B.G_theta = jv * jv.transpose();
+    B.G_theta(2, 2) += 1.0;
+  }
+  return out;
+}
+
+}  // namespace umbmark::diag

@@ -1,0 +1,108 @@
+// The diagnosis' model of a campaign: the baseline (the seeds' model:
+// systematic E_d, E_b; white wheel noise k_L, k_R; encoder quantisation;
+// ground-truth noise) plus the contract's effects, evaluated on the
+// recorded encoder travel of every run.
+//
+// Mean (MeanModel): the true path is replayed from the recorded nominal
+// wheel travel exactly as the simulator defines the effects (campaign_run.hpp):
+//   true travel  l = dL c_L (1 + s) [(1 + a) if dL < 0]
+//                r = dR c_R (1 + s) (1 + r_drift i) [(1 + a) if dR < 0]
+//   heading      (r - l) / (E_b b), times (1 - k) inside spot turns
+//   castor kick  +-kappa at the first interval of every non-turn motion
+//   predicted ground truth  the pose at t - tau, reported at (dx, dy)
+// with c_L = 2/(E_d + 1), c_R = 2/(1/E_d + 1). A piece's residual is
+//   eps = Rel(GT_a, GT_b) - Rel(P_a, P_b)        ([x, y, theta], start frame of the piece)
+// (theta wrapped), whose mean is zero when the model is right.
+//
+// Covariance (PieceBases): under the baseline eps is zero-mean with
+//   Cov(eps) = k_L^2 A_L + k_R^2 A_R + rho k_L k_R A_LR      (wheel noise, eq. 4 with correlation rho)
+//            + sigma_xy^2 G_xy + sigma_theta^2 G_theta        (ground-truth noise at both ends)
+//            + Q                                               (encoder quantisation at both ends)
+// A_* by Kelly's recursion P <- F P F^T + G_u S G_u^T over the piece's
+// encoder intervals (each an exact arc, G_u its Jacobian in the wheel
+// travels), G_xy = diag(2, 2, 0), G_theta = j j^T + e3 e3^T with
+// j = (dy, -dx, -1) (heading noise at the start rotates the piece), and
+// Q from a uniform +-half-tick error of each wheel's count at both ends
+// (zero for a standstill, whose counts do not change).
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "diagnosis/campaign.hpp"
+
+namespace umbmark::diag {
+
+/// Mean-model parameters: the baseline's and every mean effect's.
+enum ParamIndex : int {
+  kParamEd = 0,   ///< E_d
+  kParamEb,       ///< E_b
+  kParamScale,    ///< scale_error.s
+  kParamScrub,    ///< turn_scrub.k
+  kParamAsym,     ///< direction_asymmetry.a
+  kParamKappa,    ///< castor_kick.kappa [rad]
+  kParamDrift,    ///< parameter_drift.r [1/run]
+  kParamDx,       ///< gt_offset.dx [m]
+  kParamDy,       ///< gt_offset.dy [m]
+  kParamTau,      ///< time_offset.tau [s]
+  kNumParams
+};
+using ParamVector = std::array<double, kNumParams>;
+
+/// E_d = E_b = 1, every effect zero.
+ParamVector NominalParams();
+const char* ParamName(int index);
+
+/// Residuals of every piece, flattened: eps[3 j + c] (c: x, y, theta).
+class MeanModel {
+ public:
+  explicit MeanModel(const CampaignData& campaign);
+
+  /// Residuals for `p` (size 3 * pieces).
+  void Residuals(const ParamVector& p, std::vector<double>& eps) const;
+
+  /// d eps / d p_k for k in `params` (forward differences), as a
+  /// (3 * pieces) x params.size() matrix, at `p` whose residuals are `eps0`.
+  Eigen::MatrixXd Jacobian(const ParamVector& p, const std::vector<int>& params, const std::vector<double>& eps0) const;
+
+  /// Predicted relative motion of every piece (Rel(P_a, P_b)) for `p`.
+  std::vector<Pose2> PredictedPieceMotion(const ParamVector& p) const;
+
+  /// Predicted ground-truth pose at every sample of run `run` (start at
+  /// the true start pose (0, 0, 0)), for reports.
+  std::vector<Pose2> PredictRun(int run, const ParamVector& p) const;
+
+  /// Observed relative motion Rel(GT_a, GT_b) of every piece.
+  const std::vector<Pose2>& ObservedPieceMotion() const { return observed_; }
+
+  const CampaignData& campaign() const { return campaign_; }
+
+ private:
+  void ReplayRun(int run, const ParamVector& p, std::vector<Pose2>& poses) const;
+  Pose2 PoseAt(int run, const ParamVector& p, const std::vector<Pose2>& poses, double t) const;
+
+  const CampaignData& campaign_;
+  std::vector<Pose2> observed_;
+  std::vector<std::vector<int>> pieces_of_run_;
+};
+
+/// Covariance bases of one piece (see file comment).
+struct PieceBases {
+  Eigen::Matrix3d A_L = Eigen::Matrix3d::Zero(), A_R = Eigen::Matrix3d::Zero(), A_LR = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d G_xy = Eigen::Matrix3d::Zero(), G_theta = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d Q = Eigen::Matrix3d::Zero();
+  /// Effect on the piece's end pose (start frame) of one metre of extra
+  /// recorded travel of each wheel at the piece's start / end sample (the
+  /// quantisation error's lever arms; Q sums their squares x tick^2 / 12).
+  Eigen::Matrix<double, 3, 2> quant_start = Eigen::Matrix<double, 3, 2>::Zero();
+  Eigen::Matrix<double, 3, 2> quant_end = Eigen::Matrix<double, 3, 2>::Zero();
+  double travel_left_m = 0.0, travel_right_m = 0.0;  ///< sum of |wheel travel| (bumps)
+};
+
+/// Bases of every piece, along the path predicted for `p` (the shape of a
+/// piece barely depends on the parameters; the baseline fit is used).
+std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanModel& model, const ParamVector& p);
+
+}  // namespace umbmark::diag

@@ -1,0 +1,346 @@
+// Maximum-likelihood noise parameters (see noise_fit.hpp).
+#include "diagnosis/noise_fit.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Dense>
+
+#include "core/angles.hpp"
+
+namespace umbmark::diag {
+
+double NoiseParams::rho() const {
+  const double d = std::sqrt(std::max(kL2, 0.0) * std::max(kR2, 0.0));
+  return d > 0.0 ? c_LR / d : 0.0;
+}
+
+Eigen::Matrix3d PieceCovariance(const PieceBases& B, const NoiseParams& n) {
+  return n.kL2 * B.A_L + n.kR2 * B.A_R + n.c_LR * B.A_LR + n.sxy2 * B.G_xy + n.sth2 * B.G_theta + B.Q;
+}
+
+BumpMixture PieceMixture(const PieceBases& B, const NoiseParams& n) {
+  BumpMixture m;
+  m.cov[0] = PieceCovariance(B, n);
+  const double travel = B.travel_left_m + B.travel_right_m;
+  if (!(n.bump_rate > 0.0 && n.bump_s2 > 0.0 && travel > 0.0)) return m;
+  Eigen::Matrix3d per_bump = Eigen::Matrix3d::Zero();
+  int wheels = 0;
+  if (B.travel_left_m > 0.0) {
+    per_bump += B.A_L / B.travel_left_m;
+    ++wheels;
+  }
+  if (B.travel_right_m > 0.0) {
+    per_bump += B.A_R / B.travel_right_m;
+    ++wheels;
+  }
+  per_bump *= n.bump_s2 / wheels;
+  const double lambda = n.bump_rate * travel;
+  m.components = 4;
+  const double e = std::exp(-lambda);
+  m.weight[0] = e;
+  m.weight[1] = e * lambda;
+  m.weight[2] = e * lambda * lambda / 2.0;
+  m.weight[3] = std::max(0.0, 1.0 - m.weight[0] - m.weight[1] - m.weight[2]);
+  for (int k = 1; k < 4; ++k) m.cov[k] = m.cov[0] + k * per_bump;
+  return m;
+}
+
+namespace {
+
+constexpr double kLog2Pi = 1.8378770664093453;
+
+/// log N(eps; 0, C) over the first d components.
+double GaussLogPdf(const double* eps, int d, const Eigen::Matrix3d& C) {
+  if (d == 3) {
+    Eigen::LLT<Eigen::Matrix3d> llt(C);
+    if (llt.info() != Eigen::Success) return -1e300;
+    const Eigen::Vector3d e(eps[0], eps[1], eps[2]);
+    const Eigen::Vector3d z = llt.matrixL().solve(e);
+    const Eigen::Matrix3d L = llt.matrixL();
+    const double logdet = 2.0 * (std::log(L(0, 0)) + std::log(L(1, 1)) + std::log(L(2, 2)));
+    return -0.5 * (z.squaredNorm() + logdet + 3.0 * kLog2Pi);
+  }
+  const Eigen::Matrix2d C2 = C.topLeftCorner<2, 2>();
+  Eigen::LLT<Eigen::Matrix2d> llt(C2);
+  if (llt.info() != Eigen::Success) return -1e300;
+  const Eigen::Vector2d e(eps[0], eps[1]);
+  const Eigen::Vector2d z = llt.matrixL().solve(e);
+  const Eigen::Matrix2d L = llt.matrixL();
+  const double logdet = 2.0 * (std::log(L(0, 0)) + std::log(L(1, 1)));
+  return -0.5 * (z.squaredNorm() + logdet + 2.0 * kLog2Pi);
+}
+
+bool Used(const std::vector<char>& use, std::size_t j) { return use.empty() || use[j] != 0; }
+
+struct Component {
+  int param;  // 0 kL2, 1 kR2, 2 c, 3 sxy2, 4 sth2
+};
+
+double& Slot(NoiseParams& n, int m) {
+  switch (m) {
+    case 0: return n.kL2;
+    case 1: return n.kR2;
+    case 2: return n.c_LR;
+    case 3: return n.sxy2;
+    default: return n.sth2;
+  }
+}
+
+const Eigen::Matrix3d& Basis(const PieceBases& B, int m) {
+  switch (m) {
+    case 0: return B.A_L;
+    case 1: return B.A_R;
+    case 2: return B.A_LR;
+    case 3: return B.G_xy;
+    default: return B.G_theta;
+  }
+}
+
+double TotalLogLik(const std::vector<double>& eps, const std::vector<PieceBases>& bases, const std::vector<Piece>& pieces,
+                   const std::vector<char>& use, const NoiseParams& n) {
+  double ll = 0.0;
+  for (std::size_t j = 0; j < pieces.size(); ++j)
+    if (Used(use, j)) ll += PieceLogLik(&eps[3 * j], pieces[j].components, bases[j], n);
+  return ll;
+}
+
+/// Adds one piece's Fisher score and information (over the first D
+/// residual components) for the active variance components.
+template <int D>
+void AccumulateFisher(const double* eps, const PieceBases& B, const NoiseParams& n, const std::vector<int>& active,
+                      Eigen::Matrix<double, 5, 1>& score, Eigen::Matrix<double, 5, 5>& info) {
+  using Mat = Eigen::Matrix<double, D, D>;
+  using Vec = Eigen::Matrix<double, D, 1>;
+  const Mat C = PieceCovariance(B, n).template topLeftCorner<D, D>();
+  const Mat Ci = C.inverse();
+  Vec e;
+  for (int c = 0; c < D; ++c) e[c] = eps[c];
+  const Vec u = Ci * e;
+  const int p = static_cast<int>(active.size());
+  Mat M[5];
+  for (int a = 0; a < p; ++a) {
+    const Mat Bm = Basis(B, active[a]).template topLeftCorner<D, D>();
+    M[a] = Ci * Bm;
+    score[a] += 0.5 * (u.dot(Bm * u) - M[a].trace());
+  }
+  for (int a = 0; a < p; ++a)
+    for (int b = a; b < p; ++b) {
+      const double v = 0.5 * (M[a].cwiseProduct(M[b].transpose())).sum();
+      info(a, b) += v;
+      if (b != a) info(b, a) += v;
+    }
+}
+
+void Clamp(NoiseParams& n, const NoiseFitOptions& o) {
+  n.kL2 = std::max(n.kL2, o.min_k2);
+  n.kR2 = std::max(n.kR2, o.min_k2);
+  n.sxy2 = std::max(n.sxy2, o.min_sigma_xy2);
+  n.sth2 = std::max(n.sth2, o.min_sigma_theta2);
+  const double lim = 0.995 * std::sqrt(n.kL2 * n.kR2);
+  n.c_LR = std::clamp(n.c_LR, -lim, lim);
+}
+
+}  // namespace
+
+double PieceLogLik(const double* eps, int components, const PieceBases& B, const NoiseParams& n) {
+  if (!(n.bump_rate > 0.0 && n.bump_s2 > 0.0)) return GaussLogPdf(eps, components, PieceCovariance(B, n));
+  const BumpMixture m = PieceMixture(B, n);
+  if (m.components == 1) return GaussLogPdf(eps, components, m.cov[0]);
+  double lp[4], mx = -1e300;
+  for (int k = 0; k < m.components; ++k) {
+    lp[k] = m.weight[k] > 0.0 ? std::log(m.weight[k]) + GaussLogPdf(eps, components, m.cov[k]) : -1e300;
+    mx = std::max(mx, lp[k]);
+  }
+  double s = 0.0;
+  for (int k = 0; k < m.components; ++k) s += std::exp(lp[k] - mx);
+  return mx + std::log(s);
+}
+
+NoiseParams FitNoise(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
+                     const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start,
+                     const NoiseFitOptions& options) {
+  std::vector<int> active = {0, 1};
+  if (options.correlated) active.push_back(2);
+  if (options.fit_ground_truth) {
+    active.push_back(3);
+    active.push_back(4);
+  }
+  const int p = static_cast<int>(active.size());
+  NoiseParams n = start;
+  n.bump_rate = n.bump_s2 = 0.0;
+  if (!options.correlated) n.c_LR = 0.0;
+  Clamp(n, options);
+
+  // Rough start: scale the fitted variances so the mean chi^2 per component is 1.
+  for (int pass = 0; pass < 3; ++pass) {
+    double chi2 = 0.0, dof = 0.0;
+    for (std::size_t j = 0; j < pieces.size(); ++j) {
+      if (!Used(use, j)) continue;
+      const int d = pieces[j].components;
+      const Eigen::Matrix3d C = PieceCovariance(bases[j], n);
+      if (d == 3) {
+        const Eigen::Vector3d e(eps[3 * j], eps[3 * j + 1], eps[3 * j + 2]);
+        chi2 += e.dot(C.ldlt().solve(e));
+      } else {
+        const Eigen::Vector2d e(eps[3 * j], eps[3 * j + 1]);
+        chi2 += e.dot(C.topLeftCorner<2, 2>().ldlt().solve(e));
+      }
+      dof += d;
+    }
+    if (dof <= 0.0) return n;
+    const double f = std::clamp(chi2 / dof, 1e-4, 1e4);
+    if (std::abs(f - 1.0) < 0.3) break;
+    for (int m : active) Slot(n, m) *= f;
+    Clamp(n, options);
+  }
+
+  double ll = options.line_search ? TotalLogLik(eps, bases, pieces, use, n) : 0.0;
+  for (int it = 0; it < options.max_iterations; ++it) {
+    Eigen::Matrix<double, 5, 1> score = Eigen::Matrix<double, 5, 1>::Zero();
+    Eigen::Matrix<double, 5, 5> info = Eigen::Matrix<double, 5, 5>::Zero();
+    for (std::size_t j = 0; j < pieces.size(); ++j) {
+      if (!Used(use, j)) continue;
+      if (pieces[j].components == 3)
+        AccumulateFisher<3>(&eps[3 * j], bases[j], n, active, score, info);
+      else
+        AccumulateFisher<2>(&eps[3 * j], bases[j], n, active, score, info);
+    }
+    const Eigen::MatrixXd I = info.topLeftCorner(p, p);
+    const Eigen::VectorXd step = I.ldlt().solve(score.head(p));
+    if (!step.allFinite()) break;
+    if (!options.line_search) {
+      NoiseParams next = n;
+      for (int a2 = 0; a2 < p; ++a2) Slot(next, active[a2]) += step[a2];
+      Clamp(next, options);
+      double change = 0.0;
+      for (int a2 = 0; a2 < p; ++a2)
+        change = std::max(change, std::abs(Slot(next, active[a2]) - Slot(n, active[a2])) /
+                                      std::max(std::abs(Slot(n, active[a2])), 1e-12));
+      n = next;
+      if (change < options.tolerance) break;
+      continue;
+    }
+    double t = 1.0;
+    NoiseParams best = n;
+    double best_ll = ll;
+    for (int half = 0; half < 8; ++half, t *= 0.5) {
+      NoiseParams trial = n;
+      for (int a2 = 0; a2 < p; ++a2) Slot(trial, active[a2]) += t * step[a2];
+      Clamp(trial, options);
+      const double tll = TotalLogLik(eps, bases, pieces, use, trial);
+      if (tll > best_ll) {
+        best = trial;
+        best_ll = tll;
+        break;
+      }
+    }
+    const double gain = best_ll - ll;
+    n = best;
+    ll = best_ll;
+    if (!(gain > 1e-7)) break;
+  }
+  return n;
+}
+
+NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
+                     const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start) {
+  // Nelder-Mead over x = [log kL2, log kR2, log rate, log sb2].
+  auto unpack = [&](const std::array<double, 4>& x) {
+    NoiseParams n = start;
+    n.c_LR = 0.0;
+    n.kL2 = std::exp(x[0]);
+    n.kR2 = std::exp(x[1]);
+    n.bump_rate = std::exp(x[2]);
+    n.bump_s2 = std::exp(x[3]);
+    return n;
+  };
+  auto cost = [&](const std::array<double, 4>& x) {
+    for (double v : x)
+      if (!std::isfinite(v) || std::abs(v) > 60.0) return 1e300;
+    return -TotalLogLik(eps, bases, pieces, use, unpack(x));
+  };
+  const double k2 = std::max(0.5 * (start.kL2 + start.kR2), 1e-12);
+  std::vector<std::array<double, 4>> starts = {
+      {std::log(std::max(start.kL2, 1e-14) * 0.7), std::log(std::max(start.kR2, 1e-14) * 0.7), std::log(0.2),
+       std::log(30.0 * k2)},
+      {std::log(std::max(start.kL2, 1e-14) * 0.9), std::log(std::max(start.kR2, 1e-14) * 0.9), std::log(1.0),
+       std::log(6.0 * k2)}};
+  if (start.bump_rate > 0.0 && start.bump_s2 > 0.0)
+    starts.insert(starts.begin(), {std::log(start.kL2), std::log(start.kR2), std::log(start.bump_rate),
+                                   std::log(start.bump_s2)});
+  std::array<double, 4> best_x = starts.front();
+  double best_f = 1e300;
+  for (const auto& x0 : starts) {
+    std::array<std::array<double, 4>, 5> s;
+    std::array<double, 5> f;
+    s[0] = x0;
+    for (int i = 0; i < 4; ++i) {
+      s[i + 1] = x0;
+      s[i + 1][i] += i >= 2 ? 1.0 : 0.5;
+    }
+    for (int i = 0; i < 5; ++i) f[i] = cost(s[i]);
+    for (int it = 0; it < 250; ++it) {
+      std::array<int, 5> idx = {0, 1, 2, 3, 4};
+      std::sort(idx.begin(), idx.end(), [&](int a, int b) { return f[a] < f[b]; });
+      std::array<std::array<double, 4>, 5> s2;
+      std::array<double, 5> f2;
+      for (int i = 0; i < 5; ++i) {
+        s2[i] = s[idx[i]];
+        f2[i] = f[idx[i]];
+      }
+      s = s2;
+      f = f2;
+      if (std::abs(f[4] - f[0]) < 1e-6 * (1.0 + std::abs(f[0]))) break;
+      std::array<double, 4> c{};
+      for (int i = 0; i < 4; ++i)
+        for (int k = 0; k < 4; ++k) c[k] += s[i][k] / 4.0;
+      auto along = [&](double t) {
+        std::array<double, 4> x;
+        for (int k = 0; k < 4; ++k) x[k] = c[k] + t * (s[4][k] - c[k]);
+        return x;
+      };
+      const auto xr = along(-1.0);
+      const double fr = cost(xr);
+      if (fr < f[0]) {
+        const auto xe = along(-2.0);
+        const double fe = cost(xe);
+        if (fe < fr) {
+          s[4] = xe;
+          f[4] = fe;
+        } else {
+          s[4] = xr;
+          f[4] = fr;
+        }
+      } else if (fr < f[3]) {
+        s[4] = xr;
+        f[4] = fr;
+      } else {
+        const auto xc = along(fr < f[4] ? -0.5 : 0.5);
+        const double fc = cost(xc);
+        if (fc < std::min(fr, f[4])) {
+          s[4] = xc;
+          f[4] = fc;
+        } else {
+          for (int i = 1; i < 5; ++i) {
+            for (int k = 0; k < 4; ++k) s[i][k] = s[0][k] + 0.5 * (s[i][k] - s[0][k]);
+            f[i] = cost(s[i]);
+          }
+        }
+      }
+    }
+    int bi = 0;
+    for (int i = 1; i < 5; ++i)
+      if (f[i] < f[bi]) bi = i;
+    if (f[bi] < best_f) {
+      best_f = f[bi];
+      best_x = s[bi];
+    }
+  }
+  return unpack(best_x);
+}
+
+}  // namespace umbmark::diag

@@ -1,0 +1,83 @@
+// Noise parameters of the diagnosis' model, fitted by maximum likelihood to
+// the piece residuals (model.hpp):
+//   Cov(eps_j) = k_L^2 A_L + k_R^2 A_R + c A_LR + sigma_xy^2 G_xy + sigma_theta^2 G_theta + Q
+// with c = rho k_L k_R (correlated_noise; 0 in the baseline). The model is
+// linear in v = [k_L^2, k_R^2, c, sigma_xy^2, sigma_theta^2], so Fisher
+// scoring (the Gaussian REML/ML iteration for variance components,
+//   v <- v + I^-1 s,  s_m = 1/2 sum_j (eps^T C^-1 B_m C^-1 eps - tr C^-1 B_m),
+//   I_mn = 1/2 sum_j tr(C^-1 B_m C^-1 B_n))
+// converges in a few steps; bounds keep k^2, sigma^2 >= 0 and |rho| < 1.
+// This is the same estimator `fit-noise` needs (Chong & Kleeman's k_L, k_R
+// from runs with ground truth), written here on the diagnosis' pieces.
+//
+// bump_outliers (a per-wheel Poisson process of travel errors N(0, sigma_b^2),
+// `rate` per metre) makes eps_j a scale mixture: with m bumps on the piece
+// (m ~ Poisson(rate (|L| + |R|)), truncated at 3) its covariance is
+//   C_j + m sigma_b^2 (A_L / |L| + A_R / |R|) / 2
+// (a bump's effect averaged over where on the piece, and which wheel, it
+// strikes). FitBumps maximises that mixture likelihood by Nelder-Mead.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "diagnosis/model.hpp"
+
+namespace umbmark::diag {
+
+struct NoiseParams {
+  double kL2 = 1e-6, kR2 = 1e-6;  ///< k_L^2, k_R^2 [m]
+  double c_LR = 0.0;              ///< rho k_L k_R [m]
+  double sxy2 = 1e-8;             ///< sigma_xy^2 [m^2]
+  double sth2 = 1e-6;             ///< sigma_theta^2 [rad^2]
+  double bump_rate = 0.0;         ///< per metre of wheel travel
+  double bump_s2 = 0.0;           ///< sigma_b^2 [m^2]
+
+  double rho() const;
+};
+
+/// Covariance of piece j (Gaussian part: no bumps).
+Eigen::Matrix3d PieceCovariance(const PieceBases& B, const NoiseParams& n);
+
+/// Mixture of a piece under bump_outliers: weights and covariances of m = 0..3 bumps.
+struct BumpMixture {
+  int components = 1;
+  double weight[4] = {1.0, 0.0, 0.0, 0.0};
+  Eigen::Matrix3d cov[4];
+};
+BumpMixture PieceMixture(const PieceBases& B, const NoiseParams& n);
+
+struct NoiseFitOptions {
+  /// Estimate sigma_xy, sigma_theta (else fixed at the start values).
+  bool fit_ground_truth = false;
+  /// Estimate c = rho k_L k_R (correlated_noise).
+  bool correlated = false;
+  int max_iterations = 60;
+  /// Step halving on the likelihood (robust from a poor start); without it
+  /// plain Fisher steps until the relative change is below `tolerance`
+  /// (fast, for starts near the answer such as simulated null campaigns).
+  bool line_search = true;
+  double tolerance = 1e-6;
+  /// Floors of the variances (keep the covariances invertible).
+  double min_k2 = 1e-14, min_sigma_xy2 = 1e-14, min_sigma_theta2 = 1e-14;
+};
+
+/// Maximum-likelihood noise parameters on the pieces with use[j] (all when
+/// `use` is empty), from `start`. eps: residuals (3 per piece).
+NoiseParams FitNoise(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
+                     const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start,
+                     const NoiseFitOptions& options);
+
+/// As FitNoise, plus bump_outliers' rate and sigma_b (mixture likelihood,
+/// Nelder-Mead over log k_L^2, log k_R^2, log rate, log sigma_b^2; ground
+/// truth noise fixed at `start`'s).
+NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
+                     const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start);
+
+/// Log-likelihood of piece j's residual (Gaussian, or the bump mixture when
+/// n.bump_rate > 0).
+double PieceLogLik(const double* eps, int components, const PieceBases& B, const NoiseParams& n);
+
+}  // namespace umbmark::diag
