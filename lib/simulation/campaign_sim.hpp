@@ -92,7 +92,7 @@ struct CampaignSimOptions {
 struct SimulatedCampaign {
   Manifest manifest;  ///< experiments with `file` as in the input manifest
   /// Per experiment: the trajectory or endpoint data written to its file.
-  std::vector<std::variant<TrajectoryData, EndpointData>> data;
+  std::vector<std::variant<EndpointData, TrajectoryData>> data;
   GroundTruthNoise ground_truth_noise;  ///< what was applied
   int total_runs = 0;
   std::uint64_t seed = 0;
