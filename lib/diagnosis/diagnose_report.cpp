@@ -190,17 +190,21 @@ std::string DiagnoseReport(const DiagnoseSummary& s) {
 }
 
 std::string DiagnosePlotSvg(const DiagnoseSummary& s) {
+  // Gaps span orders of magnitude (a time offset can score 1e6, noise 1):
+  // bars show log10(1 + gap) per statistic kind.
   std::vector<std::string> labels;
   std::vector<double> before, after;
   const Candidate* w = Winner(s);
   for (int k = 0; k < kNumStatKinds; ++k) {
     labels.push_back(StatKindToString(static_cast<StatKind>(k)));
-    before.push_back(s.gap_by_kind[k]);
-    after.push_back(w ? w->gap_by_kind[k] : s.gap_by_kind[k]);
+    before.push_back(std::log10(1.0 + s.gap_by_kind[k]));
+    after.push_back(std::log10(1.0 + (w ? w->gap_by_kind[k] : s.gap_by_kind[k])));
   }
   const std::string name = w ? fmt::format("with {}", sim::EffectToString(w->effect)) : "no candidate";
-  return io::SvgBarChart(fmt::format("Gap per statistic (sum of (|z| - 2)^2), verdict: {}", s.verdict), labels,
-                         {before, after}, {"baseline", name}, {"#d62728", "#2ca02c"});
+  const std::string chart =
+      io::SvgBarChart(fmt::format("log10(1 + gap) per statistic, gap = sum (|z| - 2)^2; verdict: {}", s.verdict),
+                      labels, {before, after}, {"baseline", name}, {"#d62728", "#2ca02c"});
+  return io::SvgDocument(760, 40 + 28.0 * kNumStatKinds + 60, {chart});
 }
 
 }  // namespace umbmark::diag

@@ -1,0 +1,316 @@
+// Blind validation benchmark of `umbmark diagnose`: for every contract
+// effect, for no effect, and for two effects outside the contract's list,
+// simulate campaigns of random robots with random systematic errors, noise
+// and effect magnitudes in realistic ranges, hide the truth, diagnose, and
+// report the confusion matrix, top-1 accuracy on listed effects, the
+// false-alarm rate on clean campaigns, the `unexplained` rate on outside
+// effects, the median heldout_shrink and the time per diagnosis.
+//
+// Standard campaign (the issue's): 10 cw + 10 ccw squares and 20
+// back-and-forth runs, trajectories with ground truth. --extended adds a
+// free experiment of 4 figure-eight runs (arcs), which separates turn_scrub
+// from a wheelbase error.
+//
+// Random draws (uniform unless stated; "+-" = random sign):
+//   robot      wheelbase 0.2-0.6 m, wheel diameter 0.06-0.2 m (both nominal
+//              equal), ticks 500-20000 per wheel revolution
+//   truth      E_d = 1 +- 0-0.01, E_b = 1 +- 0-0.03, k_L, k_R log-uniform
+//              3e-4-3e-3 m^1/2 (independently), ground truth sigma_xy
+//              0.1-0.5 mm, sigma_theta 0.5-3 mrad (stated in the manifest)
+//   motion     square side 2-4 m, back-and-forth distance 2-5 m, speed
+//              0.2-0.5 m/s, spot turns 0.5-1.5 rad/s, 20-50 Hz, 1 s pauses
+//   effects    scale_error s +-0.005-0.03; turn_scrub k 0.02-0.10;
+//              direction_asymmetry a +-0.005-0.03; castor_kick kappa
+//              +-0.003-0.02 rad; bump_outliers rate 0.2-1 /m, sigma 3-10 mm;
+//              correlated_noise rho +-0.5-0.9; parameter_drift r
+//              +-5e-5-5e-4 per run; gt_offset |(dx, dy)| 0.01-0.05 m in a
+//              random direction; time_offset tau +-0.02-0.1 s;
+//   outside    gt_yaw_misalignment delta +-0.005-0.02 rad; floor_slope g
+//              0.002-0.01 m/m towards a random direction
+//
+// Usage: bench_diagnose [--per-class N] [--clean N] [--seed S] [--threads T]
+//                       [--null-sims B] [--extended] [--classes a,b,...]
+//                       [--json FILE] [--write-dir DIR]
+// --write-dir also writes every campaign (manifest + CSV; truth.json beside,
+// not inside) so the same cases can be diagnosed through the CLI.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/angles.hpp"
+#include "diagnosis/campaign.hpp"
+#include "diagnosis/diagnose.hpp"
+#include "io/atomic_write.hpp"
+#include "simulation/campaign_sim.hpp"
+#include "simulation/effects.hpp"
+
+using namespace umbmark;
+
+namespace {
+
+struct Args {
+  int per_class = 20;
+  int clean = 60;
+  std::uint64_t seed = 2024;
+  int threads = 2;
+  int null_sims = 500;
+  bool extended = false;
+  std::vector<std::string> classes;
+  std::string json;
+  std::string write_dir;
+};
+
+Args Parse(int argc, char** argv) {
+  Args a;
+  for (int i = 1; i < argc; ++i) {
+    const std::string k = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        fmt::print(stderr, "missing value after {}\n", k);
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (k == "--per-class") a.per_class = std::stoi(next());
+    else if (k == "--clean") a.clean = std::stoi(next());
+    else if (k == "--seed") a.seed = std::stoull(next());
+    else if (k == "--threads") a.threads = std::stoi(next());
+    else if (k == "--null-sims") a.null_sims = std::stoi(next());
+    else if (k == "--extended") a.extended = true;
+    else if (k == "--json") a.json = next();
+    else if (k == "--write-dir") a.write_dir = next();
+    else if (k == "--classes") {
+      std::string s = next();
+      std::size_t p = 0;
+      while (p <= s.size()) {
+        const std::size_t q = s.find(',', p);
+        a.classes.push_back(s.substr(p, q == std::string::npos ? std::string::npos : q - p));
+        if (q == std::string::npos) break;
+        p = q + 1;
+      }
+    } else {
+      fmt::print(stderr, "unknown argument {}\n", k);
+      std::exit(2);
+    }
+  }
+  return a;
+}
+
+struct Case {
+  std::string truth;  ///< "none", a contract effect, or an outside effect
+  bool outside = false;
+  std::uint64_t seed = 0;
+  sim::CampaignSimOptions sim;
+  Manifest manifest;
+};
+
+double U(std::mt19937_64& g, double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(g); }
+double Sign(std::mt19937_64& g) { return U(g, 0.0, 1.0) < 0.5 ? -1.0 : 1.0; }
+double LogU(std::mt19937_64& g, double lo, double hi) { return std::exp(U(g, std::log(lo), std::log(hi))); }
+
+Case MakeCase(const std::string& truth, std::uint64_t seed, bool extended) {
+  std::mt19937_64 g(seed);
+  Case c;
+  c.truth = truth;
+  c.seed = seed;
+  RobotParams robot;
+  robot.wheelbase_m = U(g, 0.2, 0.6);
+  const double d = U(g, 0.06, 0.2);
+  robot.wheel_diameter_left_m = robot.wheel_diameter_right_m = d;
+  robot.ticks_per_rev = std::round(U(g, 500.0, 20000.0));
+  const GroundTruthNoise gt{U(g, 1e-4, 5e-4), U(g, 0.5e-3, 3e-3)};
+  c.manifest = sim::StandardCampaignManifest(robot, U(g, 2.0, 4.0), U(g, 2.0, 5.0), gt);
+  if (extended) {
+    Experiment fr;
+    fr.kind = ExperimentKind::kFree;
+    fr.file = fr.resolved_file = "figure_eight.csv";
+    c.manifest.experiments.push_back(fr);
+  }
+  sim::CampaignSimOptions& o = c.sim;
+  o.seed = seed;
+  o.truth.E_d = 1.0 + Sign(g) * U(g, 0.0, 0.01);
+  o.truth.E_b = 1.0 + Sign(g) * U(g, 0.0, 0.03);
+  o.truth.k_L = LogU(g, 3e-4, 3e-3);
+  o.truth.k_R = LogU(g, 3e-4, 3e-3);
+  o.square_runs_per_direction = 10;
+  o.back_and_forth_runs = 20;
+  o.free_runs = 4;
+  o.sample_rate_hz = std::round(U(g, 20.0, 50.0));
+  o.speed_m_s = U(g, 0.2, 0.5);
+  o.turn_rate_rad_s = U(g, 0.5, 1.5);
+  o.pause_s = 1.0;
+  o.free_radius_m = U(g, 0.8, 1.5);
+  sim::Effects& fx = o.effects;
+  const auto kind = sim::EffectFromString(truth);
+  if (kind) {
+    c.outside = !sim::Describe(*kind).in_contract;
+    switch (*kind) {
+      case sim::EffectKind::kScaleError: fx.scale_s = Sign(g) * U(g, 0.005, 0.03); break;
+      case sim::EffectKind::kTurnScrub: fx.scrub_k = U(g, 0.02, 0.10); break;
+      case sim::EffectKind::kDirectionAsymmetry: fx.asymmetry_a = Sign(g) * U(g, 0.005, 0.03); break;
+      case sim::EffectKind::kCastorKick: fx.castor_kappa = Sign(g) * U(g, 0.003, 0.02); break;
+      case sim::EffectKind::kBumpOutliers:
+        fx.bump_rate = U(g, 0.2, 1.0);
+        fx.bump_sigma = U(g, 0.003, 0.01);
+        break;
+      case sim::EffectKind::kCorrelatedNoise: fx.noise_rho = Sign(g) * U(g, 0.5, 0.9); break;
+      case sim::EffectKind::kParameterDrift: fx.drift_r = Sign(g) * U(g, 5e-5, 5e-4); break;
+      case sim::EffectKind::kGtOffset: {
+        const double r = U(g, 0.01, 0.05), a = U(g, 0.0, 2.0 * kPi);
+        fx.gt_dx = r * std::cos(a);
+        fx.gt_dy = r * std::sin(a);
+        break;
+      }
+      case sim::EffectKind::kTimeOffset: fx.time_tau = Sign(g) * U(g, 0.02, 0.1); break;
+      case sim::EffectKind::kGtYawMisalignment: fx.yaw_delta = Sign(g) * U(g, 0.005, 0.02); break;
+      case sim::EffectKind::kFloorSlope:
+        fx.slope_g = U(g, 0.002, 0.01);
+        fx.slope_dir = U(g, 0.0, 2.0 * kPi);
+        break;
+    }
+  }
+  return c;
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Args args = Parse(argc, argv);
+  std::vector<std::string> classes = args.classes;
+  if (classes.empty()) {
+    classes.push_back("none");
+    for (const auto& d : sim::EffectCatalogue()) classes.emplace_back(d.name);
+  }
+  std::vector<Case> cases;
+  for (std::size_t ci = 0; ci < classes.size(); ++ci) {
+    const int count = classes[ci] == "none" ? args.clean : args.per_class;
+    for (int i = 0; i < count; ++i)
+      cases.push_back(MakeCase(classes[ci], args.seed * 1000003ull + ci * 10007ull + static_cast<std::uint64_t>(i),
+                               args.extended));
+  }
+
+  diag::DiagnoseOptions dopt;
+  dopt.threads = args.threads;
+  dopt.null_simulations = args.null_sims;
+  std::vector<std::string> verdict_names = {"none", "unexplained"};
+  for (auto k : sim::ContractEffects()) verdict_names.emplace_back(sim::EffectToString(k));
+
+  std::map<std::string, std::map<std::string, int>> confusion;
+  nlohmann::json records = nlohmann::json::array();
+  std::vector<double> times, heldout_true, heldout_verdict;
+  std::map<std::string, std::vector<double>> stage_times;
+  int listed = 0, listed_right = 0, listed_no_scrub = 0, listed_no_scrub_right = 0;
+  int clean = 0, false_alarms = 0, outside = 0, outside_unexplained = 0;
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const Case& c = cases[i];
+    const sim::SimulatedCampaign campaign = sim::SimulateCampaign(c.manifest, c.sim);
+    if (!args.write_dir.empty()) {
+      const std::string dir = fmt::format("{}/{:03d}_{}", args.write_dir, i, c.truth);
+      sim::WriteCampaign(campaign, dir + "/campaign");
+      io::WriteFileAtomically(dir + "/truth.json", sim::CampaignTruthJson(campaign, c.sim).dump(2) + "\n");
+    }
+    // Blind: the diagnosis sees the manifest and the data only.
+    const auto t0 = std::chrono::steady_clock::now();
+    const diag::CampaignData data = diag::BuildCampaign(campaign.manifest, campaign.data, dopt.pieces);
+    diag::DiagnoseOptions o = dopt;
+    o.seed = c.seed;
+    const diag::DiagnoseSummary s = diag::Diagnose(data, o);
+    const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    times.push_back(dt);
+    for (const auto& [stage, v] : s.timings) stage_times[stage].push_back(v);
+    confusion[c.truth][s.verdict] += 1;
+    const bool right = s.verdict == c.truth;
+    if (c.truth == "none") {
+      ++clean;
+      if (s.verdict != "none") ++false_alarms;
+    } else if (c.outside) {
+      ++outside;
+      if (s.verdict == "unexplained") ++outside_unexplained;
+    } else {
+      ++listed;
+      listed_right += right;
+      if (c.truth != "turn_scrub") {
+        ++listed_no_scrub;
+        listed_no_scrub_right += right;
+      }
+      for (const auto& cd : s.candidates) {
+        if (sim::EffectToString(cd.effect) == c.truth) heldout_true.push_back(cd.heldout_shrink);
+        if (sim::EffectToString(cd.effect) == s.verdict) heldout_verdict.push_back(cd.heldout_shrink);
+      }
+    }
+    nlohmann::json truth = sim::CampaignTruthJson(campaign, c.sim);
+    records.push_back({{"case", i},
+                       {"truth", c.truth},
+                       {"verdict", s.verdict},
+                       {"p_value", s.p_value},
+                       {"gap_score", s.gap_score},
+                       {"seconds", dt},
+                       {"robot",
+                        {{"wheelbase_m", c.manifest.robot.wheelbase_m},
+                         {"diameter_m", c.manifest.robot.wheel_diameter_left_m},
+                         {"ticks_per_rev", *c.manifest.robot.ticks_per_rev}}},
+                       {"sim_truth", truth},
+                       {"top",
+                        s.candidates.empty() ? nlohmann::json(nullptr)
+                                             : nlohmann::json{{"effect", sim::EffectToString(s.candidates[0].effect)},
+                                                              {"heldout_shrink", s.candidates[0].heldout_shrink},
+                                                              {"evidence", s.candidates[0].evidence}}}});
+    fmt::print("{:4d} {:<20} -> {:<20} p={:<7.4f} G={:<10.1f} {:.2f}s\n", i, c.truth, s.verdict, s.p_value,
+               s.gap_score, dt);
+    std::fflush(stdout);
+  }
+
+  fmt::print("\nConfusion matrix (rows: truth, columns: verdict)\n{:<20}", "");
+  for (const auto& v : verdict_names) fmt::print(" {:>6.6}", v);
+  fmt::print("\n");
+  for (const auto& t : classes) {
+    fmt::print("{:<20}", t);
+    for (const auto& v : verdict_names) fmt::print(" {:>6d}", confusion[t][v]);
+    fmt::print("\n");
+  }
+  auto pct = [](int a, int b) { return b > 0 ? 100.0 * a / b : std::nan(""); };
+  fmt::print("\ncampaign: {}\n", args.extended ? "standard + 4 figure-eight runs (extended)" : "standard");
+  fmt::print("top-1 accuracy on listed effects:          {:5.1f}% ({}/{})\n", pct(listed_right, listed), listed_right, listed);
+  fmt::print("  without turn_scrub (= E_b without arcs): {:5.1f}% ({}/{})\n", pct(listed_no_scrub_right, listed_no_scrub),
+             listed_no_scrub_right, listed_no_scrub);
+  fmt::print("false alarms on clean campaigns:           {:5.1f}% ({}/{})\n", pct(false_alarms, clean), false_alarms, clean);
+  fmt::print("'unexplained' on outside effects:          {:5.1f}% ({}/{})\n", pct(outside_unexplained, outside),
+             outside_unexplained, outside);
+  fmt::print("median heldout_shrink (true effect):       {:.3f}\n", Median(heldout_true));
+  fmt::print("median heldout_shrink (verdict's effect):  {:.3f}\n", Median(heldout_verdict));
+  fmt::print("time per diagnosis: median {:.2f} s, max {:.2f} s\n", Median(times),
+             times.empty() ? 0.0 : *std::max_element(times.begin(), times.end()));
+  for (const auto& [stage, v] : stage_times) fmt::print("  {:<42} median {:.3f} s\n", stage, Median(v));
+  if (!args.json.empty()) {
+    nlohmann::json summary = {{"extended", args.extended},
+                              {"seed", args.seed},
+                              {"top1_listed", pct(listed_right, listed) / 100.0},
+                              {"top1_listed_without_turn_scrub", pct(listed_no_scrub_right, listed_no_scrub) / 100.0},
+                              {"false_alarm_rate", pct(false_alarms, clean) / 100.0},
+                              {"outside_unexplained_rate", pct(outside_unexplained, outside) / 100.0},
+                              {"median_heldout_shrink_true", Median(heldout_true)},
+                              {"median_heldout_shrink_verdict", Median(heldout_verdict)},
+                              {"median_seconds", Median(times)},
+                              {"confusion", confusion},
+                              {"cases", records}};
+    io::WriteFileAtomically(args.json, summary.dump(1) + "\n");
+  }
+  return 0;
+}

@@ -1,0 +1,338 @@
+// Diagnosis tests on simulated campaigns with a known truth: the model
+// reproduces the simulator's effects exactly (noise-free), its covariance
+// matches Monte Carlo scatter, the noise fit recovers k_L, k_R, the gap's
+// p-value is calibrated on clean campaigns, known effects are found and
+// their parameters recovered, unidentifiable effects are reported as such,
+// an effect outside the list is `unexplained`, and the command writes the
+// contract's JSON.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "diagnosis/campaign.hpp"
+#include "diagnosis/diagnose.hpp"
+#include "diagnosis/gap_stats.hpp"
+#include "diagnosis/model.hpp"
+#include "diagnosis/noise_fit.hpp"
+#include "simulation/campaign_sim.hpp"
+#include "support/run_cli.hpp"
+
+using namespace umbmark;
+using namespace umbmark::diag;
+using Catch::Matchers::WithinAbs;
+using Catch::Matchers::WithinRel;
+
+namespace {
+
+RobotParams Robot(bool ticks = true) {
+  RobotParams r;
+  r.wheelbase_m = 0.35;
+  r.wheel_diameter_left_m = 0.1;
+  r.wheel_diameter_right_m = 0.1;
+  if (ticks) r.ticks_per_rev = 8192;
+  return r;
+}
+
+/// A small campaign: `square_runs` cw and ccw squares of 2 m, `bf_runs`
+/// back-and-forth runs of 2 m, optionally 3 figure-eights; 10 Hz, 0.5 m/s.
+struct Small {
+  Manifest manifest;
+  sim::CampaignSimOptions sim;
+};
+
+Small MakeSmall(std::uint64_t seed, int square_runs = 5, int bf_runs = 10, bool free = false, bool ticks = true) {
+  Small s;
+  s.manifest = sim::StandardCampaignManifest(Robot(ticks), 2.0, 2.0, GroundTruthNoise{3e-4, 1.5e-3});
+  if (free) {
+    Experiment e;
+    e.kind = ExperimentKind::kFree;
+    e.file = e.resolved_file = "free.csv";
+    s.manifest.experiments.push_back(e);
+  }
+  s.sim.seed = seed;
+  s.sim.truth.E_d = 1.004;
+  s.sim.truth.E_b = 1.012;
+  s.sim.truth.k_L = 1.5e-3;
+  s.sim.truth.k_R = 2.5e-3;
+  s.sim.square_runs_per_direction = square_runs;
+  s.sim.back_and_forth_runs = bf_runs;
+  s.sim.free_runs = 3;
+  s.sim.sample_rate_hz = 10.0;
+  s.sim.speed_m_s = 0.5;
+  s.sim.pause_s = 0.5;
+  return s;
+}
+
+CampaignData Build(const Small& s) {
+  const sim::SimulatedCampaign c = sim::SimulateCampaign(s.manifest, s.sim);
+  return BuildCampaign(c.manifest, c.data);
+}
+
+DiagnoseOptions Fast(std::uint64_t seed = 1) {
+  DiagnoseOptions o;
+  o.null_simulations = 100;
+  o.seed = seed;
+  o.threads = 2;
+  o.pieces.folds = 4;
+  return o;
+}
+
+const Candidate* Find(const DiagnoseSummary& s, sim::EffectKind k) {
+  for (const auto& c : s.candidates)
+    if (c.effect == k) return &c;
+  return nullptr;
+}
+
+ParamVector TrueParams(const Small& s) {
+  ParamVector p = NominalParams();
+  p[kParamEd] = s.sim.truth.E_d;
+  p[kParamEb] = s.sim.truth.E_b;
+  p[kParamScale] = s.sim.effects.scale_s;
+  p[kParamScrub] = s.sim.effects.scrub_k;
+  p[kParamAsym] = s.sim.effects.asymmetry_a;
+  p[kParamKappa] = s.sim.effects.castor_kappa;
+  p[kParamDrift] = s.sim.effects.drift_r;
+  p[kParamDx] = s.sim.effects.gt_dx;
+  p[kParamDy] = s.sim.effects.gt_dy;
+  p[kParamTau] = s.sim.effects.time_tau;
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("diagnose model: replays every mean effect exactly (noise-free)", "[diagnose]") {
+  // All mean effects at once, no noise, wheel travel as distances: the
+  // model's pieces must match the simulator's ground truth to rounding.
+  Small s = MakeSmall(3, 2, 2, true, false);
+  s.sim.truth.k_L = s.sim.truth.k_R = 0.0;
+  s.sim.ground_truth = GroundTruthNoise{0.0, 0.0};
+  s.sim.effects.scale_s = 0.02;
+  s.sim.effects.scrub_k = 0.05;
+  s.sim.effects.asymmetry_a = -0.015;
+  s.sim.effects.castor_kappa = 0.01;
+  s.sim.effects.drift_r = 3e-4;
+  s.sim.effects.gt_dx = 0.03;
+  s.sim.effects.gt_dy = -0.02;
+  s.sim.effects.time_tau = 0.037;
+  const CampaignData c = Build(s);
+  const MeanModel model(c);
+  std::vector<double> eps;
+  model.Residuals(TrueParams(s), eps);
+  double worst = 0.0;
+  for (double e : eps) worst = std::max(worst, std::abs(e));
+  CHECK(worst < 1e-8);
+  // ...and the nominal model is far off.
+  model.Residuals(NominalParams(), eps);
+  double nominal = 0.0;
+  for (double e : eps) nominal = std::max(nominal, std::abs(e));
+  CHECK(nominal > 1e-2);
+}
+
+TEST_CASE("diagnose model: piece covariance matches Monte Carlo scatter", "[diagnose]") {
+  // At the true parameters the whitened scores of many noisy runs have unit
+  // variance and no correlation (eq. 4 noise, ground-truth noise and
+  // quantisation, 2000+ pieces: sample variance within ~10 %).
+  Small s = MakeSmall(11, 15, 30);
+  s.manifest.robot.ticks_per_rev = 1024;  // coarse ticks: quantisation matters
+  const CampaignData c = Build(s);
+  const MeanModel model(c);
+  std::vector<double> eps;
+  const ParamVector p = TrueParams(s);
+  model.Residuals(p, eps);
+  const std::vector<PieceBases> bases = ComputeBases(c, model, p);
+  NoiseParams n;
+  n.kL2 = s.sim.truth.k_L * s.sim.truth.k_L;
+  n.kR2 = s.sim.truth.k_R * s.sim.truth.k_R;
+  n.sxy2 = 3e-4 * 3e-4;
+  n.sth2 = 1.5e-3 * 1.5e-3;
+  const std::vector<Scores> z = PieceScores(eps, bases, c.pieces, n);
+  for (PieceType type : {PieceType::kStraight, PieceType::kTurn, PieceType::kStand}) {
+    double sq[3] = {0, 0, 0}, prod = 0;
+    int count = 0;
+    for (std::size_t j = 0; j < z.size(); ++j) {
+      if (c.pieces[j].type != type) continue;
+      ++count;
+      for (int k = 0; k < 3; ++k) sq[k] += z[j][k] * z[j][k];
+      prod += z[j][0] * z[j][2];
+    }
+    INFO(PieceTypeToString(type) << ": " << count << " pieces");
+    REQUIRE(count > 100);
+    const double tol = 4.0 * std::sqrt(2.0 / count);
+    for (int k = 0; k < 3; ++k) CHECK_THAT(sq[k] / count, WithinAbs(1.0, tol));
+    CHECK_THAT(prod / count, WithinAbs(0.0, 4.0 / std::sqrt(count)));
+  }
+}
+
+TEST_CASE("diagnose: clean campaign: baseline recovered, no gap", "[diagnose]") {
+  const Small s = MakeSmall(21);
+  const CampaignData c = Build(s);
+  const DiagnoseSummary d = Diagnose(c, Fast());
+  CHECK(d.verdict == "none");
+  CHECK(d.p_value > 0.01);
+  CHECK_THAT(d.baseline.E_d, WithinAbs(1.004, 3e-4));
+  CHECK_THAT(d.baseline.E_b, WithinAbs(1.012, 2e-3));
+  CHECK_THAT(d.baseline.k_L, WithinRel(1.5e-3, 0.3));
+  CHECK_THAT(d.baseline.k_R, WithinRel(2.5e-3, 0.3));
+  CHECK(d.baseline.returns.size() == 3);  // cw, ccw, fwd_back
+  // turn_scrub is E_b without arcs: reported as indistinguishable, not fitted.
+  const Candidate* scrub = Find(d, sim::EffectKind::kTurnScrub);
+  REQUIRE(scrub);
+  CHECK_FALSE(scrub->identifiable);
+  bool listed = false;
+  for (const auto& t : d.indistinguishable) listed = listed || t.find("turn_scrub") != std::string::npos;
+  CHECK(listed);
+}
+
+TEST_CASE("diagnose: ground truth noise is estimated when the manifest does not state it", "[diagnose]") {
+  Small s = MakeSmall(23);
+  s.sim.ground_truth = GroundTruthNoise{4e-4, 2e-3};
+  s.sim.state_ground_truth = false;
+  const CampaignData c = Build(s);
+  REQUIRE_FALSE(c.ground_truth);
+  DiagnoseOptions o = Fast();
+  o.effects = {sim::EffectKind::kScaleError};
+  const DiagnoseSummary d = Diagnose(c, o);
+  CHECK(d.baseline.ground_truth_estimated);
+  CHECK_THAT(d.baseline.sigma_xy_m, WithinRel(4e-4, 0.15));
+  CHECK_THAT(d.baseline.sigma_theta_rad, WithinRel(2e-3, 0.15));
+  CHECK(d.verdict == "none");
+}
+
+TEST_CASE("diagnose: p-value is calibrated on campaigns from the baseline itself", "[diagnose]") {
+  // 16 clean campaigns: p-values should look uniform. P(>= 5 of 16 below
+  // 0.1) = 0.017 and the mean of 16 uniforms is 0.5 +- 0.072.
+  int below = 0;
+  double sum = 0.0;
+  const int campaigns = 16;
+  for (int i = 0; i < campaigns; ++i) {
+    Small s = MakeSmall(100 + static_cast<std::uint64_t>(i), 3, 6);
+    s.sim.truth.E_d = 1.0 + 0.002 * (i % 3);
+    DiagnoseOptions o = Fast(7 + static_cast<std::uint64_t>(i));
+    o.null_simulations = 60;
+    o.effects = {sim::EffectKind::kScaleError};  // the p-value does not depend on the candidates
+    const DiagnoseSummary d = Diagnose(Build(s), o);
+    below += d.p_value < 0.1;
+    sum += d.p_value;
+  }
+  CHECK(below <= 4);
+  CHECK_THAT(sum / campaigns, WithinAbs(0.5, 0.22));
+}
+
+TEST_CASE("diagnose: gt_offset is found and its offset recovered", "[diagnose]") {
+  Small s = MakeSmall(31);
+  s.sim.effects.gt_dx = 0.025;
+  s.sim.effects.gt_dy = -0.015;
+  const DiagnoseSummary d = Diagnose(Build(s), Fast());
+  CHECK(d.significant);
+  CHECK(d.verdict == "gt_offset");
+  const Candidate* c = Find(d, sim::EffectKind::kGtOffset);
+  REQUIRE(c);
+  CHECK_THAT(c->params.at("dx"), WithinAbs(0.025, 5.0 * c->param_se.at("dx")));
+  CHECK_THAT(c->params.at("dy"), WithinAbs(-0.015, 5.0 * c->param_se.at("dy")));
+  CHECK(c->param_se.at("dx") < 0.003);
+  CHECK(c->shrink > 0.8);
+  CHECK(c->heldout_shrink > 0.5);
+  // The strongest discrepancy is in the spot turns (where the offset point moves).
+  REQUIRE_FALSE(d.where.empty());
+  CHECK(d.where.front().subset.find("spot turn") != std::string::npos);
+}
+
+TEST_CASE("diagnose: castor_kick is found, kappa recovered", "[diagnose]") {
+  Small s = MakeSmall(41);
+  s.sim.effects.castor_kappa = -0.008;
+  const DiagnoseSummary d = Diagnose(Build(s), Fast());
+  CHECK(d.verdict == "castor_kick");
+  const Candidate* c = Find(d, sim::EffectKind::kCastorKick);
+  REQUIRE(c);
+  CHECK_THAT(c->params.at("kappa"), WithinAbs(-0.008, 5.0 * c->param_se.at("kappa")));
+  CHECK(c->heldout_shrink > 0.5);
+}
+
+TEST_CASE("diagnose: direction_asymmetry is found on the backward legs", "[diagnose]") {
+  Small s = MakeSmall(43);
+  s.sim.effects.asymmetry_a = 0.012;
+  const DiagnoseSummary d = Diagnose(Build(s), Fast());
+  CHECK(d.verdict == "direction_asymmetry");
+  const Candidate* c = Find(d, sim::EffectKind::kDirectionAsymmetry);
+  REQUIRE(c);
+  CHECK_THAT(c->params.at("a"), WithinAbs(0.012, 5.0 * c->param_se.at("a")));
+}
+
+TEST_CASE("diagnose: turn_scrub needs arcs: found with figure-eights", "[diagnose]") {
+  Small s = MakeSmall(51, 5, 10, true);
+  s.sim.effects.scrub_k = 0.05;
+  const DiagnoseSummary d = Diagnose(Build(s), Fast());
+  const Candidate* c = Find(d, sim::EffectKind::kTurnScrub);
+  REQUIRE(c);
+  CHECK(c->identifiable);
+  CHECK(d.verdict == "turn_scrub");
+  CHECK_THAT(c->params.at("k"), WithinAbs(0.05, 5.0 * c->param_se.at("k")));
+  // With scrub in the model, E_b returns to the true wheelbase error.
+  CHECK_THAT(c->E_b, WithinAbs(1.012, 3e-3));
+}
+
+TEST_CASE("diagnose: endpoint-only squares cannot separate scale_error from E_b", "[diagnose]") {
+  Small s = MakeSmall(61, 8, 10);
+  s.manifest.experiments.pop_back();  // squares only
+  s.sim.endpoint_squares = true;
+  s.sim.effects.scale_s = 0.02;
+  const CampaignData c = Build(s);
+  REQUIRE(c.pieces.size() == 16);  // one return-error piece per run
+  DiagnoseOptions o = Fast();
+  const DiagnoseSummary d = Diagnose(c, o);
+  const Candidate* sc = Find(d, sim::EffectKind::kScaleError);
+  REQUIRE(sc);
+  CHECK_FALSE(sc->identifiable);
+  bool listed = false;
+  for (const auto& t : d.indistinguishable) listed = listed || t.find("scale_error") != std::string::npos;
+  CHECK(listed);
+  CHECK(d.verdict != "scale_error");
+}
+
+TEST_CASE("diagnose: an effect outside the list is unexplained, not a confident wrong name", "[diagnose]") {
+  Small s = MakeSmall(71);
+  s.sim.effects.yaw_delta = 0.012;  // motion-capture yaw misalignment
+  const DiagnoseSummary d = Diagnose(Build(s), Fast());
+  CHECK(d.significant);
+  CHECK(d.verdict == "unexplained");
+}
+
+TEST_CASE("umbmark diagnose: contract JSON, report, plot", "[diagnose][cli]") {
+  using testing::Q;
+  const auto dir = testing::TempDir("diagnose-cli");
+  Small s = MakeSmall(81, 3, 6);
+  s.sim.effects.time_tau = 0.06;
+  const sim::SimulatedCampaign c = sim::SimulateCampaign(s.manifest, s.sim);
+  const std::string manifest = sim::WriteCampaign(c, (dir / "campaign").string());
+  auto r = testing::RunCli("diagnose " + Q(manifest) + " --null-sims 100 --folds 3 --json " + Q(dir / "d.json") +
+                           " --plot " + Q(dir / "gap.svg"));
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  CHECK(r.out.find("Verdict: time_offset") != std::string::npos);
+  const auto j = nlohmann::json::parse(testing::Slurp((dir / "d.json").string()));
+  CHECK(j["gap"]["score"].is_number());
+  CHECK(j["gap"]["p_value"].is_number());
+  CHECK(j["gap"]["where"].is_array());
+  REQUIRE_FALSE(j["gap"]["where"].empty());
+  for (const char* k : {"experiment", "subset", "statistic", "size_se"}) CHECK(j["gap"]["where"][0].contains(k));
+  REQUIRE(j["candidates"].size() == 9);
+  for (const auto& cd : j["candidates"]) {
+    CHECK(cd["effect"].is_string());
+    CHECK(cd["params"].is_object());
+    CHECK(cd["shrink"].is_number());
+    CHECK(cd["heldout_shrink"].is_number());
+  }
+  CHECK(j["candidates"][0]["effect"] == "time_offset");
+  CHECK(j["verdict"]["effect"] == "time_offset");
+  CHECK(testing::Slurp((dir / "gap.svg").string()).find("<svg") != std::string::npos);
+  // --json - writes JSON alone.
+  r = testing::RunCli("diagnose " + Q(manifest) + " --null-sims 20 --folds 2 --effects time_offset --json -");
+  REQUIRE(r.status == 0);
+  CHECK(nlohmann::json::parse(r.out)["verdict"]["effect"] == "time_offset");
+  // Usage and input errors.
+  CHECK(testing::RunCli("diagnose " + Q(manifest) + " --effects warp").status == 2);
+  CHECK(testing::RunCli("diagnose " + Q(dir / "missing.toml")).status == 2);
+}
