@@ -103,7 +103,7 @@ TEST_CASE("endpoint CSV without an etheta column", "[io][endpoint]") {
   CHECK_FALSE(d.runs[0].etheta_rad.has_value());
 }
 
-TEST_CASE("endpoint etheta is wrapped to (-pi, pi]", "[io][endpoint]") {
+TEST_CASE("endpoint etheta is wrapped to the interval -pi (excluded) to pi", "[io][endpoint]") {
   const EndpointData d = io::ParseEndpointCsv("run,direction,ex_m,ey_m,etheta_rad\n1,cw,0,0,7\n2,cw,0,0,-3.5\n", "x");
   CHECK(*d.runs[0].etheta_rad == Approx(7.0 - 2.0 * kPi).margin(1e-15));
   CHECK(*d.runs[1].etheta_rad == Approx(-3.5 + 2.0 * kPi).margin(1e-15));
