@@ -217,3 +217,39 @@ TEST_CASE("Runs in one direction only: exit 1 naming the file", "[cli][bad-input
   CHECK(r2.status == 1);
   CHECK(r2.err.rfind((dir / "bad_dir.csv").string() + ":3:", 0) == 0);
 }
+
+TEST_CASE("calibrate --refine adds the contract's refined object", "[cli][refine]") {
+  const auto r = RunCli("calibrate " + Q(Imported() / "campaign.toml") + " --refine --json -");
+  REQUIRE(r.status == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  const auto& ref = j.at("refined");
+  for (const char* key : {"wheelbase_m", "wheel_diameter_left_m", "wheel_diameter_right_m"}) {
+    INFO(key);
+    CHECK(ref.at("parameters").at(key).is_number());
+    // The refined parameters are a correction of at most a few percent.
+    CHECK(ref["parameters"][key].get<double>() == Approx(j["recorded_parameters"][key].get<double>()).epsilon(0.05));
+  }
+  REQUIRE(ref.at("covariance").size() == 3);
+  for (int i = 0; i < 3; ++i) {
+    REQUIRE(ref["covariance"][i].size() == 3);
+    CHECK(ref["covariance"][i][i].get<double>() > 0.0);
+    for (int k = 0; k < 3; ++k)
+      CHECK(ref["covariance"][i][k].get<double>() == Approx(ref["covariance"][k][i].get<double>()).epsilon(1e-12));
+  }
+  CHECK(ref.at("final_cost").get<double>() >= 0.0);
+  CHECK(ref.at("covariance_order") ==
+        nlohmann::json({"wheelbase_m", "wheel_diameter_left_m", "wheel_diameter_right_m"}));
+}
+
+TEST_CASE("calibrate --refine --free scale on endpoint squares fails the quality gate (exit 3)", "[cli][refine]") {
+  // Return errors of squares do not determine the mean wheel diameter.
+  const auto r = RunCli("calibrate " + Q(kSrc / "data/examples/endpoints.csv") + " --robot " +
+                        Q(kSrc / "data/examples/robot.toml") + " --side 0.75 --refine --free scale --json -");
+  CHECK(r.status == 3);
+  CHECK(r.out.empty());  // no numbers from a failed fit
+  CHECK(r.err.find("refined calibration failed") != std::string::npos);
+  // With the scale held (the default), the same data calibrate.
+  const auto ok = RunCli("calibrate " + Q(kSrc / "data/examples/endpoints.csv") + " --robot " +
+                         Q(kSrc / "data/examples/robot.toml") + " --side 0.75 --refine --json -");
+  CHECK(ok.status == 0);
+}
