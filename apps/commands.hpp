@@ -22,5 +22,6 @@ Command SetupEvaluate(CLI::App& parent);
 Command SetupImport(CLI::App& parent);
 Command SetupSimulate(CLI::App& parent);
 Command SetupDiagnose(CLI::App& parent);
+Command SetupPredict(CLI::App& parent);
 
 }  // namespace umbmark::cli

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   commands.push_back(cli::SetupImport(app));
   commands.push_back(cli::SetupSimulate(app));
   commands.push_back(cli::SetupDiagnose(app));
+  commands.push_back(cli::SetupPredict(app));
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,167 @@
+// `umbmark predict --robot R.toml --kl K --kr K --path SPEC [--P0 ...]
+//   [--monte-carlo RUNS [--partitions P] [--seed N] [--threads T]]`:
+// closed-form mean pose and covariance after a path (Chong & Kleeman eqs.
+// 23-28), optionally next to a Monte Carlo estimate of the same quantities
+// (each segment split into P partitions with white wheel noise).
+#include <cmath>
+#include <memory>
+#include <optional>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "core/angles.hpp"
+#include "core/errors.hpp"
+#include "error_models/path_covariance.hpp"
+#include "error_models/path_spec.hpp"
+#include "simulation/monte_carlo.hpp"
+
+namespace umbmark::cli {
+namespace {
+
+struct PredictOptions {
+  RobotFlags robot;
+  double k_L = 0.0, k_R = 0.0;
+  std::string path;
+  std::vector<double> p0;  // 3 (diagonal), 6 (upper triangle) or 9 (row-major) values
+  std::optional<std::int64_t> mc_runs;
+  int partitions = 1000;
+  std::uint64_t seed = 1;
+  int threads = 0;
+  JsonFlag json;
+};
+
+/// --P0: 3 values = diagonal variances [xx, yy, thth]; 6 = upper triangle
+/// [xx, xy, xth, yy, yth, thth]; 9 = row-major 3x3.
+PoseCovariance ParseP0(const std::vector<double>& v) {
+  PoseCovariance P = PoseCovariance::Zero();
+  if (v.empty()) return P;
+  if (v.size() == 3) {
+    P.diagonal() << v[0], v[1], v[2];
+  } else if (v.size() == 6) {
+    P << v[0], v[1], v[2], v[1], v[3], v[4], v[2], v[4], v[5];
+  } else if (v.size() == 9) {
+    P << v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8];
+    if (!P.isApprox(P.transpose(), 1e-12)) throw InvalidOptions("--P0: the 3x3 matrix is not symmetric");
+  } else {
+    throw InvalidOptions(fmt::format("--P0 takes 3, 6 or 9 comma-separated values, got {}", v.size()));
+  }
+  if (!P.allFinite()) throw InvalidOptions("--P0: values must be finite");
+  return P;
+}
+
+nlohmann::json JsonMatrix(const PoseCovariance& P) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int i = 0; i < 3; ++i) rows.push_back({P(i, 0), P(i, 1), P(i, 2)});
+  return rows;
+}
+
+void PrintCovariance(const char* title, const Pose2& mean, const PoseCovariance& P) {
+  const double sx = std::sqrt(P(0, 0)), sy = std::sqrt(P(1, 1)), st = std::sqrt(P(2, 2));
+  fmt::print("{}\n", title);
+  fmt::print("  mean      x = {:.6g} m, y = {:.6g} m, theta = {:.6g} rad\n", mean.x, mean.y, mean.theta);
+  fmt::print("  stddev    x = {:.6g} m, y = {:.6g} m, theta = {:.6g} rad\n", sx, sy, st);
+  auto corr = [](double c, double a, double b) { return a > 0 && b > 0 ? 100.0 * c / (a * b) : 0.0; };
+  fmt::print("  corr (%)  x-theta = {:.4f}, y-theta = {:.4f}, x-y = {:.4f}\n", corr(P(0, 2), sx, st),
+             corr(P(1, 2), sy, st), corr(P(0, 1), sx, sy));
+  fmt::print("  covariance [m, m, rad]:\n");
+  for (int i = 0; i < 3; ++i) fmt::print("    {:>14.6e} {:>14.6e} {:>14.6e}\n", P(i, 0), P(i, 1), P(i, 2));
+}
+
+int RunPredict(const PredictOptions& o) {
+  const RobotParams robot = o.robot.Resolve();
+  const WheelNoise noise{o.k_L, o.k_R};
+  const std::vector<PathSegment> spec = ParsePathSpec(o.path);
+  const std::vector<WheelSegment> path = ToWheelSegments(spec, robot.wheelbase_m);
+  const PoseCovariance P0 = ParseP0(o.p0);
+  const PathCovarianceSummary pred = PredictPathCovariance(path, robot.wheelbase_m, noise, P0);
+  // Mean heading wrapped to (-pi, pi]; the continuous value is reported too.
+  const double theta_shift = WrapAngle(pred.mean.theta) - pred.mean.theta;
+  const Pose2 mean{pred.mean.x, pred.mean.y, pred.mean.theta + theta_shift};
+
+  nlohmann::json segments = nlohmann::json::array();
+  for (std::size_t i = 0; i < path.size(); ++i)
+    segments.push_back({{"left_m", path[i].left_m},
+                        {"right_m", path[i].right_m},
+                        {"form", SegmentFormToString(SegmentFormOf(path[i]))}});
+  nlohmann::json j = {{"path", PathSpecToString(spec)},
+                      {"wheelbase_m", robot.wheelbase_m},
+                      {"k_L", o.k_L},
+                      {"k_R", o.k_R},
+                      {"P0", JsonMatrix(P0)},
+                      {"segments", segments},
+                      {"mean", {mean.x, mean.y, mean.theta}},
+                      {"theta_continuous_rad", pred.mean.theta},
+                      {"covariance", JsonMatrix(pred.covariance)}};
+  if (o.json.PrintText()) {
+    fmt::print("Path {} (wheelbase {} m, k_L = {} m^1/2, k_R = {} m^1/2)\n", PathSpecToString(spec),
+               robot.wheelbase_m, o.k_L, o.k_R);
+    PrintCovariance("Closed form (Chong & Kleeman eqs. 23-28):", mean, pred.covariance);
+  }
+
+  if (o.mc_runs) {
+    sim::SimulationModel model;
+    model.nominal = robot;
+    model.noise = noise;
+    model.initial_covariance = P0;
+    const sim::SimPlan plan = sim::CompilePlan(model, path, o.partitions);
+    sim::MonteCarloOptions mo;
+    mo.runs = *o.mc_runs;
+    mo.seed = o.seed;
+    mo.threads = o.threads;
+    const sim::MonteCarloSummary mc = sim::RunMonteCarlo(plan, mo);
+    const Pose2 mc_mean{mc.mean.x, mc.mean.y, mc.mean.theta + theta_shift};
+    j["monte_carlo"] = {{"mean", {mc_mean.x, mc_mean.y, mc_mean.theta}},
+                        {"covariance", JsonMatrix(mc.covariance)},
+                        {"runs", mc.runs},
+                        {"partitions", o.partitions},
+                        {"seed", mc.seed},
+                        {"threads", mc.threads},
+                        {"steps", mc.runs * mc.steps_per_run},
+                        {"seconds", mc.seconds},
+                        {"steps_per_second", mc.steps_per_second},
+                        {"kernel", mc.kernel}};
+    if (o.json.PrintText()) {
+      fmt::print("\n");
+      PrintCovariance(fmt::format("Monte Carlo ({} runs x {} partitions per segment, seed {}):", mc.runs,
+                                  o.partitions, mc.seed)
+                          .c_str(),
+                      mc_mean, mc.covariance);
+      fmt::print("  {:.3e} wheel steps per second ({} threads, {} kernel, {:.3f} s)\n", mc.steps_per_second,
+                 mc.threads, mc.kernel, mc.seconds);
+    }
+  }
+  o.json.Emit(j);
+  return 0;
+}
+
+}  // namespace
+
+Command SetupPredict(CLI::App& parent) {
+  auto opts = std::make_shared<PredictOptions>();
+  auto* app = parent.add_subcommand("predict", "Closed-form pose mean and covariance after a path (Chong & Kleeman)");
+  opts->robot.Bind(*app);
+  app->add_option("--kl", opts->k_L, "Left wheel noise constant k_L [m^1/2]")->required()->check(CLI::NonNegativeNumber);
+  app->add_option("--kr", opts->k_R, "Right wheel noise constant k_R [m^1/2]")->required()->check(CLI::NonNegativeNumber);
+  app->add_option("--path", opts->path, "Segments: line:D, turn:ANGLE_RAD, arc:L_LEFT:L_RIGHT (comma-separated)")
+      ->required();
+  app->add_option("--P0", opts->p0,
+                  "Initial pose covariance: 3 values (variances xx,yy,thth), 6 (xx,xy,xth,yy,yth,thth) or 9 (row-major)")
+      ->delimiter(',');
+  app->add_option("--monte-carlo", opts->mc_runs, "Also estimate mean and covariance from RUNS simulated runs")
+      ->check(CLI::Range(static_cast<std::int64_t>(2), static_cast<std::int64_t>(1) << 40));
+  app->add_option("--partitions", opts->partitions, "Monte Carlo: partitions per segment")
+      ->check(CLI::Range(1, 1 << 30))
+      ->capture_default_str();
+  app->add_option("--seed", opts->seed, "Monte Carlo: seed (run i uses streams derived from (seed, i))")
+      ->capture_default_str();
+  app->add_option("--threads", opts->threads, "Monte Carlo: worker threads (0 = all cores)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  opts->json.Bind(*app);
+  return {app, [opts] { return RunPredict(*opts); }};
+}
+
+}  // namespace umbmark::cli

@@ -1,0 +1,118 @@
+// Maximum-likelihood fit of Chong & Kleeman's wheel noise constants k_L,
+// k_R (eq. 4) from return errors of repeated runs (their section 6.3 fits
+// them by trial and error from 60 runs of 10 m forward and back).
+//
+// Model: the return error of run i (e = true final pose - odometry final
+// pose, Borenstein & Feng eq. 3.1) is Gaussian,
+//   e_i ~ N(mu_g(i), S_i),  S_i = k_L^2 A_L,i + k_R^2 A_R,i + Q_i(k) + M_i,
+// where A_L,i, A_R,i are the motion covariance per unit k^2 along run i's
+// path (closed forms, eqs. 23-28, or Kelly's form along a logged
+// trajectory), Q_i the second-order heading term (k^4, second_order.hpp:
+// without it k_L^2 comes out ~13% low and k_R^2 ~10% high for Chong &
+// Kleeman's 10 m forward-and-back, and the 95% intervals cover the truth
+// in only ~90% of simulated campaigns), M_i the covariance of the external
+// reference's own error
+// (MeasurementCovariance), and mu_g a free systematic mean per group
+// (experiment and direction) -- residual systematic errors (UMBmark leaves
+// some) must not be read as noise. Runs without a heading error use the x-y
+// block. The group means are profiled out in closed form (generalised least
+// squares) and the likelihood is maximised over (log k_L, log k_R) with
+// Ceres' gradient solver (L-BFGS, automatic derivatives).
+//
+// 95% intervals: profile likelihood, {k : 2 (min NLL(k, .) - NLL_min) <=
+// 3.8415} (chi^2_1), found by bracketing and root finding; a bound that the
+// data cannot close is +inf.
+//
+// Goodness of fit: each of the six covariance elements of the residuals
+// (pooled over runs, N - G degrees of freedom) against the model's average
+// S_i, with the sampling standard error of a Gaussian sample covariance
+// sqrt(sum_i S_jj S_kk + S_jk^2) / (N - G), so the user sees which elements
+// the model cannot explain (Chong & Kleeman could not match all six).
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "error_models/second_order.hpp"
+#include "error_models/wheel_noise.hpp"
+#include "kinematics/pose2.hpp"
+
+namespace umbmark {
+
+/// One run's data for the fit.
+struct NoiseFitRun {
+  std::string group;  ///< systematic-mean group (e.g. "fwd_back" or "exp2:cw")
+  std::string run;    ///< run id (for reports)
+  Eigen::Vector3d error = Eigen::Vector3d::Zero();  ///< [ex, ey, etheta] (etheta wrapped)
+  bool has_theta = true;                            ///< false: etheta not measured
+  CovarianceBasis basis;                            ///< motion covariance per unit k^2
+  /// Second-order (heading-squared) term, k^4 terms of S_i (second_order.hpp);
+  /// zero to fit the pure first-order model.
+  SecondOrderBasis second_order;
+  PoseCovariance measurement = PoseCovariance::Zero();  ///< reference error covariance M_i
+};
+
+/// Covariance of the reference's error in a return error whose true
+/// relative pose (start frame) is `relative`, when the reference measures
+/// the start and the end pose each with independent noise sigma_xy [m] (per
+/// axis) and sigma_theta [rad]:
+///   M = diag(2 s_xy^2, 2 s_xy^2, s_th^2) + s_th^2 u u^T,  u = [y, -x, -1].
+PoseCovariance MeasurementCovariance(double sigma_xy_m, double sigma_theta_rad, const Pose2& relative);
+
+struct NoiseFitOptions {
+  /// Confidence level of the profile-likelihood intervals, in (0, 1).
+  double confidence = 0.95;
+  /// L-BFGS iteration limit of each optimisation (>= 10).
+  int max_iterations = 200;
+  /// Restricted maximum likelihood (REML): adds 1/2 sum_g log det(sum_i
+  /// S_i^-1) so the noise estimate allows for the degrees of freedom the
+  /// group means use (ML underestimates k^2 by about groups / runs).
+  bool restricted = false;
+  /// Empty when valid, else a message naming the bad field.
+  std::string Check() const;
+};
+
+/// Observed vs predicted for one covariance element.
+struct CovarianceElementCheck {
+  std::string element;       ///< "xx", "yy", "thth", "xy", "xth", "yth"
+  double observed = 0.0;     ///< pooled residual covariance
+  double predicted = 0.0;    ///< model average of S_i
+  double standard_error = 0.0;
+  double z = 0.0;            ///< (observed - predicted) / standard_error
+  int runs = 0;              ///< runs that enter this element
+};
+
+struct NoiseFitSummary {
+  double k_L = 0.0, k_R = 0.0;                     ///< [m^1/2]
+  std::array<double, 2> k_L_ci{0.0, 0.0};          ///< profile interval (high may be +inf)
+  std::array<double, 2> k_R_ci{0.0, 0.0};
+  double confidence = 0.95;
+  double neg_log_likelihood = 0.0;                 ///< at the optimum (constants dropped)
+  int runs = 0;
+  std::vector<std::string> groups;                 ///< group names, first-seen order
+  std::vector<Eigen::Vector3d> group_means;        ///< fitted systematic means
+  std::vector<Eigen::Vector3d> residuals;          ///< e_i - mu_g(i), per run
+  std::vector<PoseCovariance> predicted_run_covariance;  ///< S_i at the fit
+  std::vector<CovarianceElementCheck> goodness_of_fit;   ///< six elements
+  PoseCovariance observed_covariance = PoseCovariance::Zero();
+  PoseCovariance predicted_covariance = PoseCovariance::Zero();
+  int iterations = 0;
+  std::string solver_message;
+
+  std::string BriefReport() const;
+};
+
+/// Fits k_L, k_R. Throws InvalidOptions for bad options, InputError (file
+/// "") when the data cannot identify the model (fewer than groups + 2 runs,
+/// a group with a single run, non-finite errors), and QualityGateError when
+/// the solver fails to converge or the likelihood is not finite at the fit.
+NoiseFitSummary FitNoise(const std::vector<NoiseFitRun>& runs, const NoiseFitOptions& options = {});
+
+/// Negative log-likelihood (constants dropped) at given k with the group
+/// means profiled out; +inf when some S_i is not positive definite.
+double NoiseNegLogLikelihood(const std::vector<NoiseFitRun>& runs, double k_L, double k_R);
+
+}  // namespace umbmark
