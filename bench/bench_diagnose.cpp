@@ -30,7 +30,7 @@
 //
 // Usage: bench_diagnose [--per-class N] [--clean N] [--seed S] [--threads T]
 //                       [--null-sims B] [--extended] [--classes a,b,...]
-//                       [--json FILE] [--write-dir DIR]
+//                       [--json FILE] [--write-dir DIR] [--only-case I]
 // --write-dir also writes every campaign (manifest + CSV; truth.json beside,
 // not inside) so the same cases can be diagnosed through the CLI.
 #include <algorithm>
@@ -68,6 +68,7 @@ struct Args {
   std::vector<std::string> classes;
   std::string json;
   std::string write_dir;
+  int only_case = -1;
 };
 
 Args Parse(int argc, char** argv) {
@@ -89,6 +90,7 @@ Args Parse(int argc, char** argv) {
     else if (k == "--extended") a.extended = true;
     else if (k == "--json") a.json = next();
     else if (k == "--write-dir") a.write_dir = next();
+    else if (k == "--only-case") a.only_case = std::stoi(next());
     else if (k == "--classes") {
       std::string s = next();
       std::size_t p = 0;
@@ -220,6 +222,7 @@ int main(int argc, char** argv) {
   int clean = 0, false_alarms = 0, outside = 0, outside_unexplained = 0;
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const Case& c = cases[i];
+    if (args.only_case >= 0 && static_cast<int>(i) != args.only_case) continue;
     const sim::SimulatedCampaign campaign = sim::SimulateCampaign(c.manifest, c.sim);
     if (!args.write_dir.empty()) {
       const std::string dir = fmt::format("{}/{:03d}_{}", args.write_dir, i, c.truth);

@@ -45,6 +45,59 @@ double IntervalTravel(const DiagRun& r, std::size_t i) {
   return std::max(std::abs(r.left[i + 1] - r.left[i]), std::abs(r.right[i + 1] - r.right[i]));
 }
 
+/// Expected fraction of a tick beyond the count (see DiagRun::q_sd_left)
+/// and the remaining quantisation sd, for one wheel of a run with counts.
+void QuantisationPhase(const std::vector<std::int64_t>& ticks, const std::vector<sim::MotionSegment>& motions,
+                       double tick_m, std::vector<double>& cum_m, std::vector<double>& sd_m) {
+  const std::size_t n = ticks.size();
+  cum_m.resize(n);
+  sd_m.assign(n, 0.0);
+  std::vector<double> phase(n, 0.5);
+  const double unknown = tick_m / std::sqrt(12.0);
+  int last_dir = 0;  // direction of the last movement before the current standstill
+  std::size_t next = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    while (next < motions.size() && motions[next].EndSample() < i) {
+      // The motion is over: remember which way this wheel last turned.
+      for (std::size_t k = motions[next].EndSample(); k > motions[next].FirstSample(); --k) {
+        const std::int64_t d = ticks[k] - ticks[k - 1];
+        if (d != 0) {
+          last_dir = d > 0 ? 1 : -1;
+          break;
+        }
+      }
+      ++next;
+    }
+    bool moving = false;
+    if (next < motions.size() && motions[next].FirstSample() < i && i < motions[next].EndSample())
+      moving = ticks[motions[next].EndSample()] != ticks[motions[next].FirstSample()] ||
+               ticks[i] != ticks[motions[next].FirstSample()];
+    if (moving || last_dir == 0) {
+      phase[i] = 0.5;
+      sd_m[i] = unknown;
+    } else {
+      // A stop ends a motion at the sample after its last moving interval,
+      // so the motion's own end sample is stopped too.
+      phase[i] = last_dir > 0 ? 0.0 : 1.0;
+    }
+    if (!moving && next < motions.size() && i == motions[next].EndSample()) {
+      int dir = 0;
+      for (std::size_t k = i; k > motions[next].FirstSample(); --k) {
+        const std::int64_t d = ticks[k] - ticks[k - 1];
+        if (d != 0) {
+          dir = d > 0 ? 1 : -1;
+          break;
+        }
+      }
+      if (dir != 0) {
+        phase[i] = dir > 0 ? 0.0 : 1.0;
+        sd_m[i] = 0.0;
+      }
+    }
+    cum_m[i] = (static_cast<double>(ticks[i] - ticks[0]) + phase[i]) * tick_m;
+  }
+}
+
 /// Interval classes, castor kicks and active windows from the motions.
 void AnnotateIntervals(DiagRun& r) {
   const std::size_t intervals = r.t.empty() ? 0 : r.t.size() - 1;
@@ -272,6 +325,8 @@ CampaignData BuildCampaign(const Manifest& manifest, const std::vector<std::vari
         sim::MotionOptions mo = options.motion;
         mo.min_stand_intervals = 2;
         r.motions = sim::SegmentMotions(r.left, r.right, manifest.robot.wheelbase_m, mo);
+        r.q_sd_left.assign(r.t.size(), 0.0);
+        r.q_sd_right.assign(r.t.size(), 0.0);
         AnnotateIntervals(r);
         const int fold = fold_of(r.direction);
         c.runs.push_back(std::move(r));
@@ -314,6 +369,13 @@ CampaignData BuildCampaign(const Manifest& manifest, const std::vector<std::vari
         if (tr.has_ticks())
           mo.stand_eps_m = 0.5 * std::min(manifest.robot.MetresPerTickLeft(), manifest.robot.MetresPerTickRight());
         r.motions = sim::SegmentMotions(r.left, r.right, manifest.robot.wheelbase_m, mo);
+        if (tr.has_ticks()) {
+          QuantisationPhase(tr.ticks_left, r.motions, manifest.robot.MetresPerTickLeft(), r.left, r.q_sd_left);
+          QuantisationPhase(tr.ticks_right, r.motions, manifest.robot.MetresPerTickRight(), r.right, r.q_sd_right);
+        } else {
+          r.q_sd_left.assign(r.t.size(), 0.0);
+          r.q_sd_right.assign(r.t.size(), 0.0);
+        }
         AnnotateIntervals(r);
         const int fold = fold_of(r.direction);
         c.runs.push_back(std::move(r));

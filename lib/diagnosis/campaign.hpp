@@ -69,6 +69,15 @@ struct DiagRun {
   std::vector<signed char> interval_class;
   std::vector<signed char> kick;
   std::vector<float> window_start, window_end;
+  /// Encoder quantisation per sample and wheel: the cumulative travel above
+  /// is the count plus the expected fraction of a tick the wheel has turned
+  /// beyond it (contract: counts are whole ticks of true rotation, and the
+  /// controller stops a wheel the instant its count reaches the target):
+  /// 0 after a stop moving forward (p = T), 1 after a stop moving backward
+  /// (p just below T + 1), 1/2 while moving or before the first motion
+  /// (unknown start phase); q_sd_* is the standard deviation of what is left
+  /// [m]: tick / sqrt(12), or 0 after a stop.
+  std::vector<double> q_sd_left, q_sd_right;
   bool has_heading = true;  ///< endpoint runs: etheta_rad measured
 };
 

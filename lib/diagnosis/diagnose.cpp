@@ -252,6 +252,8 @@ struct NullPiece {
   bool moves_left = false, moves_right = false;
 };
 
+constexpr double kSqrt12 = 3.4641016151377544;
+
 /// G of `count` null campaigns starting at replicate `first`.
 void SimulateNull(const Context& ctx, const std::vector<NullPiece>& np, const Eigen::MatrixXd& K, int first, int count,
                   std::vector<double>& out) {
@@ -284,6 +286,7 @@ void SimulateNull(const Context& ctx, const std::vector<NullPiece>& np, const Ei
     double nb_x = 0, nb_y = 0, nb_t = 0, qb_l = 0, qb_r = 0;
     for (std::size_t j = 0; j < n; ++j) {
       const Piece& p = c.pieces[j];
+      const DiagRun& run = c.runs[p.run];
       double na_x, na_y, na_t, qa_l, qa_r;
       if (p.run == prev_run && p.a == prev_b) {
         na_x = nb_x;
@@ -295,14 +298,14 @@ void SimulateNull(const Context& ctx, const std::vector<NullPiece>& np, const Ei
         na_x = sxy * normal();
         na_y = sxy * normal();
         na_t = sth * normal();
-        qa_l = (gen.Uniform() - 0.5) * c.tick_left_m;
-        qa_r = (gen.Uniform() - 0.5) * c.tick_right_m;
+        qa_l = (gen.Uniform() - 0.5) * kSqrt12 * run.q_sd_left[p.a];
+        qa_r = (gen.Uniform() - 0.5) * kSqrt12 * run.q_sd_right[p.a];
       }
       nb_x = sxy * normal();
       nb_y = sxy * normal();
       nb_t = sth * normal();
-      qb_l = np[j].moves_left ? (gen.Uniform() - 0.5) * c.tick_left_m : qa_l;
-      qb_r = np[j].moves_right ? (gen.Uniform() - 0.5) * c.tick_right_m : qa_r;
+      qb_l = np[j].moves_left ? (gen.Uniform() - 0.5) * kSqrt12 * run.q_sd_left[p.b] : qa_l;
+      qb_r = np[j].moves_right ? (gen.Uniform() - 0.5) * kSqrt12 * run.q_sd_right[p.b] : qa_r;
       prev_run = p.run;
       prev_b = p.b;
       const Eigen::Vector3d z(normal(), normal(), normal());
@@ -800,8 +803,14 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
   // ---- 4. Verdict -----------------------------------------------------------
   std::vector<std::size_t> rank(cands.size());
   for (std::size_t i = 0; i < rank.size(); ++i) rank[i] = i;
+  // Best first: effects that close most of the held-out gap with positive
+  // evidence, by evidence; then the others by evidence; unidentifiable last.
+  auto qualifies = [&](const Candidate& cd) {
+    return cd.identifiable && cd.evidence > 0.0 && cd.heldout_shrink >= options.min_heldout_shrink;
+  };
   std::stable_sort(rank.begin(), rank.end(), [&](std::size_t a, std::size_t b) {
     if (cands[a].identifiable != cands[b].identifiable) return cands[a].identifiable;
+    if (qualifies(cands[a]) != qualifies(cands[b])) return qualifies(cands[a]);
     return cands[a].evidence > cands[b].evidence;
   });
   for (std::size_t i : rank) out.candidates.push_back(cands[i]);
@@ -810,7 +819,7 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
     out.verdict_reason = fmt::format("the gap is not significant (p = {:.3g} >= alpha = {})", out.p_value, options.alpha);
   } else {
     const Candidate* best = out.candidates.empty() || !out.candidates.front().identifiable ? nullptr : &out.candidates.front();
-    if (best && best->evidence > 0.0 && best->heldout_shrink >= options.min_heldout_shrink) {
+    if (best && qualifies(*best)) {
       out.verdict = sim::EffectToString(best->effect);
       out.verdict_reason = fmt::format(
           "{} closes {:.0f}% of the gap on held-out runs (held-out log-likelihood +{:.1f} nats over the baseline)",

@@ -171,8 +171,6 @@ std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanMod
   const double b = campaign.robot.wheelbase_m * p[kParamEb];
   const double E_d = p[kParamEd];
   const double c_L = 2.0 / (E_d + 1.0), c_R = 2.0 * E_d / (E_d + 1.0);
-  const double q_L = campaign.tick_left_m * campaign.tick_left_m / 12.0;
-  const double q_R = campaign.tick_right_m * campaign.tick_right_m / 12.0;
   for (std::size_t j = 0; j < campaign.pieces.size(); ++j) {
     const Piece& pc = campaign.pieces[j];
     const DiagRun& r = campaign.runs[pc.run];
@@ -223,8 +221,15 @@ std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanMod
     if (!first_moving && !r.endpoint) {
       B.quant_start = M_start;
       B.quant_end = G_last;
-      P_Q = q_L * (M_start.col(0) * M_start.col(0).transpose() + G_last.col(0) * G_last.col(0).transpose()) +
-            q_R * (M_start.col(1) * M_start.col(1).transpose() + G_last.col(1) * G_last.col(1).transpose());
+      // A wheel that did not turn in the piece has the same count error at
+      // both ends: it cancels.
+      const double va[2] = {std::pow(r.q_sd_left[pc.a], 2), std::pow(r.q_sd_right[pc.a], 2)};
+      const double vb[2] = {std::pow(r.q_sd_left[pc.b], 2), std::pow(r.q_sd_right[pc.b], 2)};
+      const bool turned[2] = {B.travel_left_m > 0.0, B.travel_right_m > 0.0};
+      for (int w = 0; w < 2; ++w) {
+        if (!turned[w]) continue;
+        P_Q += va[w] * M_start.col(w) * M_start.col(w).transpose() + vb[w] * G_last.col(w) * G_last.col(w).transpose();
+      }
     }
     B.A_L = P_L;
     B.A_R = P_R;
