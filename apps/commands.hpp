@@ -23,5 +23,6 @@ Command SetupImport(CLI::App& parent);
 Command SetupSimulate(CLI::App& parent);
 Command SetupDiagnose(CLI::App& parent);
 Command SetupPredict(CLI::App& parent);
+Command SetupFitNoise(CLI::App& parent);
 
 }  // namespace umbmark::cli

@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   commands.push_back(cli::SetupSimulate(app));
   commands.push_back(cli::SetupDiagnose(app));
   commands.push_back(cli::SetupPredict(app));
+  commands.push_back(cli::SetupFitNoise(app));
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,281 @@
+// `umbmark fit-noise DATA... --robot R.toml [--distance D] [--meas-sigma SXY[,STH]]
+//   [--plot FILE.svg] [--json FILE]`, or `umbmark fit-noise MANIFEST.toml`:
+// maximum-likelihood k_L, k_R (Chong & Kleeman eq. 4) with 95% profile
+// intervals and a goodness-of-fit table, from
+//  - endpoint CSVs of back-and-forth runs (`--distance D`: D forward, D back),
+//  - trajectory CSVs of runs of any shape (path from the ticks, return error
+//    from ground truth at the first and last sample),
+//  - a campaign manifest: every run with ground truth at start and end, with
+//    a systematic mean per experiment and direction.
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <variant>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "core/angles.hpp"
+#include "core/errors.hpp"
+#include "error_models/noise_fit.hpp"
+#include "error_models/noise_fit_data.hpp"
+#include "io/atomic_write.hpp"
+#include "io/data_file.hpp"
+#include "io/manifest.hpp"
+#include "io/svg_plot.hpp"
+
+namespace umbmark::cli {
+namespace {
+
+struct FitNoiseOptions {
+  std::vector<std::string> inputs;
+  RobotFlags robot;
+  std::optional<double> distance_m;
+  std::vector<double> meas_sigma;  // [sigma_xy_m] or [sigma_xy_m, sigma_theta_rad]
+  bool first_order = false;
+  bool reml = false;
+  std::string plot;
+  JsonFlag json;
+};
+
+struct Loaded {
+  std::vector<NoiseFitRun> runs;
+  std::vector<std::string> sources;
+  int skipped = 0;
+  double sigma_xy = 0.0, sigma_theta = 0.0;
+};
+
+NoiseFitInputOptions InputOptions(const FitNoiseOptions& o, const std::optional<GroundTruthNoise>& manifest_gt) {
+  NoiseFitInputOptions in;
+  in.second_order = !o.first_order;
+  if (!o.meas_sigma.empty()) {
+    if (o.meas_sigma.size() > 2) throw InvalidOptions("--meas-sigma takes SXY or SXY,STHETA");
+    in.sigma_xy_m = o.meas_sigma[0];
+    in.sigma_theta_rad = o.meas_sigma.size() > 1 ? o.meas_sigma[1] : 0.0;
+    if (!(in.sigma_xy_m >= 0.0) || !(in.sigma_theta_rad >= 0.0))
+      throw InvalidOptions("--meas-sigma values must be >= 0");
+  } else if (manifest_gt) {
+    in.sigma_xy_m = manifest_gt->sigma_xy_m;
+    in.sigma_theta_rad = manifest_gt->sigma_theta_rad;
+  }
+  return in;
+}
+
+void AppendManifest(const std::string& path, const FitNoiseOptions& o, Loaded& out) {
+  const Manifest m = io::ReadManifest(path);
+  const RobotParams robot = o.robot.Resolve(m.robot);
+  const NoiseFitInputOptions in = InputOptions(o, m.ground_truth);
+  out.sigma_xy = in.sigma_xy_m;
+  out.sigma_theta = in.sigma_theta_rad;
+  int index = 0;
+  for (const Experiment& e : m.experiments) {
+    ++index;
+    const std::string prefix = fmt::format("exp{}:{}:", index, ExperimentKindToString(e.kind));
+    io::RunFile rf = io::ReadRunFile(e.resolved_file);
+    if (auto* t = std::get_if<TrajectoryData>(&rf)) {
+      int skipped = 0;
+      auto runs = NoiseRunsFromTrajectories(*t, robot, prefix, in, &skipped);
+      out.skipped += skipped;
+      out.runs.insert(out.runs.end(), runs.begin(), runs.end());
+    } else {
+      const auto& ep = std::get<EndpointData>(rf);
+      if (e.kind == ExperimentKind::kBackAndForth) {
+        auto runs = NoiseRunsFromEndpoints(ep, BackAndForthPath(e.distance_m), robot.wheelbase_m, prefix, in);
+        out.runs.insert(out.runs.end(), runs.begin(), runs.end());
+      } else if (e.kind == ExperimentKind::kSquare) {
+        for (const bool cw : {true, false}) {  // one path per direction
+          EndpointData part{ep.path, {}};
+          for (const auto& r : ep.runs) {
+            if (r.direction != "cw" && r.direction != "ccw")
+              throw InputError(ep.path, r.line, 0, fmt::format("square run direction '{}' must be cw or ccw", r.direction));
+            if ((r.direction == "cw") == cw) part.runs.push_back(r);
+          }
+          auto runs = NoiseRunsFromEndpoints(part, SquarePath(e.side_m, cw), robot.wheelbase_m, prefix, in);
+          out.runs.insert(out.runs.end(), runs.begin(), runs.end());
+        }
+      } else {
+        throw InputError(e.resolved_file, "a 'free' experiment needs a trajectory CSV (its path comes from the ticks)");
+      }
+    }
+    out.sources.push_back(e.resolved_file);
+  }
+}
+
+Loaded Load(const FitNoiseOptions& o) {
+  Loaded out;
+  for (const std::string& path : o.inputs) {
+    if (io::IsManifestPath(path)) {
+      AppendManifest(path, o, out);
+      continue;
+    }
+    const RobotParams robot = o.robot.Resolve();
+    const NoiseFitInputOptions in = InputOptions(o, std::nullopt);
+    out.sigma_xy = in.sigma_xy_m;
+    out.sigma_theta = in.sigma_theta_rad;
+    const std::string prefix = o.inputs.size() > 1 ? path + ":" : "";
+    io::RunFile rf = io::ReadRunFile(path);
+    if (auto* t = std::get_if<TrajectoryData>(&rf)) {
+      int skipped = 0;
+      auto runs = NoiseRunsFromTrajectories(*t, robot, prefix, in, &skipped);
+      out.skipped += skipped;
+      out.runs.insert(out.runs.end(), runs.begin(), runs.end());
+    } else {
+      if (!o.distance_m)
+        throw InvalidOptions(path + " holds endpoint errors: give --distance D (each run drove D forward, then D back)");
+      auto runs = NoiseRunsFromEndpoints(std::get<EndpointData>(rf), BackAndForthPath(*o.distance_m),
+                                         robot.wheelbase_m, prefix, in);
+      out.runs.insert(out.runs.end(), runs.begin(), runs.end());
+    }
+    out.sources.push_back(path);
+  }
+  return out;
+}
+
+nlohmann::json JsonMatrix(const PoseCovariance& P) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int i = 0; i < 3; ++i) rows.push_back({P(i, 0), P(i, 1), P(i, 2)});
+  return rows;
+}
+
+/// Figure 4 of Chong & Kleeman: run scatter with 95% ellipses, observed
+/// (solid) and fitted (dashed), for ex-ey, ex-etheta, ey-etheta.
+std::string PlotSvg(const NoiseFitSummary& s) {
+  const bool centred = s.groups.size() > 1;
+  const double scale95 = std::sqrt(-2.0 * std::log(0.05));  // 2-D 95% ellipse: sqrt(chi^2_2(0.95))
+  const double unit[3] = {1e3, 1e3, 1e3};                      // mm, mm, mrad
+  const char* label[3] = {"ex [mm]", "ey [mm]", "etheta [mrad]"};
+  const int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+  // Observed centre: sample mean (single group) or 0 (residuals).
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  if (!centred) centre = s.group_means[0];
+  std::vector<std::string> parts;
+  const double size = 360;
+  for (int k = 0; k < 3; ++k) {
+    const int a = pairs[k][0], b = pairs[k][1];
+    io::SvgPanel p(60 + k * (size + 70), 50, size, size,
+                   fmt::format("{} vs {}{}", label[b], label[a], centred ? " (residuals about group means)" : ""));
+    std::vector<io::SvgPoint> pts;
+    for (std::size_t i = 0; i < s.residuals.size(); ++i) {
+      const Eigen::Vector3d& r = s.residuals[i];
+      if (!std::isfinite(r(a)) || !std::isfinite(r(b))) continue;
+      pts.push_back({(r(a) + centre(a)) * unit[a], (r(b) + centre(b)) * unit[b]});
+    }
+    std::vector<io::SvgPoint> extent = pts;
+    const PoseCovariance& O = s.observed_covariance;
+    const PoseCovariance& P = s.predicted_covariance;
+    for (const PoseCovariance* C : {&O, &P}) {
+      const double rx = scale95 * std::sqrt(std::max((*C)(a, a), 0.0)) * unit[a];
+      const double ry = scale95 * std::sqrt(std::max((*C)(b, b), 0.0)) * unit[b];
+      extent.push_back({centre(a) * unit[a] + rx, centre(b) * unit[b] + ry});
+      extent.push_back({centre(a) * unit[a] - rx, centre(b) * unit[b] - ry});
+    }
+    p.FitExtent(extent, false, false);
+    p.Axes(label[a], label[b]);
+    p.Points(pts, "#1f77b4", 2.5);
+    const io::SvgPoint c{centre(a) * unit[a], centre(b) * unit[b]};
+    p.CovarianceEllipse(c, O(a, a) * unit[a] * unit[a], O(a, b) * unit[a] * unit[b], O(b, b) * unit[b] * unit[b],
+                        scale95, "#111");
+    p.CovarianceEllipse(c, P(a, a) * unit[a] * unit[a], P(a, b) * unit[a] * unit[b], P(b, b) * unit[b] * unit[b],
+                        scale95, "#d62728", "6,4");
+    p.Legend({{"#111", "observed 95%"}, {"#d62728", fmt::format("fitted k_L={:.3g}, k_R={:.3g} 95%", s.k_L, s.k_R)}});
+    parts.push_back(p.Render());
+  }
+  return io::SvgDocument(3 * (size + 70) + 40, size + 110, parts);
+}
+
+int RunFitNoise(const FitNoiseOptions& o) {
+  Loaded data = Load(o);
+  if (data.runs.empty()) throw InputError(o.inputs.front(), "no run with ground truth at its start and end");
+  NoiseFitOptions fo;
+  fo.restricted = o.reml;
+  NoiseFitSummary s;
+  try {
+    s = FitNoise(data.runs, fo);
+  } catch (const InputError& e) {
+    throw InputError(o.inputs.front(), e.message());
+  }
+
+  nlohmann::json gof = nlohmann::json::array();
+  for (const auto& g : s.goodness_of_fit)
+    gof.push_back({{"element", g.element},
+                   {"observed", g.observed},
+                   {"predicted", g.predicted},
+                   {"standard_error", g.standard_error},
+                   {"z", g.z},
+                   {"runs", g.runs}});
+  nlohmann::json groups = nlohmann::json::array();
+  for (std::size_t g = 0; g < s.groups.size(); ++g) {
+    int n = 0;
+    for (const auto& r : data.runs) n += r.group == s.groups[g];
+    groups.push_back({{"group", s.groups[g]},
+                      {"runs", n},
+                      {"systematic_mean", {s.group_means[g](0), s.group_means[g](1), s.group_means[g](2)}}});
+  }
+  const nlohmann::json j = {{"k_L", s.k_L},
+                            {"k_R", s.k_R},
+                            {"k_L_ci95", {JsonNumber(s.k_L_ci[0]), JsonNumber(s.k_L_ci[1])}},
+                            {"k_R_ci95", {JsonNumber(s.k_R_ci[0]), JsonNumber(s.k_R_ci[1])}},
+                            {"runs", s.runs},
+                            {"skipped_runs", data.skipped},
+                            {"groups", groups},
+                            {"meas_sigma", {data.sigma_xy, data.sigma_theta}},
+                            {"second_order", !o.first_order},
+                            {"restricted", o.reml},
+                            {"neg_log_likelihood", s.neg_log_likelihood},
+                            {"goodness_of_fit", gof},
+                            {"observed_covariance", JsonMatrix(s.observed_covariance)},
+                            {"predicted_covariance", JsonMatrix(s.predicted_covariance)},
+                            {"inputs", data.sources}};
+  if (o.json.PrintText()) {
+    fmt::print("fit-noise: {} runs in {} group(s){}\n", s.runs, s.groups.size(),
+               data.skipped ? fmt::format(" ({} runs without ground truth at both ends skipped)", data.skipped) : "");
+    fmt::print("  k_L = {:.4g} m^1/2   95% interval [{:.4g}, {:.4g}]\n", s.k_L, s.k_L_ci[0], s.k_L_ci[1]);
+    fmt::print("  k_R = {:.4g} m^1/2   95% interval [{:.4g}, {:.4g}]\n", s.k_R, s.k_R_ci[0], s.k_R_ci[1]);
+    fmt::print("  reference noise per pose: {:.3g} m, {:.3g} rad; model: {} order{}\n", data.sigma_xy,
+               data.sigma_theta, o.first_order ? "first" : "second", o.reml ? ", REML" : "");
+    fmt::print("Systematic mean per group (ex [mm], ey [mm], etheta [mrad]):\n");
+    for (std::size_t g = 0; g < s.groups.size(); ++g)
+      fmt::print("  {:<40} {:>9.3f} {:>9.3f} {:>9.3f}\n", s.groups[g], 1e3 * s.group_means[g](0),
+                 1e3 * s.group_means[g](1), 1e3 * s.group_means[g](2));
+    fmt::print("Goodness of fit (residual covariance, observed vs model):\n");
+    fmt::print("  {:<6} {:>13} {:>13} {:>13} {:>7} {:>5}\n", "elem", "observed", "predicted", "std.error", "z",
+               "runs");
+    bool flagged = false;
+    for (const auto& g : s.goodness_of_fit) {
+      const bool bad = std::abs(g.z) > 3.0;
+      flagged |= bad;
+      fmt::print("  {:<6} {:>13.4e} {:>13.4e} {:>13.4e} {:>7.2f} {:>5}{}\n", g.element, g.observed, g.predicted,
+                 g.standard_error, g.z, g.runs, bad ? "  <- not explained by the model" : "");
+    }
+    if (flagged) fmt::print("  |z| > 3: the wheel noise model cannot explain that element (see docs/noise-model.md)\n");
+  }
+  if (!o.plot.empty()) io::WriteFileAtomically(o.plot, PlotSvg(s));
+  o.json.Emit(j);
+  return 0;
+}
+
+}  // namespace
+
+Command SetupFitNoise(CLI::App& parent) {
+  auto opts = std::make_shared<FitNoiseOptions>();
+  auto* app = parent.add_subcommand("fit-noise", "k_L, k_R (Chong & Kleeman) from back-and-forth or any trajectory runs");
+  app->add_option("DATA", opts->inputs, "Endpoint or trajectory CSV(s), or campaign manifest(s)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  opts->robot.Bind(*app);
+  app->add_option("--distance", opts->distance_m, "Endpoint data: each run drove D forward, then D back [m]")
+      ->check(CLI::PositiveNumber);
+  app->add_option("--meas-sigma", opts->meas_sigma,
+                  "Noise of the external reference per measured pose: SXY[,STHETA] [m, rad] (default: the "
+                  "manifest's [ground_truth], else 0)")
+      ->delimiter(',');
+  app->add_flag("--first-order", opts->first_order, "Fit the first-order model only (no heading-squared term)");
+  app->add_flag("--reml", opts->reml, "Restricted maximum likelihood (allow for the fitted systematic means)");
+  app->add_option("--plot", opts->plot, "Write pairwise 95% ellipses, observed vs fitted, over the runs (SVG)");
+  opts->json.Bind(*app);
+  return {app, [opts] { return RunFitNoise(*opts); }};
+}
+
+}  // namespace umbmark::cli

@@ -1,0 +1,181 @@
+// `umbmark fit-noise` end to end: endpoint CSV with --distance, the same
+// runs as a trajectory CSV (path from the wheel travel, return error from
+// ground truth at both ends), a campaign manifest, the JSON keys of the
+// contract, the SVG plot, and the exit codes.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/angles.hpp"
+#include "error_models/path_spec.hpp"
+#include "simulation/wheel_noise_sim.hpp"
+
+using namespace umbmark;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int status = -1;
+  std::string out;
+};
+
+Result Run(const std::string& args) {
+  const std::string cmd = std::string(UMBMARK_EXE) + " " + args + " 2>/dev/null";
+  Result r;
+  FILE* p = popen(cmd.c_str(), "r");
+  REQUIRE(p != nullptr);
+  char buf[4096];
+  std::size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+void Write(const fs::path& p, const std::string& text) {
+  std::ofstream f(p);
+  f << text;
+}
+
+/// 60 simulated runs of 10 m forward and back (k_L = 0.0004, k_R = 0.00058,
+/// b = 0.371), written both as an endpoint CSV and as a trajectory CSV.
+struct Campaign {
+  fs::path dir, robot, endpoint, trajectory, manifest;
+};
+
+Campaign MakeCampaign() {
+  Campaign c;
+  c.dir = fs::temp_directory_path() / fmt::format("umbmark_fit_noise_cli_{}", ::getpid());
+  fs::create_directories(c.dir);
+  c.robot = c.dir / "robot.toml";
+  Write(c.robot, "wheelbase_m = 0.371\nwheel_diameter_left_m = 0.1\nwheel_diameter_right_m = 0.1\n");
+  sim::SimulationModel m;
+  m.nominal.wheelbase_m = 0.371;
+  m.nominal.wheel_diameter_left_m = m.nominal.wheel_diameter_right_m = 0.1;
+  m.noise = {0.00040, 0.00058};
+  const auto path = ToWheelSegments(BackAndForthPath(10.0), 0.371);
+  const int P = 100;
+  const sim::SimPlan plan = sim::CompilePlan(m, path, P);
+  const auto traces = sim::SimulateTraces(plan, 77, 0, 60, 10);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> N01;
+  const double sxy = 0.0005, sth = 0.0017;
+  std::string ep = "run,direction,ex_m,ey_m,etheta_rad\n";
+  std::string tr = "run,direction,t_s,dist_left_m,dist_right_m,x_gt_m,y_gt_m,theta_gt_rad\n";
+  for (const auto& t : traces) {
+    const Pose2 gs{sxy * N01(rng), sxy * N01(rng), sth * N01(rng)};
+    const Pose2 te = t.truth.back();
+    const Pose2 ge{te.x + sxy * N01(rng), te.y + sxy * N01(rng), te.theta + sth * N01(rng)};
+    const Pose2 rel = RelativeTo(gs, ge);
+    ep += fmt::format("{},fwd_back,{:.17g},{:.17g},{:.17g}\n", t.run + 1, rel.x, rel.y, WrapAngle(rel.theta));
+    // Trajectory: commanded wheel travel at every recorded sample; ground
+    // truth (world frame, arbitrary origin) only at the first and last.
+    const Pose2 origin{2.0, -1.0, 0.7};
+    const Pose2 w0 = Compose(origin, gs), w1 = Compose(origin, ge);
+    tr += fmt::format("{},fwd_back,0,0,0,{:.17g},{:.17g},{:.17g}\n", t.run + 1, w0.x, w0.y, w0.theta);
+    for (std::size_t i = 0; i < t.truth.size(); ++i) {
+      const double s = t.segment[i] == 0 ? 10.0 * t.partition[i] / P : 10.0 - 10.0 * t.partition[i] / P;
+      const bool last = i + 1 == t.truth.size();
+      tr += fmt::format("{},fwd_back,{},{:.17g},{:.17g},{},{},{}\n", t.run + 1, 0.1 * static_cast<double>(i + 1), s, s,
+                        last ? fmt::format("{:.17g}", w1.x) : "", last ? fmt::format("{:.17g}", w1.y) : "",
+                        last ? fmt::format("{:.17g}", w1.theta) : "");
+    }
+  }
+  c.endpoint = c.dir / "fwd_back.csv";
+  c.trajectory = c.dir / "fwd_back_traj.csv";
+  Write(c.endpoint, ep);
+  Write(c.trajectory, tr);
+  c.manifest = c.dir / "campaign.toml";
+  Write(c.manifest,
+        "[robot]\nwheelbase_m = 0.371\nwheel_diameter_left_m = 0.1\nwheel_diameter_right_m = 0.1\n\n"
+        "[ground_truth]\nsigma_xy_m = 0.0005\nsigma_theta_rad = 0.0017\n\n"
+        "[[experiment]]\nkind = \"back_and_forth\"\ndistance_m = 10.0\nfile = \"fwd_back.csv\"\n");
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("fit-noise CLI: endpoint, trajectory and manifest inputs agree; contract keys; plot", "[fit_noise_cli]") {
+  const Campaign c = MakeCampaign();
+  const fs::path svg = c.dir / "fig4.svg";
+  const Result ep = Run(fmt::format("fit-noise {} --robot {} --distance 10 --meas-sigma 0.0005,0.0017 --json - --plot {}",
+                                    c.endpoint.string(), c.robot.string(), svg.string()));
+  REQUIRE(ep.status == 0);
+  const auto j = nlohmann::json::parse(ep.out);
+  for (const char* key : {"k_L", "k_R", "k_L_ci95", "k_R_ci95"}) CHECK(j.contains(key));
+  const double kL = j["k_L"], kR = j["k_R"];
+  CHECK(kL == Approx(0.00040).epsilon(0.35));
+  CHECK(kR == Approx(0.00058).epsilon(0.35));
+  CHECK(j["k_L_ci95"][0].get<double>() < kL);
+  CHECK(j["k_L_ci95"][1].get<double>() > kL);
+  CHECK(j["runs"] == 60);
+  CHECK(j["goodness_of_fit"].size() == 6);
+  // The plot has three panels with two ellipses each.
+  std::ifstream f(svg);
+  const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  CHECK(text.find("<svg") != std::string::npos);
+  CHECK(text.find("etheta [mrad]") != std::string::npos);
+
+  // Same runs as a trajectory CSV: the path comes from the wheel travel.
+  // First order: Kelly's form along the samples equals the closed form.
+  const Result ep1 = Run(fmt::format("fit-noise {} --robot {} --distance 10 --meas-sigma 0.0005,0.0017 --first-order "
+                                     "--json -",
+                                     c.endpoint.string(), c.robot.string()));
+  const Result tr1 = Run(fmt::format("fit-noise {} --robot {} --meas-sigma 0.0005,0.0017 --first-order --json -",
+                                     c.trajectory.string(), c.robot.string()));
+  REQUIRE(tr1.status == 0);
+  const auto je1 = nlohmann::json::parse(ep1.out), jt1 = nlohmann::json::parse(tr1.out);
+  CHECK(jt1["k_L"].get<double>() == Approx(je1["k_L"].get<double>()).epsilon(1e-6));
+  CHECK(jt1["k_R"].get<double>() == Approx(je1["k_R"].get<double>()).epsilon(1e-6));
+  // Default (with the second-order term): the trajectory's 10 samples per
+  // leg evaluate that term by a coarser midpoint rule than the closed path.
+  const Result tr = Run(fmt::format("fit-noise {} --robot {} --meas-sigma 0.0005,0.0017 --json -",
+                                    c.trajectory.string(), c.robot.string()));
+  REQUIRE(tr.status == 0);
+  const auto jt = nlohmann::json::parse(tr.out);
+  CHECK(jt["k_L"].get<double>() == Approx(kL).epsilon(1e-3));
+  CHECK(jt["k_R"].get<double>() == Approx(kR).epsilon(1e-3));
+
+  // Manifest: reference noise from [ground_truth], path from distance_m.
+  const Result mf = Run(fmt::format("fit-noise {} --json -", c.manifest.string()));
+  REQUIRE(mf.status == 0);
+  const auto jm = nlohmann::json::parse(mf.out);
+  CHECK(jm["k_L"].get<double>() == Approx(kL).epsilon(1e-9));
+  CHECK(jm["groups"][0]["group"] == "exp1:back_and_forth:fwd_back");
+
+  // Human-readable output names the goodness-of-fit table.
+  const Result text_out = Run(fmt::format("fit-noise {} --robot {} --distance 10", c.endpoint.string(), c.robot.string()));
+  CHECK(text_out.status == 0);
+  CHECK(text_out.out.find("Goodness of fit") != std::string::npos);
+  if (!std::getenv("UMBMARK_KEEP_TEST_FILES")) fs::remove_all(c.dir);
+}
+
+TEST_CASE("fit-noise CLI exit codes", "[fit_noise_cli]") {
+  const Campaign c = MakeCampaign();
+  // Endpoint data without --distance: usage error.
+  CHECK(Run(fmt::format("fit-noise {} --robot {}", c.endpoint.string(), c.robot.string())).status == 2);
+  // Unknown flag / bad --meas-sigma.
+  CHECK(Run(fmt::format("fit-noise {} --robot {} --distance -1", c.endpoint.string(), c.robot.string())).status == 2);
+  CHECK(Run(fmt::format("fit-noise {} --robot {} --distance 10 --meas-sigma 1,2,3", c.endpoint.string(),
+                        c.robot.string()))
+            .status == 2);
+  // Bad data: a text cell.
+  const fs::path bad = c.dir / "bad.csv";
+  Write(bad, "run,direction,ex_m,ey_m,etheta_rad\n1,fwd_back,0.001,abc,0.0\n2,fwd_back,0.0,0.0,0.0\n");
+  CHECK(Run(fmt::format("fit-noise {} --robot {} --distance 10", bad.string(), c.robot.string())).status == 1);
+  // Too few runs to identify the model: bad data (1).
+  const fs::path few = c.dir / "few.csv";
+  Write(few, "run,direction,ex_m,ey_m,etheta_rad\n1,fwd_back,0.001,0.01,0.001\n2,fwd_back,0.0,0.0,0.0\n");
+  CHECK(Run(fmt::format("fit-noise {} --robot {} --distance 10", few.string(), c.robot.string())).status == 1);
+  fs::remove_all(c.dir);
+}
