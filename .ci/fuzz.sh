@@ -89,11 +89,12 @@ for target in "${targets[@]}"; do
       find tests/data data -maxdepth 3 -type f -name '*.toml' -exec cp {} "$seeds/" \; ;;
     *) dict="" ;;
   esac
-  echo "== $target: $(ls "$seeds" | wc -l) seed files, ${seconds} s"
+  echo "== $target: $(ls "$seeds" | wc -l) seed files, $(ls "$corpus" | wc -l) corpus files, ${seconds} s"
   args=(-max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=16384 -print_final_stats=1
         -artifact_prefix="$build/artifacts/$target-")
   if [[ -n $dict ]]; then args+=(-dict="$build/$dict"); fi
-  if ! "$build/$target" "${args[@]}" "$corpus" "$seeds" 2>&1 | tail -n 40; then
+  # Keep the log short: progress lines and libFuzzer's dictionary advice out.
+  if ! "$build/$target" "${args[@]}" "$corpus" "$seeds" 2>&1 | grep -v -e '# Uses:' -e 'NEW_FUNC' -e '^#[0-9]*[[:space:]]*\(NEW\|REDUCE\|pulse\|RELOAD\)' | tail -n 40; then
     echo "FUZZ FAILURE in $target; reproducers:" >&2
     ls -l "$build/artifacts" >&2 || true
     status=1
