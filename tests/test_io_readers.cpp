@@ -37,8 +37,6 @@ InputError Thrown(F&& f) {
   return InputError("", "");
 }
 
-constexpr double kDegToRad = kPi / 180.0;
-
 }  // namespace
 
 TEST_CASE("endpoint CSV with BOM, CRLF, comments, blank lines and shuffled columns", "[io][endpoint]") {
