@@ -219,6 +219,26 @@ TEST_CASE("encoder quantisation: whole ticks, start phase, stop rule", "[simulat
   CHECK(traces[0].phase_left != traces[1].phase_left);
 }
 
+TEST_CASE("all SIMD kernels give identical bits", "[simulator]") {
+  const SimPlan plan = CompilePlan(BasicModel(0.4, 0.01, 0.02), {{3.0, 1.0}, {0.0, 2.0}, {-0.6, 0.6}}, 50);
+  const std::string best = SimKernelName();
+  std::vector<Pose2> ref(37);
+  SimulateRuns(plan, 123, 3, 37, ref.data());
+  for (const std::string& k : SimKernelsAvailable()) {
+    REQUIRE(SelectSimKernel(k));
+    std::vector<Pose2> out(37);
+    SimulateRuns(plan, 123, 3, 37, out.data());
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      INFO("kernel " << k << " run " << i);
+      CHECK(out[i].x == ref[i].x);
+      CHECK(out[i].y == ref[i].y);
+      CHECK(out[i].theta == ref[i].theta);
+    }
+  }
+  REQUIRE(SelectSimKernel(best));
+  CHECK_FALSE(SelectSimKernel("no-such-kernel"));
+}
+
 TEST_CASE("every run depends only on (seed, run index): lanes, blocks, threads", "[simulator]") {
   const SimPlan plan = CompilePlan(BasicModel(0.4, 0.003, 0.002), {{3.0, 1.0}}, 100);
   std::vector<Pose2> all(40), part(3);

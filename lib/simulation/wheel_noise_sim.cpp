@@ -14,6 +14,9 @@
 #include "simulation/wheel_noise_sim.hpp"
 
 #include <cmath>
+#include <algorithm>
+#include <atomic>
+#include <string>
 #include <cstring>
 
 #include <Eigen/Eigenvalues>
@@ -62,61 +65,78 @@ struct Recorder {
 
 UMBMARK_INLINE std::uint64_t Rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
 
+/// Partitions whose normals are generated ahead in one batch: the normal
+/// generator (long dependency chains: log, square root) and the pose update
+/// (a short chain carried from partition to partition) run as two loops so
+/// the CPU overlaps many independent normal computations (software
+/// pipelining). 2 x 32 x kSimLanes doubles = 8 KiB, in L1.
+constexpr int kChunk = 32;
+
 /// The fast path of one segment for all lanes (branch-free, vectorisable).
 /// kTiny: every half angle |h| <= 1/16 (short polynomials), else <= pi/4.
 template <bool kRecord, bool kTiny>
 UMBMARK_INLINE void FastSegment(BlockState& __restrict b, const LaneSegment& __restrict seg, double inv_b,
                                 int seg_index, const Recorder* rec) {
   const double half_inv_b = 0.5 * inv_b;
-  for (int p = 0; p < seg.partitions; ++p) {
+  alignas(64) double z0[kChunk][W], z1[kChunk][W];
+  for (int p0 = 0; p0 < seg.partitions; p0 += kChunk) {
+    const int n = std::min(kChunk, seg.partitions - p0);
+    // 1. Normals for n partitions (xoshiro256++, two outputs per pair).
+    for (int q = 0; q < n; ++q) {
 #pragma GCC unroll 1
-    for (int j = 0; j < W; ++j) {
-      // xoshiro256++, two outputs.
-      std::uint64_t s0 = b.r0[j], s1 = b.r1[j], s2 = b.r2[j], s3 = b.r3[j];
-      const std::uint64_t ra = Rotl(s0 + s3, 23) + s0;
-      std::uint64_t t = s1 << 17;
-      s2 ^= s0;
-      s3 ^= s1;
-      s1 ^= s2;
-      s0 ^= s3;
-      s2 ^= t;
-      s3 = Rotl(s3, 45);
-      const std::uint64_t rb = Rotl(s0 + s3, 23) + s0;
-      t = s1 << 17;
-      s2 ^= s0;
-      s3 ^= s1;
-      s1 ^= s2;
-      s0 ^= s3;
-      s2 ^= t;
-      s3 = Rotl(s3, 45);
-      b.r0[j] = s0;
-      b.r1[j] = s1;
-      b.r2[j] = s2;
-      b.r3[j] = s3;
-      double z0, z1;
-      NormalPairFromBits(ra, rb, z0, z1);
-      // Wheel travel of this partition (eq. 4) and the exact arc.
-      const double l = fm::Fma(seg.sl[j], z0, seg.ml[j]);
-      const double r = fm::Fma(seg.sr[j], z1, seg.mr[j]);
-      const double h = (r - l) * half_inv_b;
-      double sinc, ch;
-      if constexpr (kTiny) {
-        fm::SincCosTiny(h, sinc, ch);
-      } else {
-        fm::SincCosQuarter(h, sinc, ch);
+      for (int j = 0; j < W; ++j) {
+        std::uint64_t s0 = b.r0[j], s1 = b.r1[j], s2 = b.r2[j], s3 = b.r3[j];
+        const std::uint64_t ra = Rotl(s0 + s3, 23) + s0;
+        std::uint64_t t = s1 << 17;
+        s2 ^= s0;
+        s3 ^= s1;
+        s1 ^= s2;
+        s0 ^= s3;
+        s2 ^= t;
+        s3 = Rotl(s3, 45);
+        const std::uint64_t rb = Rotl(s0 + s3, 23) + s0;
+        t = s1 << 17;
+        s2 ^= s0;
+        s3 ^= s1;
+        s1 ^= s2;
+        s0 ^= s3;
+        s2 ^= t;
+        s3 = Rotl(s3, 45);
+        b.r0[j] = s0;
+        b.r1[j] = s1;
+        b.r2[j] = s2;
+        b.r3[j] = s3;
+        NormalPairFromBits(ra, rb, z0[q][j], z1[q][j]);
       }
-      const double sh = h * sinc;
-      const double chord = 0.5 * (l + r) * sinc;
-      const double c = b.c[j], s = b.s[j];
-      const double cm = fm::Fma(c, ch, -s * sh), sm = fm::Fma(s, ch, c * sh);
-      b.x[j] = fm::Fma(chord, cm, b.x[j]);
-      b.y[j] = fm::Fma(chord, sm, b.y[j]);
-      b.c[j] = fm::Fma(cm, ch, -sm * sh);
-      b.s[j] = fm::Fma(sm, ch, cm * sh);
-      b.th[j] = fm::Fma(r - l, inv_b, b.th[j]);
     }
-    if constexpr (kRecord) {
-      if ((p + 1) % rec->every == 0 || p + 1 == seg.partitions) rec->Store(b, seg_index, p + 1);
+    // 2. The exact arc of every partition.
+    for (int q = 0; q < n; ++q) {
+#pragma GCC unroll 1
+      for (int j = 0; j < W; ++j) {
+        // Wheel travel of this partition (eq. 4) and the exact arc.
+        const double l = fm::Fma(seg.sl[j], z0[q][j], seg.ml[j]);
+        const double r = fm::Fma(seg.sr[j], z1[q][j], seg.mr[j]);
+        const double h = (r - l) * half_inv_b;
+        double sinc, ch;
+        if constexpr (kTiny) {
+          fm::SincCosTiny(h, sinc, ch);
+        } else {
+          fm::SincCosQuarter(h, sinc, ch);
+        }
+        const double sh = h * sinc;
+        const double chord = 0.5 * (l + r) * sinc;
+        const double c = b.c[j], s = b.s[j];
+        const double cm = fm::Fma(c, ch, -s * sh), sm = fm::Fma(s, ch, c * sh);
+        b.x[j] = fm::Fma(chord, cm, b.x[j]);
+        b.y[j] = fm::Fma(chord, sm, b.y[j]);
+        b.c[j] = fm::Fma(cm, ch, -sm * sh);
+        b.s[j] = fm::Fma(sm, ch, cm * sh);
+        b.th[j] = fm::Fma(r - l, inv_b, b.th[j]);
+      }
+      if constexpr (kRecord) {
+        const int p = p0 + q;
+        if ((p + 1) % rec->every == 0 || p + 1 == seg.partitions) rec->Store(b, seg_index, p + 1);
+      }
     }
   }
 }
@@ -196,20 +216,26 @@ struct Kernel {
   const char* name;
 };
 
-Kernel SelectKernel() {
+/// The kernels this CPU can run, best first.
+std::vector<Kernel> AvailableKernels() {
+  std::vector<Kernel> out;
 #ifdef UMBMARK_SIM_DISPATCH
   __builtin_cpu_init();
   if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl"))
-    return {&RunBlockAvx512, "avx512"};
-  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return {&RunBlockAvx2, "avx2"};
+    out.push_back({&RunBlockAvx512, "avx512"});
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) out.push_back({&RunBlockAvx2, "avx2"});
 #endif
-  return {&RunBlockBaseline, "baseline"};
+  out.push_back({&RunBlockBaseline, "baseline"});
+  return out;
 }
 
-const Kernel& TheKernel() {
-  static const Kernel k = SelectKernel();
-  return k;
+std::atomic<const Kernel*>& CurrentKernel() {
+  static const std::vector<Kernel> kernels = AvailableKernels();
+  static std::atomic<const Kernel*> current{&kernels.front()};
+  return current;
 }
+
+const Kernel& TheKernel() { return *CurrentKernel().load(); }
 
 /// Square root of P0 (P0 = S S^T) via the symmetric eigen-decomposition
 /// (works for semidefinite P0).
@@ -285,6 +311,23 @@ void SetupBlock(const SimPlan& plan, const Eigen::Matrix3d& sqrt_p0, std::uint64
 }  // namespace
 
 const char* SimKernelName() { return TheKernel().name; }
+
+std::vector<std::string> SimKernelsAvailable() {
+  std::vector<std::string> names;
+  for (const Kernel& k : AvailableKernels()) names.push_back(k.name);
+  return names;
+}
+
+bool SelectSimKernel(const std::string& name) {
+  static const std::vector<Kernel> kernels = AvailableKernels();
+  for (const Kernel& k : kernels) {
+    if (name == k.name) {
+      CurrentKernel().store(&k);
+      return true;
+    }
+  }
+  return false;
+}
 
 void SimulateRuns(const SimPlan& plan, std::uint64_t seed, std::int64_t first_run, std::int64_t count, Pose2* out) {
   const Eigen::Matrix3d sqrt_p0 = CovarianceSqrt(plan.initial_covariance);

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "kinematics/pose2.hpp"
@@ -29,8 +30,16 @@ namespace umbmark::sim {
 /// Runs simulated together in one kernel call.
 inline constexpr int kSimLanes = 16;
 
-/// Name of the kernel this CPU uses ("avx512", "avx2", "baseline").
+/// Name of the kernel in use ("avx512", "avx2", "baseline"); the best one
+/// the CPU supports unless SelectSimKernel chose another.
 const char* SimKernelName();
+
+/// Kernels this CPU can run, best first.
+std::vector<std::string> SimKernelsAvailable();
+
+/// Uses kernel `name` from now on (tests and benchmarks compare kernels);
+/// false when the CPU cannot run it. All kernels give identical results.
+bool SelectSimKernel(const std::string& name);
 
 /// True final pose (start frame, theta continuous) of runs first_run ..
 /// first_run + count - 1, written to out[0 .. count-1].
