@@ -185,6 +185,8 @@ void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, co
       travel += 0.5 * (std::abs(r.left[i + 1] - r.left[i]) + std::abs(r.right[i + 1] - r.right[i]));
     p.travel_m = travel;
     p.subset = subsets.Get(r.experiment, SubsetName(kind, r, type, sign, first));
+    p.pooled_subset = subsets.Get(r.experiment, std::string("all runs, ") + PieceTypeToString(type));
+    p.campaign_subset = subsets.Get(-1, std::string("all experiments, ") + PieceTypeToString(type));
     c.pieces.push_back(p);
   };
   std::size_t cur = g0;
@@ -337,6 +339,7 @@ CampaignData BuildCampaign(const Manifest& manifest, const std::vector<std::vari
         p.type = PieceType::kReturn;
         p.components = c.runs.back().has_heading ? 3 : 2;
         p.subset = subsets.Get(static_cast<int>(e), c.runs.back().direction + ", return error");
+        p.pooled_subset = subsets.Get(static_cast<int>(e), "all runs, return error");
         p.fold = fold;
         p.travel_m = 4.0 * ex.side_m;
         c.pieces.push_back(p);

@@ -43,9 +43,12 @@ struct Piece {
   bool motion_first = false;  ///< first piece of its motion
   int components = 3;         ///< 2 for return errors without heading
   double travel_m = 0.0;      ///< nominal (|dL| + |dR|) / 2 over the piece
-  /// Subset within its experiment (CampaignData::subsets), e.g. "cw,
-  /// straight (first piece)".
+  /// Subsets the piece belongs to (CampaignData::subsets): its own, e.g.
+  /// "cw, straight (first piece)"; its experiment's pooled one, e.g. "all
+  /// runs, straight"; and the campaign's, e.g. "all experiments, straight".
   int subset = 0;
+  int pooled_subset = -1;
+  int campaign_subset = -1;
   int fold = 0;  ///< cross-validation fold (by run)
 };
 
@@ -90,7 +93,7 @@ struct ExperimentInfo {
 };
 
 struct SubsetInfo {
-  int experiment = 0;
+  int experiment = 0;  ///< -1: campaign-wide
   std::string name;  ///< e.g. "cw, straight (first piece)"
 };
 

@@ -44,7 +44,7 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
   nlohmann::json where = nlohmann::json::array();
   for (const auto& w : s.where) {
     where.push_back({{"experiment", w.experiment + 1},
-                     {"experiment_label", s.experiment_labels[w.experiment]},
+                     {"experiment_label", w.experiment >= 0 ? s.experiment_labels[w.experiment] : "all experiments"},
                      {"subset", w.subset},
                      {"statistic", StatKindToString(w.statistic)},
                      {"component", w.component},
@@ -161,7 +161,8 @@ std::string DiagnoseReport(const DiagnoseSummary& s) {
                    s.gap_score, s.null_median, 100.0 * (1.0 - s.alpha), s.null_quantile_alpha, s.p_value,
                    s.null_simulations, s.significant ? "significant" : "not significant"));
   for (const auto& w : s.where) {
-    line(fmt::format("    {:+7.2f} SE  exp {}  {:<38} {:<11} {}", w.z, w.experiment + 1, w.subset,
+    line(fmt::format("    {:+8.2f} SE  {:<6} {:<40} {:<11} {}", w.z,
+                     w.experiment >= 0 ? fmt::format("exp {}", w.experiment + 1) : std::string("all"), w.subset,
                      StatKindToString(w.statistic), w.component));
   }
   line("");

@@ -146,28 +146,34 @@ GapSummary ComputeGap(const CampaignData& campaign, const std::vector<Scores>& s
     std::vector<std::array<double, 6>> per_run;  // sum[3], count[3] by run index in experiment
   };
   std::vector<Acc> acc(S);
-  for (std::size_t s = 0; s < S; ++s)
-    acc[s].per_run.assign(campaign.experiments[campaign.subsets[s].experiment].runs, {0, 0, 0, 0, 0, 0});
+  for (std::size_t s = 0; s < S; ++s) {
+    const int e = campaign.subsets[s].experiment;
+    acc[s].per_run.assign(e >= 0 ? campaign.experiments[e].runs : campaign.runs.size(), {0, 0, 0, 0, 0, 0});
+  }
   static const int pa[3] = {0, 0, 1}, pb[3] = {1, 2, 2};
   for (std::size_t j = 0; j < campaign.pieces.size(); ++j) {
     if (use && !(*use)[j]) continue;
     const Piece& p = campaign.pieces[j];
-    Acc& a = acc[p.subset];
     const Scores& z = scores[j];
-    const int ri = campaign.runs[p.run].index_in_experiment;
-    for (int c = 0; c < 3; ++c) {
-      if (std::isnan(z[c])) continue;
-      a.n[c] += 1;
-      a.sum[c] += z[c];
-      a.sq[c] += z[c] * z[c];
-      if (std::abs(z[c]) > options.tail_z) a.tail[c] += 1;
-      a.per_run[ri][c] += z[c];
-      a.per_run[ri][3 + c] += 1.0;
-    }
-    for (int k = 0; k < 3; ++k) {
-      if (std::isnan(z[pa[k]]) || std::isnan(z[pb[k]])) continue;
-      a.prod[k] += z[pa[k]] * z[pb[k]];
-      a.nprod[k] += 1;
+    const DiagRun& run = campaign.runs[p.run];
+    for (int member : {p.subset, p.pooled_subset, p.campaign_subset}) {
+      if (member < 0) continue;
+      Acc& a = acc[member];
+      const int ri = campaign.subsets[member].experiment >= 0 ? run.index_in_experiment : run.campaign_index;
+      for (int c = 0; c < 3; ++c) {
+        if (std::isnan(z[c])) continue;
+        a.n[c] += 1;
+        a.sum[c] += z[c];
+        a.sq[c] += z[c] * z[c];
+        if (std::abs(z[c]) > options.tail_z) a.tail[c] += 1;
+        a.per_run[ri][c] += z[c];
+        a.per_run[ri][3 + c] += 1.0;
+      }
+      for (int k = 0; k < 3; ++k) {
+        if (std::isnan(z[pa[k]]) || std::isnan(z[pb[k]])) continue;
+        a.prod[k] += z[pa[k]] * z[pb[k]];
+        a.nprod[k] += 1;
+      }
     }
   }
   GapSummary g;
