@@ -244,6 +244,10 @@ void CrossValidate(const Context& ctx, const std::vector<double>& eps, const Eig
 
 double Gap(const Context& ctx, double score) { return std::max(0.0, score - ctx.null_median); }
 
+/// 1 - after / before, 0 without a gap, floored at -1 (an effect that makes
+/// the gap more than twice as large is simply "much worse").
+double Shrink(double after, double before) { return before > 0.0 ? std::max(-1.0, 1.0 - after / before) : 0.0; }
+
 /// Per-piece data for simulating null campaigns.
 struct NullPiece {
   Eigen::Matrix3d wheel_chol = Eigen::Matrix3d::Zero();
@@ -743,7 +747,7 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
           cvs, ll);
       cd.heldout_loglik_gain = ll - cv_ll_base;
       const double gcv = ComputeGap(c, cvs, options.gap).score;
-      cd.heldout_shrink = gap_cv_before > 0.0 ? 1.0 - Gap(ctx, gcv) / gap_cv_before : 0.0;
+      cd.heldout_shrink = Shrink(Gap(ctx, gcv), gap_cv_before);
     } else if (kind == sim::EffectKind::kCorrelatedNoise || kind == sim::EffectKind::kBumpOutliers) {
       const bool corr = kind == sim::EffectKind::kCorrelatedNoise;
       cd.parameters = corr ? 1 : 2;
@@ -775,13 +779,13 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
           cvs, ll);
       cd.heldout_loglik_gain = ll - cv_ll_base;
       const double gcv = ComputeGap(c, cvs, options.gap).score;
-      cd.heldout_shrink = gap_cv_before > 0.0 ? 1.0 - Gap(ctx, gcv) / gap_cv_before : 0.0;
+      cd.heldout_shrink = Shrink(Gap(ctx, gcv), gap_cv_before);
     } else {
       cd.identifiable = false;
       cd.note = "not a contract effect; not fitted";
       return;
     }
-    cd.shrink = gap_before > 0.0 ? 1.0 - Gap(ctx, cd.gap_after) / gap_before : 0.0;
+    cd.shrink = Shrink(Gap(ctx, cd.gap_after), gap_before);
     cd.evidence = cd.heldout_loglik_gain - options.complexity_penalty_nats * cd.parameters;
   };
   {

@@ -118,7 +118,7 @@ std::vector<Scores> PieceScores(const std::vector<double>& eps, const std::vecto
     Eigen::LLT<Eigen::Matrix3d> llt(Permute(mean));
     const Eigen::Matrix3d Linv = llt.matrixL().solve(Eigen::Matrix3d::Identity());
     const Eigen::Vector3d w = Linv * ep;
-    double sd[4][3];
+    double sd[kMaxBumpsPerPiece + 1][3];
     for (int k = 0; k < m.components; ++k) {
       const Eigen::Matrix3d S = Linv * Permute(m.cov[k]) * Linv.transpose();
       for (int c = 0; c < 3; ++c) sd[k][c] = std::sqrt(std::max(S(c, c), 1e-300));

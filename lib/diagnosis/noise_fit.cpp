@@ -39,13 +39,15 @@ BumpMixture PieceMixture(const PieceBases& B, const NoiseParams& n) {
   }
   per_bump *= n.bump_s2 / wheels;
   const double lambda = n.bump_rate * travel;
-  m.components = 4;
-  const double e = std::exp(-lambda);
-  m.weight[0] = e;
-  m.weight[1] = e * lambda;
-  m.weight[2] = e * lambda * lambda / 2.0;
-  m.weight[3] = std::max(0.0, 1.0 - m.weight[0] - m.weight[1] - m.weight[2]);
-  for (int k = 1; k < 4; ++k) m.cov[k] = m.cov[0] + k * per_bump;
+  m.components = kMaxBumpsPerPiece + 1;
+  double term = std::exp(-lambda), used = 0.0;
+  for (int k = 0; k < kMaxBumpsPerPiece; ++k) {
+    m.weight[k] = term;
+    used += term;
+    term *= lambda / (k + 1);
+  }
+  m.weight[kMaxBumpsPerPiece] = std::max(0.0, 1.0 - used);
+  for (int k = 1; k <= kMaxBumpsPerPiece; ++k) m.cov[k] = m.cov[0] + k * per_bump;
   return m;
 }
 
@@ -193,7 +195,7 @@ double PieceLogLik(const double* eps, int components, const PieceBases& B, const
   if (!(n.bump_rate > 0.0 && n.bump_s2 > 0.0)) return GaussLogPdf(eps, components, PieceCovariance(B, n));
   const BumpMixture m = PieceMixture(B, n);
   if (m.components == 1) return GaussLogPdf(eps, components, m.cov[0]);
-  double lp[4], mx = -1e300;
+  double lp[kMaxBumpsPerPiece + 1], mx = -1e300;
   for (int k = 0; k < m.components; ++k) {
     lp[k] = m.weight[k] > 0.0 ? std::log(m.weight[k]) + GaussLogPdf(eps, components, m.cov[k]) : -1e300;
     mx = std::max(mx, lp[k]);
@@ -357,6 +359,9 @@ NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBase
   auto cost = [&](const std::array<double, 4>& x) {
     for (double v : x)
       if (!std::isfinite(v) || std::abs(v) > 60.0) return 1e300;
+    // Physical bumps only (see the header): outside, a steep wall.
+    if (x[2] < std::log(1e-4) || x[2] > std::log(2.0) || x[3] < std::log(1e-10) || x[3] > std::log(1e-2))
+      return 1e300;
     return -TotalLogLik(eps, bases, pieces, use, unpack(x));
   };
   const double k2 = std::max(0.5 * (start.kL2 + start.kR2), 1e-12);
@@ -368,6 +373,10 @@ NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBase
   if (start.bump_rate > 0.0 && start.bump_s2 > 0.0)
     starts.insert(starts.begin(), {std::log(start.kL2), std::log(start.kR2), std::log(start.bump_rate),
                                    std::log(start.bump_s2)});
+  for (auto& x : starts) {
+    x[2] = std::clamp(x[2], std::log(2e-4), std::log(1.9));
+    x[3] = std::clamp(x[3], std::log(2e-10), std::log(0.5e-2));
+  }
   std::array<double, 4> best_x = starts.front();
   double best_f = 1e300;
   for (const auto& x0 : starts) {

@@ -15,7 +15,7 @@
 //
 // bump_outliers (a per-wheel Poisson process of travel errors N(0, sigma_b^2),
 // `rate` per metre) makes eps_j a scale mixture: with m bumps on the piece
-// (m ~ Poisson(rate (|L| + |R|)), truncated at 3) its covariance is
+// (m ~ Poisson(rate (|L| + |R|)), truncated at kMaxBumpsPerPiece) its covariance is
 //   C_j + m sigma_b^2 (A_L / |L| + A_R / |R|) / 2
 // (a bump's effect averaged over where on the piece, and which wheel, it
 // strikes). FitBumps maximises that mixture likelihood by Nelder-Mead.
@@ -44,11 +44,16 @@ struct NoiseParams {
 /// Covariance of piece j (Gaussian part: no bumps).
 Eigen::Matrix3d PieceCovariance(const PieceBases& B, const NoiseParams& n);
 
-/// Mixture of a piece under bump_outliers: weights and covariances of m = 0..3 bumps.
+/// Most bumps per piece the mixture distinguishes (the Poisson tail beyond
+/// is lumped into this count).
+inline constexpr int kMaxBumpsPerPiece = 5;
+
+/// Mixture of a piece under bump_outliers: weights and covariances of
+/// m = 0 .. kMaxBumpsPerPiece bumps.
 struct BumpMixture {
   int components = 1;
-  double weight[4] = {1.0, 0.0, 0.0, 0.0};
-  Eigen::Matrix3d cov[4];
+  double weight[kMaxBumpsPerPiece + 1] = {1.0};
+  Eigen::Matrix3d cov[kMaxBumpsPerPiece + 1];
 };
 BumpMixture PieceMixture(const PieceBases& B, const NoiseParams& n);
 
@@ -81,7 +86,8 @@ NoiseParams FitNoise(const std::vector<double>& eps, const std::vector<PieceBase
 
 /// As FitNoise, plus bump_outliers' rate and sigma_b (mixture likelihood,
 /// Nelder-Mead over log k_L^2, log k_R^2, log rate, log sigma_b^2; ground
-/// truth noise fixed at `start`'s).
+/// truth noise fixed at `start`'s). The search is bounded to physical
+/// bumps: rate in [1e-4, 2] per metre, sigma_b in [0.01, 100] mm.
 NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
                      const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start);
 

@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# Blind validation of `umbmark diagnose` through the command line.
+#
+# 1. bench_diagnose writes N random campaigns per class (every contract
+#    effect, none, and the two outside effects) as files: CASE/campaign/
+#    (manifest + CSV, what `diagnose` sees) and CASE/truth.json beside it
+#    (never read by diagnose). Its own in-process results go to
+#    OUT/inprocess.txt.
+# 2. Every campaign is diagnosed with the `umbmark diagnose` command, its
+#    verdict read from the JSON and compared with the hidden truth.
+#
+# Usage: bench/blind_validation.sh [BUILD_DIR] [N] [SEED] [--extended]
+#   defaults: BUILD_DIR=build, N=3 campaigns per class (2N clean), SEED=99.
+# Prints per-class results and the top-1 accuracy, false-alarm rate and
+# `unexplained` rate of the command-line path.
+set -euo pipefail
+
+BUILD=${1:-build}
+N=${2:-3}
+SEED=${3:-99}
+EXTRA=${4:-}
+UMBMARK="$BUILD/umbmark"
+BENCH="$BUILD/bench_diagnose"
+for exe in "$UMBMARK" "$BENCH"; do
+  [[ -x "$exe" ]] || { echo "missing $exe (build the umbmark and bench_diagnose targets)" >&2; exit 2; }
+done
+
+OUT=$(mktemp -d "${TMPDIR:-/tmp}/umbmark-blind.XXXXXX")
+echo "writing campaigns to $OUT/cases"
+"$BENCH" --per-class "$N" --clean $((2 * N)) --seed "$SEED" $EXTRA --write-dir "$OUT/cases" \
+  --json "$OUT/inprocess.json" > "$OUT/inprocess.txt"
+
+declare -A total right
+listed=0; listed_right=0; clean=0; alarms=0; outside=0; outside_unexplained=0
+start=$(date +%s.%N)
+for dir in "$OUT"/cases/*/; do
+  name=$(basename "$dir")
+  truth=${name#*_}
+  "$UMBMARK" diagnose "$dir/campaign/campaign.toml" --json "$dir/diagnosis.json" > "$dir/report.txt"
+  verdict=$(tr -d '\n ' < "$dir/diagnosis.json" | sed -n 's/.*"verdict":{"effect":"\([a-z_]*\)".*/\1/p')
+  total[$truth]=$(( ${total[$truth]:-0} + 1 ))
+  expected=$truth
+  [[ "$truth" == gt_yaw_misalignment || "$truth" == floor_slope ]] && expected=unexplained
+  if [[ "$verdict" == "$expected" ]]; then right[$truth]=$(( ${right[$truth]:-0} + 1 )); fi
+  case "$truth" in
+    none) clean=$((clean + 1)); [[ "$verdict" != none ]] && alarms=$((alarms + 1)) ;;
+    gt_yaw_misalignment|floor_slope)
+      outside=$((outside + 1)); [[ "$verdict" == unexplained ]] && outside_unexplained=$((outside_unexplained + 1)) ;;
+    *) listed=$((listed + 1)); [[ "$verdict" == "$truth" ]] && listed_right=$((listed_right + 1)) ;;
+  esac
+  printf '%-40s truth %-20s verdict %s\n' "$name" "$truth" "$verdict"
+done
+end=$(date +%s.%N)
+
+echo
+echo "per class (verdict == truth; outside effects count 'unexplained'):"
+for t in "${!total[@]}"; do
+  printf '  %-20s %d/%d\n' "$t" "${right[$t]:-0}" "${total[$t]}"
+done
+pct() { awk -v a="$1" -v b="$2" 'BEGIN { if (b > 0) printf "%.1f%%", 100 * a / b; else printf "n/a" }'; }
+echo "top-1 on listed effects:   $(pct $listed_right $listed) ($listed_right/$listed)"
+echo "false alarms (clean):      $(pct $alarms $clean) ($alarms/$clean)"
+echo "unexplained (outside):     $(pct $outside_unexplained $outside) ($outside_unexplained/$outside)"
+echo "command-line time per diagnosis: $(awk -v s="$start" -v e="$end" -v n="$((listed + clean + outside))" 'BEGIN { printf "%.2f s", (e - s) / n }')"
+echo "in-process results: $OUT/inprocess.txt"
