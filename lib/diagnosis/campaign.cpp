@@ -184,6 +184,17 @@ void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, co
     for (std::size_t i = a; i < b; ++i)
       travel += 0.5 * (std::abs(r.left[i + 1] - r.left[i]) + std::abs(r.right[i + 1] - r.right[i]));
     p.travel_m = travel;
+    if (type == PieceType::kStand && travel > 0.0) {
+      // Ground truth missing where a motion starts or ends: the stretch
+      // that was meant as standstill holds motion; type it by its travel.
+      const double L = r.left[b] - r.left[a], R = r.right[b] - r.right[a];
+      const sim::MotionClass cls = sim::ClassifyMotion(L, R, c.robot.wheelbase_m, o.motion);
+      p.type = type = cls == sim::MotionClass::kStraight ? PieceType::kStraight
+                      : cls == sim::MotionClass::kTurn   ? PieceType::kTurn
+                                                         : PieceType::kArc;
+      p.sign = sign = cls == sim::MotionClass::kTurn ? (R - L >= 0.0 ? 1 : -1) : (R + L >= 0.0 ? 1 : -1);
+      p.motion_first = first = false;
+    }
     p.subset = subsets.Get(r.experiment, SubsetName(kind, r, type, sign, first));
     p.pooled_subset = subsets.Get(r.experiment, std::string("all runs, ") + PieceTypeToString(type));
     p.campaign_subset = subsets.Get(-1, std::string("all experiments, ") + PieceTypeToString(type));
