@@ -18,6 +18,7 @@
 #include "calibration/refine.hpp"
 #include "core/angles.hpp"
 #include "core/errors.hpp"
+#include "error_models/noise_fit.hpp"
 #include "error_models/trajectory_covariance.hpp"
 #include "kinematics/odometry.hpp"
 #include "simulation/rng.hpp"
@@ -495,6 +496,7 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
   bs.runs = static_cast<int>(c.runs.size());
   // Return errors per experiment and direction: observed vs predicted.
   {
+    std::vector<NoiseFitRun> fit_runs;
     std::map<std::pair<int, std::string>, std::vector<int>> groups;
     for (std::size_t r = 0; r < c.runs.size(); ++r) groups[{c.runs[r].experiment, c.runs[r].direction}].push_back(static_cast<int>(r));
     const WheelNoise wn{bs.k_L, bs.k_R};
@@ -530,6 +532,14 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
         wt.left_m.assign(r.left.begin() + static_cast<std::ptrdiff_t>(g0), r.left.begin() + static_cast<std::ptrdiff_t>(g1 + 1));
         wt.right_m.assign(r.right.begin() + static_cast<std::ptrdiff_t>(g0), r.right.begin() + static_cast<std::ptrdiff_t>(g1 + 1));
         const TrajectoryCovarianceSummary tc = TrajectoryCovariance(wt, c.robot.wheelbase_m * p[kParamEb]);
+        NoiseFitRun fr;
+        fr.group = fmt::format("exp{}:{}", r.experiment + 1, r.direction);
+        fr.run = r.id;
+        fr.error = eo;
+        fr.has_theta = !r.endpoint || r.has_heading;
+        fr.basis = tc.motion;
+        fr.measurement = MeasurementCovariance(std::sqrt(noise.sxy2), std::sqrt(noise.sth2), ro);
+        fit_runs.push_back(fr);
         Eigen::Matrix3d C = tc.motion.Evaluate(wn);
         C(0, 0) += 2.0 * noise.sxy2;
         C(1, 1) += 2.0 * noise.sxy2;
@@ -547,6 +557,16 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
         rp.observed_cov /= rp.runs - 1;
       }
       bs.returns.push_back(rp);
+    }
+    try {
+      const NoiseFitSummary nf = umbmark::FitNoise(fit_runs);
+      bs.return_fit = true;
+      bs.return_k_L = nf.k_L;
+      bs.return_k_R = nf.k_R;
+      bs.return_k_L_ci = nf.k_L_ci;
+      bs.return_k_R_ci = nf.k_R_ci;
+    } catch (const std::exception& e) {
+      bs.return_fit_note = std::string("fit-noise on return errors not available: ") + e.what();
     }
     // Residual growth per segment type.
     for (PieceType t : {PieceType::kStraight, PieceType::kTurn, PieceType::kArc, PieceType::kStand, PieceType::kReturn}) {

@@ -115,6 +115,16 @@ struct BaselineSummary {
   std::vector<ReturnPrediction> returns;
   std::vector<GrowthRow> growth;
   int pieces = 0, runs = 0;
+  /// Cross-check: k_L, k_R from the runs' return errors alone by the
+  /// fit-noise estimator (error_models/noise_fit.hpp: systematic mean per
+  /// experiment and direction, Kelly's covariance along each run, the
+  /// ground truth's noise), with 95 % profile intervals. Absent when that
+  /// fit cannot run (too few runs per group); a disagreement with the piece
+  /// estimate above says the noise does not grow with distance as eq. 4 has it.
+  bool return_fit = false;
+  double return_k_L = 0.0, return_k_R = 0.0;
+  std::array<double, 2> return_k_L_ci{0.0, 0.0}, return_k_R_ci{0.0, 0.0};
+  std::string return_fit_note;
 };
 
 struct Candidate {

@@ -115,6 +115,12 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
             {"sigma_theta_rad", Num(b.sigma_theta_rad)},
             {"ground_truth_noise_estimated", b.ground_truth_estimated},
             {"start", b.start},
+            {"return_error_noise_fit",
+             b.return_fit ? nlohmann::json{{"k_L", Num(b.return_k_L)},
+                                           {"k_R", Num(b.return_k_R)},
+                                           {"k_L_ci95", {Num(b.return_k_L_ci[0]), Num(b.return_k_L_ci[1])}},
+                                           {"k_R_ci95", {Num(b.return_k_R_ci[0]), Num(b.return_k_R_ci[1])}}}
+                          : nlohmann::json(b.return_fit_note)},
             {"runs", b.runs},
             {"pieces", b.pieces},
             {"return_errors", returns},
@@ -137,6 +143,13 @@ std::string DiagnoseReport(const DiagnoseSummary& s) {
   line(fmt::format("  ground truth: sigma_xy = {:.3g} m, sigma_theta = {:.3g} rad; start: {}", b.sigma_xy_m,
                    b.sigma_theta_rad, b.start));
   line(fmt::format("  {} runs, {} pieces", b.runs, b.pieces));
+  if (b.return_fit)
+    line(fmt::format("  cross-check, fit-noise on the runs' return errors: k_L = {:.3g} [{:.3g}, {:.3g}], k_R = {:.3g} "
+                     "[{:.3g}, {:.3g}] m^1/2 (95%)",
+                     b.return_k_L, b.return_k_L_ci[0], b.return_k_L_ci[1], b.return_k_R, b.return_k_R_ci[0],
+                     b.return_k_R_ci[1]));
+  else if (!b.return_fit_note.empty())
+    line("  " + b.return_fit_note);
   line("  return errors per experiment and direction (mean x, y [mm], theta [mrad]; sd from the covariance):");
   for (const auto& r : b.returns) {
     line(fmt::format("    exp {} {:<10} {:>3} runs  observed ({:+8.2f}, {:+8.2f}, {:+8.2f}) sd ({:6.2f}, {:6.2f}, {:6.2f})",
