@@ -28,6 +28,8 @@ namespace umbmark::diag {
 std::string DiagnoseOptions::Check() const {
   if (null_simulations < 20) return fmt::format("null_simulations = {} must be >= 20", null_simulations);
   if (!(alpha > 0.0 && alpha < 0.5)) return fmt::format("alpha = {} must be in (0, 0.5)", alpha);
+  if (!(full_shrink >= min_heldout_shrink && full_shrink <= 1.0))
+    return fmt::format("full_shrink = {} must be in [min_heldout_shrink, 1]", full_shrink);
   if (!(min_heldout_shrink > 0.0 && min_heldout_shrink <= 1.0))
     return fmt::format("min_heldout_shrink = {} must be in (0, 1]", min_heldout_shrink);
   if (!(complexity_penalty_nats >= 0.0))
@@ -829,8 +831,11 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
   for (std::size_t i = 0; i < rank.size(); ++i) rank[i] = i;
   // Best first: effects that close most of the held-out gap with positive
   // evidence, by evidence; then the others by evidence; unidentifiable last.
+  // A winner must also leave no significant gap behind, unless it closes
+  // nearly all of it (a tiny misfit of a huge effect still scores high).
   auto qualifies = [&](const Candidate& cd) {
-    return cd.identifiable && cd.evidence > 0.0 && cd.heldout_shrink >= options.min_heldout_shrink;
+    return cd.identifiable && cd.evidence > 0.0 && cd.heldout_shrink >= options.min_heldout_shrink &&
+           (cd.gap_after <= out.null_quantile_alpha || cd.heldout_shrink >= options.full_shrink);
   };
   std::stable_sort(rank.begin(), rank.end(), [&](std::size_t a, std::size_t b) {
     if (cands[a].identifiable != cands[b].identifiable) return cands[a].identifiable;
@@ -851,10 +856,15 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
     } else {
       out.verdict = "unexplained";
       out.verdict_reason =
-          best ? fmt::format("significant gap (p = {:.3g}); the best candidate, {}, closes only {:.0f}% of it on "
-                             "held-out runs",
-                             out.p_value, sim::EffectToString(best->effect), 100.0 * best->heldout_shrink)
-               : "significant gap and no identifiable candidate";
+          !best ? "significant gap and no identifiable candidate"
+          : best->heldout_shrink < options.min_heldout_shrink || best->evidence <= 0.0
+              ? fmt::format("significant gap (p = {:.3g}); the best candidate, {}, closes only {:.0f}% of it on "
+                            "held-out runs",
+                            out.p_value, sim::EffectToString(best->effect), 100.0 * best->heldout_shrink)
+              : fmt::format("significant gap (p = {:.3g}); the best candidate, {}, closes {:.0f}% of it on held-out "
+                            "runs but leaves a significant gap (G = {:.1f} > {:.1f})",
+                            out.p_value, sim::EffectToString(best->effect), 100.0 * best->heldout_shrink,
+                            best->gap_after, out.null_quantile_alpha);
     }
   }
   // What the data cannot tell apart.

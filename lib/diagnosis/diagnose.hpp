@@ -23,7 +23,8 @@
 //     ranked by held-out log-likelihood gain minus complexity_penalty_nats
 //     per parameter.
 //  4. Verdict: `none` when p >= alpha; else the top candidate if its
-//     heldout_shrink >= min_heldout_shrink; else `unexplained`. Effects the
+//     heldout_shrink >= min_heldout_shrink and it leaves no significant gap
+//     (or closes >= full_shrink of it); else `unexplained`. Effects the
 //     data cannot tell apart (from the baseline, or from each other) are
 //     listed.
 //
@@ -59,6 +60,9 @@ struct DiagnoseOptions {
   /// A winning effect must close at least this fraction of the gap on
   /// held-out runs. Default 0.5 ("most of it").
   double min_heldout_shrink = 0.5;
+  /// ...and leave no significant gap (G after the effect below the null's
+  /// 1 - alpha quantile) unless its heldout_shrink reaches this. Default 0.9.
+  double full_shrink = 0.9;
   /// Held-out log-likelihood an effect must gain per parameter. Default 2 nats.
   double complexity_penalty_nats = 2.0;
   /// Seed of the bootstrap. Default 1.
