@@ -16,6 +16,7 @@
 #include "core/errors.hpp"
 #include "error_models/path_covariance.hpp"
 #include "error_models/path_spec.hpp"
+#include "error_models/second_order.hpp"
 #include "simulation/monte_carlo.hpp"
 
 namespace umbmark::cli {
@@ -95,10 +96,18 @@ int RunPredict(const PredictOptions& o) {
                       {"mean", {mean.x, mean.y, mean.theta}},
                       {"theta_continuous_rad", pred.mean.theta},
                       {"covariance", JsonMatrix(pred.covariance)}};
+  // Second-order (heading-squared) correction, docs/noise-model.md.
+  const SecondOrderBasis q2 = SecondOrderHeadingBasis(path, robot.wheelbase_m);
+  const Eigen::Vector3d dm = q2.Mean(noise, P0(2, 2));
+  const Pose2 mean2{mean.x + dm(0), mean.y + dm(1), mean.theta};
+  const PoseCovariance cov2 = pred.covariance + q2.Covariance(noise, P0(2, 2));
+  j["second_order"] = {{"mean", {mean2.x, mean2.y, mean2.theta}}, {"covariance", JsonMatrix(cov2)}};
   if (o.json.PrintText()) {
     fmt::print("Path {} (wheelbase {} m, k_L = {} m^1/2, k_R = {} m^1/2)\n", PathSpecToString(spec),
                robot.wheelbase_m, o.k_L, o.k_R);
     PrintCovariance("Closed form (Chong & Kleeman eqs. 23-28):", mean, pred.covariance);
+    fmt::print("\n");
+    PrintCovariance("With the second-order heading term (track shortening):", mean2, cov2);
   }
 
   if (o.mc_runs) {

@@ -59,6 +59,10 @@ TEST_CASE("predict line:10,line:-10 matches numerical propagation to 1e-9", "[pr
     for (int b = 0; b < 3; ++b)
       CHECK(std::abs(j["covariance"][a][b].get<double>() - ref(a, b)) <= 1e-9 * std::sqrt(ref(a, a) * ref(b, b)));
   CHECK(std::abs(j["mean"][0].get<double>()) < 1e-12);
+  // The second-order block adds the track shortening to ex only.
+  CHECK(j["second_order"]["covariance"][0][0].get<double>() > 1.03 * ref(0, 0));
+  CHECK(j["second_order"]["covariance"][1][1].get<double>() == Approx(ref(1, 1)).epsilon(1e-9));
+  CHECK(j["second_order"]["mean"][0].get<double>() == Approx(1.80e-4).epsilon(0.01));
   fs::remove(robot);
 }
 

@@ -217,6 +217,26 @@ TEST_CASE("encoder quantisation: whole ticks, start phase, stop rule", "[simulat
     CHECK(t.truth[1].y == Approx(p2.y).margin(1e-13));
   }
   CHECK(traces[0].phase_left != traces[1].phase_left);
+  // Encoder readings along a finely recorded trace: whole ticks of the
+  // continuous wheel position (phase + true rotation / true metres per tick),
+  // the targets at the segment ends.
+  const auto fine = SimulateTraces(plan, 11, 0, 1, 1);
+  const RunTrace& f = fine[0];
+  REQUIRE(f.ticks_left.size() == 40);
+  CHECK(f.ticks_left[19] == 318);
+  CHECK(f.ticks_left[39] == 0);
+  CHECK(f.wheel_left_m[19] == Approx(318 * mpt));
+  for (std::size_t i = 0; i + 1 < 20; ++i) {
+    const double pos = f.phase_left + (318 - f.phase_left) * static_cast<double>(i + 1) / 20.0;
+    CHECK(f.ticks_left[i] == static_cast<std::int64_t>(std::floor(pos)));
+  }
+  CHECK(f.ticks_left[20] == static_cast<std::int64_t>(std::floor(318.0 - 317.0 / 20.0)));
+  // Without quantisation the encoders report the commanded travel.
+  const SimPlan smooth = CompilePlan(BasicModel(0.4, 0.01, 0.01), {{1.0, 1.0}, {-1.0, -1.0}}, 4);
+  const RunTrace s = SimulateTraces(smooth, 1, 0, 1, 1)[0];
+  CHECK(s.ticks_left.empty());
+  CHECK(s.wheel_left_m[1] == Approx(0.5));
+  CHECK(s.wheel_right_m[5] == Approx(0.5));
 }
 
 TEST_CASE("all SIMD kernels give identical bits", "[simulator]") {

@@ -71,6 +71,8 @@ SimPlan CompilePlan(const SimulationModel& model, const std::vector<WheelSegment
   const double mpt_L = nom.MetresPerTickLeft(), mpt_R = nom.MetresPerTickRight();
   plan.true_metres_per_tick_left = g_L * mpt_L;
   plan.true_metres_per_tick_right = g_R * mpt_R;
+  plan.nominal_metres_per_tick_left = mpt_L;
+  plan.nominal_metres_per_tick_right = mpt_R;
   double cum_L = 0.0, cum_R = 0.0;           // cumulative nominal travel
   std::int64_t T_L = 0, T_R = 0;             // count targets
   double p_L = 0.0, p_R = 0.0;               // stop positions for start phase 0
@@ -95,6 +97,8 @@ SimPlan CompilePlan(const SimulationModel& model, const std::vector<WheelSegment
     s.odo_right_m = static_cast<double>(target_R - T_R) * mpt_R;
     s.ticks_left = target_L;
     s.ticks_right = target_R;
+    s.stop_left_ticks = np_L;
+    s.stop_right_ticks = np_R;
     plan.segments.push_back(s);
     odo = DiffDriveStep(odo, s.odo_left_m, s.odo_right_m, nom.wheelbase_m);
     T_L = target_L;

@@ -74,6 +74,10 @@ struct SimSegment {
   double odo_left_m = 0.0, odo_right_m = 0.0;
   /// Encoder counts at the end of the segment (quantised plans only).
   std::int64_t ticks_left = 0, ticks_right = 0;
+  /// Continuous wheel positions [ticks] where the segment stops (quantised
+  /// plans; for encoder start phase 0 -- a wheel that has not moved yet
+  /// still sits at its phase).
+  double stop_left_ticks = 0.0, stop_right_ticks = 0.0;
 };
 
 struct SimPlan {
@@ -87,6 +91,7 @@ struct SimPlan {
   /// (-1: the wheel never moves, or no quantisation).
   bool quantised = false;
   double true_metres_per_tick_left = 0.0, true_metres_per_tick_right = 0.0;
+  double nominal_metres_per_tick_left = 0.0, nominal_metres_per_tick_right = 0.0;
   int phase_segment_left = -1, phase_segment_right = -1;
   /// Final pose the odometry computes (deterministic for a plan).
   Pose2 odometry_final;

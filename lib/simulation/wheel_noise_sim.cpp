@@ -342,6 +342,56 @@ void SimulateRuns(const SimPlan& plan, std::uint64_t seed, std::int64_t first_ru
   }
 }
 
+namespace {
+
+/// Encoder readings of a trace at its samples (see RunTrace).
+void AddEncoderReadings(const SimPlan& plan, RunTrace& t) {
+  const std::size_t n = t.segment.size();
+  t.wheel_left_m.resize(n);
+  t.wheel_right_m.resize(n);
+  if (plan.quantised) {
+    t.ticks_left.resize(n);
+    t.ticks_right.resize(n);
+  }
+  // Cumulative odometry travel and wheel positions at every segment start.
+  std::vector<double> odo_l(plan.segments.size() + 1, 0.0), odo_r(plan.segments.size() + 1, 0.0);
+  std::vector<double> pos_l(plan.segments.size() + 1, t.phase_left), pos_r(plan.segments.size() + 1, t.phase_right);
+  std::vector<std::int64_t> cnt_l(plan.segments.size() + 1, 0), cnt_r(plan.segments.size() + 1, 0);
+  for (std::size_t k = 0; k < plan.segments.size(); ++k) {
+    const SimSegment& s = plan.segments[k];
+    odo_l[k + 1] = odo_l[k] + s.odo_left_m;
+    odo_r[k + 1] = odo_r[k] + s.odo_right_m;
+    const bool moved_l = plan.phase_segment_left >= 0 && static_cast<int>(k) >= plan.phase_segment_left;
+    const bool moved_r = plan.phase_segment_right >= 0 && static_cast<int>(k) >= plan.phase_segment_right;
+    pos_l[k + 1] = moved_l ? s.stop_left_ticks : t.phase_left;
+    pos_r[k + 1] = moved_r ? s.stop_right_ticks : t.phase_right;
+    cnt_l[k + 1] = s.ticks_left;
+    cnt_r[k + 1] = s.ticks_right;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(t.segment[i]);
+    const SimSegment& s = plan.segments[k];
+    const double f = static_cast<double>(t.partition[i]) / s.partitions;
+    if (!plan.quantised) {
+      t.wheel_left_m[i] = odo_l[k] + f * s.odo_left_m;
+      t.wheel_right_m[i] = odo_r[k] + f * s.odo_right_m;
+      continue;
+    }
+    // Whole ticks of the continuous wheel position; exactly the target at
+    // the segment end (where a backward stop sits just below T + 1).
+    auto count = [&](const std::vector<double>& pos, const std::vector<std::int64_t>& cnt) {
+      if (t.partition[i] == s.partitions) return cnt[k + 1];
+      return static_cast<std::int64_t>(std::floor(pos[k] + f * (pos[k + 1] - pos[k])));
+    };
+    t.ticks_left[i] = count(pos_l, cnt_l);
+    t.ticks_right[i] = count(pos_r, cnt_r);
+    t.wheel_left_m[i] = static_cast<double>(t.ticks_left[i]) * plan.nominal_metres_per_tick_left;
+    t.wheel_right_m[i] = static_cast<double>(t.ticks_right[i]) * plan.nominal_metres_per_tick_right;
+  }
+}
+
+}  // namespace
+
 std::vector<RunTrace> SimulateTraces(const SimPlan& plan, std::uint64_t seed, std::int64_t first_run,
                                      std::int64_t count, int record_every) {
   const Eigen::Matrix3d sqrt_p0 = CovarianceSqrt(plan.initial_covariance);
@@ -358,7 +408,10 @@ std::vector<RunTrace> SimulateTraces(const SimPlan& plan, std::uint64_t seed, st
     rec.traces = &traces;
     rec.lanes = valid;
     fn(b, segs.data(), static_cast<int>(segs.size()), plan.true_wheelbase_m, &rec);
-    for (int j = 0; j < valid; ++j) all.push_back(std::move(traces[j]));
+    for (int j = 0; j < valid; ++j) {
+      AddEncoderReadings(plan, traces[j]);
+      all.push_back(std::move(traces[j]));
+    }
   }
   return all;
 }

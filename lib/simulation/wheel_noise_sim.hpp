@@ -55,6 +55,12 @@ struct RunTrace {
   std::vector<int> segment;    ///< segment index of the sample
   std::vector<int> partition;  ///< partitions done in that segment (1..P)
   std::vector<Pose2> truth;    ///< true pose
+  /// What the encoders report at each sample: cumulative wheel travel in
+  /// nominal metres (whole ticks times metres per tick when quantised; the
+  /// commanded travel, linear within a segment, otherwise).
+  std::vector<double> wheel_left_m, wheel_right_m;
+  /// Cumulative encoder counts (quantised plans only; empty otherwise).
+  std::vector<std::int64_t> ticks_left, ticks_right;
 };
 
 /// Traces of runs first_run .. first_run + count - 1 (same numbers as
