@@ -118,54 +118,36 @@ bool ProfiledNll(const std::vector<NoiseFitRun>& runs, const Grouping& grp, cons
   return true;
 }
 
-/// NLL as a function of free log-k parameters; a fixed k (>= 0) replaces
-/// one of them for the profile likelihood.
+/// NLL as a function of (log k_L, log k_R).
 struct NllCost {
   const std::vector<NoiseFitRun>* runs;
   const Grouping* grp;
-  int fixed = -1;         ///< -1: both free (params = [log kL, log kR]); 0: kL fixed; 1: kR fixed
-  double fixed_k = 0.0;
   bool restricted = false;  ///< REML (see NoiseFitOptions::restricted)
 
   template <typename T>
   bool operator()(const T* p, T* cost) const {
-    T qL, qR;
-    if (fixed < 0) {
-      qL = exp(T(2.0) * p[0]);
-      qR = exp(T(2.0) * p[1]);
-    } else if (fixed == 0) {
-      qL = T(fixed_k * fixed_k);
-      qR = exp(T(2.0) * p[0]);
-    } else {
-      qL = exp(T(2.0) * p[0]);
-      qR = T(fixed_k * fixed_k);
-    }
+    const T qL = exp(T(2.0) * p[0]), qR = exp(T(2.0) * p[1]);
     return ProfiledNll<T>(*runs, *grp, qL, qR, cost, nullptr, restricted);
   }
 };
 
-/// Automatic first derivatives of NllCost with N free parameters (a
-/// minimal stand-in for ceres::AutoDiffFirstOrderFunction that keeps the
-/// Jets on the stack).
-template <int N>
+/// Automatic first derivatives of NllCost (a minimal stand-in for
+/// ceres::AutoDiffFirstOrderFunction that keeps the Jets on the stack).
 class NllFunction final : public ceres::FirstOrderFunction {
  public:
   explicit NllFunction(const NllCost& cost) : cost_(cost) {}
   bool Evaluate(const double* parameters, double* cost, double* gradient) const override {
-    if (gradient == nullptr) {
-      const double p[2] = {parameters[0], N > 1 ? parameters[N - 1] : 0.0};
-      return cost_(p, cost);
-    }
-    using J = ceres::Jet<double, N>;
-    J p[2] = {J(0.0), J(0.0)};  // padded: NllCost reads p[1] only when N == 2
-    for (int i = 0; i < N; ++i) p[i] = J(parameters[i], i);
+    if (gradient == nullptr) return cost_(parameters, cost);
+    using J = ceres::Jet<double, 2>;
+    const J p[2] = {J(parameters[0], 0), J(parameters[1], 1)};
     J out(0.0);
     if (!cost_(p, &out)) return false;
     *cost = out.a;
-    for (int i = 0; i < N; ++i) gradient[i] = out.v[i];
+    gradient[0] = out.v[0];
+    gradient[1] = out.v[1];
     return true;
   }
-  int NumParameters() const override { return N; }
+  int NumParameters() const override { return 2; }
 
  private:
   NllCost cost_;
@@ -193,19 +175,66 @@ ceres::GradientProblemSolver::Options SolverOptions(int max_iterations) {
 Minimum Minimise(const NllCost& cost, std::vector<double> start, int max_iterations) {
   Minimum m;
   ceres::GradientProblemSolver::Summary summary;
-  if (cost.fixed < 0) {
-    ceres::GradientProblem problem(new NllFunction<2>(cost));
-    ceres::Solve(SolverOptions(max_iterations), problem, start.data(), &summary);
-  } else {
-    ceres::GradientProblem problem(new NllFunction<1>(cost));
-    ceres::Solve(SolverOptions(max_iterations), problem, start.data(), &summary);
-  }
+  ceres::GradientProblem problem(new NllFunction(cost));
+  ceres::Solve(SolverOptions(max_iterations), problem, start.data(), &summary);
   m.ok = summary.termination_type == ceres::CONVERGENCE && std::isfinite(summary.final_cost);
   m.nll = summary.final_cost;
   m.params = start;
   m.iterations = static_cast<int>(summary.iterations.size());
   m.message = summary.message;
   return m;
+}
+
+/// Brent's minimisation of f on [a, b] (parabolic interpolation with golden
+/// section fallback; Brent 1973, ch. 5), to an absolute tolerance tol in x.
+template <typename F>
+double BrentMinimum(F f, double a, double b, double tol, double* fmin) {
+  constexpr double kGolden = 0.3819660112501051;
+  double x = a + kGolden * (b - a), w = x, v = x;
+  double fx = f(x), fw = fx, fv = fx;
+  double d = 0.0, e = 0.0;
+  for (int it = 0; it < 200; ++it) {
+    const double m = 0.5 * (a + b);
+    const double tol1 = tol + 1e-12 * std::abs(x), tol2 = 2.0 * tol1;
+    if (std::abs(x - m) <= tol2 - 0.5 * (b - a)) break;
+    bool golden = true;
+    if (std::abs(e) > tol1 && std::isfinite(fx) && std::isfinite(fw) && std::isfinite(fv)) {
+      double r = (x - w) * (fx - fv), q = (x - v) * (fx - fw), p = (x - v) * q - (x - w) * r;
+      q = 2.0 * (q - r);
+      if (q > 0.0) p = -p;
+      q = std::abs(q);
+      const double e_prev = e;
+      e = d;
+      if (std::abs(p) < std::abs(0.5 * q * e_prev) && p > q * (a - x) && p < q * (b - x)) {
+        d = p / q;
+        const double u = x + d;
+        if (u - a < tol2 || b - u < tol2) d = x < m ? tol1 : -tol1;
+        golden = false;
+      }
+    }
+    if (golden) {
+      e = (x < m ? b : a) - x;
+      d = kGolden * e;
+    }
+    const double u = std::abs(d) >= tol1 ? x + d : x + (d > 0 ? tol1 : -tol1);
+    const double fu = f(u);
+    if (fu <= fx) {
+      (u < x ? b : a) = x;
+      v = w, fv = fw;
+      w = x, fw = fx;
+      x = u, fx = fu;
+    } else {
+      (u < x ? a : b) = u;
+      if (fu <= fw || w == x) {
+        v = w, fv = fw;
+        w = u, fw = fu;
+      } else if (fu <= fv || v == x || v == w) {
+        v = u, fv = fu;
+      }
+    }
+  }
+  *fmin = fx;
+  return x;
 }
 
 /// Inverse of the standard normal CDF by bisection on erfc (ample for a
@@ -280,8 +309,7 @@ NoiseFitSummary FitNoise(const std::vector<NoiseFitRun>& runs, const NoiseFitOpt
   (void)mean_all;
 
   // 3. Maximum likelihood over (log k_L, log k_R).
-  NllCost cost{&runs, &grp};
-  cost.restricted = options.restricted;
+  NllCost cost{&runs, &grp, options.restricted};
   double nll0 = 0.0;
   if (!ProfiledNll(runs, grp, q(0), q(1), &nll0))
     throw QualityGateError("fit-noise: the starting point has a singular run covariance");
@@ -302,18 +330,21 @@ NoiseFitSummary FitNoise(const std::vector<NoiseFitRun>& runs, const NoiseFitOpt
   // 4. Profile-likelihood intervals.
   const double zq = NormalQuantile(0.5 * (1.0 + options.confidence));
   const double delta = 0.5 * zq * zq;  // chi^2_1 quantile / 2
-  auto profile = [&](int which, double k, double other_log_start) {
-    NllCost c = cost;
-    c.fixed = which;
-    c.fixed_k = k;
-    // Start the free parameter where it was; fall back to the optimum.
+  // Profile NLL: with one k fixed, minimise over the other by Brent's method
+  // in log k (one-dimensional and robust where the likelihood is flat, e.g.
+  // when the other k is at its boundary 0), also trying the other k = 0.
+  auto nll_at = [&](int which, double k_fixed, double k_other) {
     double v = 0.0;
-    const double q_fixed = k * k, q_other = std::exp(2.0 * other_log_start);
-    const bool finite = which == 0 ? ProfiledNll<double>(runs, grp, q_fixed, q_other, &v, nullptr, options.restricted)
-                                   : ProfiledNll<double>(runs, grp, q_other, q_fixed, &v, nullptr, options.restricted);
-    if (!finite) return std::numeric_limits<double>::infinity();
-    const Minimum m = Minimise(c, {other_log_start}, options.max_iterations);
-    return std::isfinite(m.nll) ? std::min(m.nll, v) : v;
+    const double qf = k_fixed * k_fixed, qo = k_other * k_other;
+    const bool ok = which == 0 ? ProfiledNll<double>(runs, grp, qf, qo, &v, nullptr, options.restricted)
+                               : ProfiledNll<double>(runs, grp, qo, qf, &v, nullptr, options.restricted);
+    return ok ? v : std::numeric_limits<double>::infinity();
+  };
+  auto profile = [&](int which, double k, double other_log_start) {
+    double best_v = 0.0;
+    BrentMinimum([&](double u) { return nll_at(which, k, std::exp(u)); }, other_log_start - 15.0,
+                 other_log_start + 5.0, 1e-7, &best_v);
+    return std::min(best_v, nll_at(which, k, 0.0));
   };
   auto interval = [&](int which) -> std::array<double, 2> {
     const double khat = which == 0 ? out.k_L : out.k_R;
