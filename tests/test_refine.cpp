@@ -248,6 +248,8 @@ TEST_CASE("refine: options are checked and the bad field is named", "[refine][op
   CHECK(ScaleModeFromString(ScaleModeToString(ScaleMode::kFixed)) == ScaleMode::kFixed);
   CHECK(TrajectoryCovarianceFromString("solver_scaled") == TrajectoryCovariance::kSolverScaled);
   CHECK_FALSE(ScaleModeFromString("fix").has_value());
+  CHECK(RefineInputKindFromString(RefineInputKindToString(RefineInputKind::kTrajectories)) ==
+        RefineInputKind::kTrajectories);
 }
 
 TEST_CASE("refine: data it cannot use are input errors", "[refine][input]") {

@@ -68,6 +68,12 @@ const char* RefineInputKindToString(RefineInputKind k) {
   return k == RefineInputKind::kReturnErrors ? "return_errors" : "trajectories";
 }
 
+std::optional<RefineInputKind> RefineInputKindFromString(std::string_view s) {
+  if (s == "return_errors") return RefineInputKind::kReturnErrors;
+  if (s == "trajectories") return RefineInputKind::kTrajectories;
+  return std::nullopt;
+}
+
 std::string RefineOptions::Check() const {
   auto positive = [](const char* name, double v) -> std::string {
     if (!std::isfinite(v) || !(v > 0.0)) return fmt::format("{} = {} must be a finite number > 0", name, v);

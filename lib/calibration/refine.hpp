@@ -7,7 +7,8 @@
 //    to their return errors): the exact commanded-square model
 //    (simulation/commanded_square.hpp) predicts every run's return error;
 //    every run is a residual, weighted by the run-to-run scatter of its
-//    (set, direction) group (see RefineOptions::min_runs_for_group_covariance).
+//    (set, direction) group (rules and small-sample corrections:
+//    refine_endpoint.cpp; choices and their checks: docs/refine.md).
 //  - Trajectories with ground truth: odometry from the encoder samples vs
 //    ground truth along the whole path of every run, sampled evenly in
 //    travelled distance with a fixed number of poses per run (so a long run
@@ -52,8 +53,12 @@ namespace umbmark {
 
 /// How the overall scale E_s (mean wheel diameter) is treated.
 enum class ScaleMode {
-  kAuto,   ///< return errors: fixed at 1 (first-order unobservable); trajectories: free, fixed (with a note) if the data do not determine it
-  kFixed,  ///< E_s = 1 (the reference mean diameter factor is kept, as classic UMBmark does)
+  /// Return errors: held (first-order unobservable). Trajectories: free,
+  /// held (with a note) if the data do not determine it.
+  kAuto,
+  /// Held at RefineStart::E_s (default 1: the reference mean diameter
+  /// factor is kept, as classic UMBmark does).
+  kFixed,
   kFree    ///< estimated; RefineError if the data do not determine it
 };
 const char* ScaleModeToString(ScaleMode m);
@@ -221,6 +226,7 @@ struct RefineSolverReport {
 
 enum class RefineInputKind { kReturnErrors, kTrajectories };
 const char* RefineInputKindToString(RefineInputKind k);
+std::optional<RefineInputKind> RefineInputKindFromString(std::string_view s);
 
 /// How one group of return errors was weighted.
 struct RefineGroupWeighting {
