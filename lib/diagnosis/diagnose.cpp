@@ -414,6 +414,7 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
   // ---- 1. Baseline -------------------------------------------------------
   ParamVector p = NominalParams();
   out.baseline.start = "nominal (E_d = E_b = 1)";
+  bool refined = false;
   if (options.use_refine) {
     try {
       RefineOptions ro;
@@ -448,12 +449,14 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
         p[kParamEb] = rs.E_b;
         out.baseline.start = fmt::format("refined calibration ({}): E_d = {:.6f}, E_b = {:.6f}",
                                          tsets.empty() ? "return errors" : "trajectories", rs.E_d, rs.E_b);
+        refined = true;
       }
     } catch (const std::exception& e) {
       out.notes.push_back(std::string("refined calibration unavailable, starting from the nominal robot: ") + e.what());
     }
   }
   const auto t_refine = Clock::now();
+  const ParamVector start_p = p;
 
   NoiseParams noise;
   const bool gt_known = c.ground_truth.has_value();
@@ -474,6 +477,19 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
     p = base.p;
     if (round == 0) ctx.bases = ComputeBases(c, model, p);
     noise = FitNoise(base.eps, ctx.bases, c.pieces, {}, noise, ctx.noise_fit);
+  }
+  if (refined && base.cov.rows() == 2) {
+    // The calibration and the model's best fit on the pieces should agree
+    // when the model is right; far apart, systematic effects are at work.
+    const ParamVector& p0 = start_p;
+    const double zd = (p[kParamEd] - p0[kParamEd]) / std::sqrt(std::max(base.cov(0, 0), 1e-300));
+    const double zb = (p[kParamEb] - p0[kParamEb]) / std::sqrt(std::max(base.cov(1, 1), 1e-300));
+    if (std::max(std::abs(zd), std::abs(zb)) > 5.0)
+      out.notes.push_back(fmt::format(
+          "the refined calibration (E_d = {:.6f}, E_b = {:.6f}) and the baseline's best fit on the pieces (E_d = "
+          "{:.6f}, E_b = {:.6f}) differ by {:.0f} and {:.0f} standard errors: the two weigh the runs differently, "
+          "which matters only when the runs leave the model",
+          p0[kParamEd], p0[kParamEb], p[kParamEd], p[kParamEb], zd, zb));
   }
   ctx.p_base = p;
   ctx.noise_base = noise;
