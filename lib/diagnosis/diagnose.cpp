@@ -163,8 +163,6 @@ double TypicalMagnitude(int param) {
   }
 }
 
-bool raw_zero(const Eigen::MatrixXd& J) { return !(J.norm() > 0.0); }
-
 /// Contract parameter name of a mean-model parameter.
 const char* ContractParamName(int index) { return ParamName(index); }
 
@@ -743,7 +741,7 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
       }
       if (!identifiable) {
         cd.identifiable = false;
-        cd.note = raw_zero(Jw_e) ? "not identifiable on these data: these experiments do not show it at all"
+        cd.note = !(Jw_e.norm() > 0.0) ? "not identifiable on these data: these experiments do not show it at all"
                                  : fmt::format("not identifiable on these data: indistinguishable from the baseline's {} "
                                                "(a {})",
                                                ParamName(mimics),

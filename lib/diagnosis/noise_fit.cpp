@@ -78,12 +78,6 @@ double GaussLogPdf(const double* eps, int d, const Eigen::Matrix3d& C) {
 
 bool Used(const std::vector<char>& use, std::size_t j) { return use.empty() || use[j] != 0; }
 
-/// Huber weight of a piece with Mahalanobis distance^2 m (1 inside the
-/// threshold c^2, c / sqrt(m) beyond): bounds the pull of a piece whose
-/// mean the model misses (an unmodelled effect) on the noise estimate.
-inline double HuberWeight(double m, double c2) { return m <= c2 ? 1.0 : std::sqrt(c2 / m); }
-/// The matching objective term rho(m): m inside, 2 c sqrt(m) - c^2 beyond.
-inline double HuberRho(double m, double c2) { return m <= c2 ? m : 2.0 * std::sqrt(c2 * m) - c2; }
 
 struct Component {
   int param;  // 0 kL2, 1 kR2, 2 c, 3 sxy2, 4 sth2
@@ -118,14 +112,13 @@ double TotalLogLik(const std::vector<double>& eps, const std::vector<PieceBases>
 }
 
 /// chi^2 quantiles at 0.999 for 1, 2 and 3 degrees of freedom (trimming).
-constexpr double kHuberC2[4] = {0.0, 10.83, 13.82, 16.27};
+constexpr double kTrimChi2[4] = {0.0, 10.83, 13.82, 16.27};
 /// 1 / E[m | m < q_0.999] * d for chi^2_3: the variance lost by trimming.
 constexpr double kTrimConsistency = 1.0051;
 
-/// The robust objective: -1/2 sum (rho(m_j) + log det C_j).
-double RobustObjective(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
-                       const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& n,
-                       bool robust) {
+/// Gaussian log-likelihood without constants: -1/2 sum (m_j + log det C_j).
+double Objective(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
+                 const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& n) {
   double ll = 0.0;
   for (std::size_t j = 0; j < pieces.size(); ++j) {
     if (!Used(use, j)) continue;
@@ -147,7 +140,7 @@ double RobustObjective(const std::vector<double>& eps, const std::vector<PieceBa
       const Eigen::Matrix2d L = llt.matrixL();
       logdet = 2.0 * std::log(L(0, 0) * L(1, 1));
     }
-    ll += -0.5 * ((robust ? HuberRho(m, kHuberC2[d]) : m) + logdet);
+    ll += -0.5 * (m + logdet);
   }
   return ll;
 }
@@ -156,7 +149,7 @@ double RobustObjective(const std::vector<double>& eps, const std::vector<PieceBa
 /// residual components) for the active variance components.
 template <int D>
 void AccumulateFisher(const double* eps, const PieceBases& B, const NoiseParams& n, const std::vector<int>& active,
-                      double c2, Eigen::Matrix<double, 5, 1>& score, Eigen::Matrix<double, 5, 5>& info) {
+                      Eigen::Matrix<double, 5, 1>& score, Eigen::Matrix<double, 5, 5>& info) {
   using Mat = Eigen::Matrix<double, D, D>;
   using Vec = Eigen::Matrix<double, D, 1>;
   const Mat C = PieceCovariance(B, n).template topLeftCorner<D, D>();
@@ -164,13 +157,12 @@ void AccumulateFisher(const double* eps, const PieceBases& B, const NoiseParams&
   Vec e;
   for (int c = 0; c < D; ++c) e[c] = eps[c];
   const Vec u = Ci * e;
-  const double w = c2 > 0.0 ? HuberWeight(e.dot(u), c2) : 1.0;
   const int p = static_cast<int>(active.size());
   Mat M[5];
   for (int a = 0; a < p; ++a) {
     const Mat Bm = Basis(B, active[a]).template topLeftCorner<D, D>();
     M[a] = Ci * Bm;
-    score[a] += 0.5 * (w * u.dot(Bm * u) - M[a].trace());
+    score[a] += 0.5 * (u.dot(Bm * u) - M[a].trace());
   }
   for (int a = 0; a < p; ++a)
     for (int b = a; b < p; ++b) {
@@ -249,16 +241,16 @@ NoiseParams FitNoiseOnce(const std::vector<double>& eps, const std::vector<Piece
     Clamp(n, options);
   }
 
-  double ll = options.line_search ? RobustObjective(eps, bases, pieces, use, n, false) : 0.0;
+  double ll = options.line_search ? Objective(eps, bases, pieces, use, n) : 0.0;
   for (int it = 0; it < options.max_iterations; ++it) {
     Eigen::Matrix<double, 5, 1> score = Eigen::Matrix<double, 5, 1>::Zero();
     Eigen::Matrix<double, 5, 5> info = Eigen::Matrix<double, 5, 5>::Zero();
     for (std::size_t j = 0; j < pieces.size(); ++j) {
       if (!Used(use, j)) continue;
       if (pieces[j].components == 3)
-        AccumulateFisher<3>(&eps[3 * j], bases[j], n, active, 0.0, score, info);
+        AccumulateFisher<3>(&eps[3 * j], bases[j], n, active, score, info);
       else
-        AccumulateFisher<2>(&eps[3 * j], bases[j], n, active, 0.0, score, info);
+        AccumulateFisher<2>(&eps[3 * j], bases[j], n, active, score, info);
     }
     const Eigen::MatrixXd I = info.topLeftCorner(p, p);
     const Eigen::VectorXd step = I.ldlt().solve(score.head(p));
@@ -282,7 +274,7 @@ NoiseParams FitNoiseOnce(const std::vector<double>& eps, const std::vector<Piece
       NoiseParams trial = n;
       for (int a2 = 0; a2 < p; ++a2) Slot(trial, active[a2]) += t * step[a2];
       Clamp(trial, options);
-      const double tll = RobustObjective(eps, bases, pieces, use, trial, false);
+      const double tll = Objective(eps, bases, pieces, use, trial);
       if (tll > best_ll) {
         best = trial;
         best_ll = tll;
@@ -324,7 +316,7 @@ NoiseParams FitNoise(const std::vector<double>& eps, const std::vector<PieceBase
   for (int round = 0; round < 6; ++round) {
     for (std::size_t j = 0; j < pieces.size(); ++j) {
       const int d = pieces[j].components;
-      keep[j] = Used(use, j) && Mahalanobis(&eps[3 * j], d, bases[j], n) <= kHuberC2[d];
+      keep[j] = Used(use, j) && Mahalanobis(&eps[3 * j], d, bases[j], n) <= kTrimChi2[d];
     }
     if (keep == prev) break;
     NoiseFitOptions o = options;
