@@ -405,6 +405,26 @@ CampaignData BuildCampaign(const Manifest& manifest, const std::vector<std::vari
     c.tick_right_m = manifest.robot.MetresPerTickRight();
   }
   if (c.pieces.empty()) throw InputError(manifest.path, "no run of the campaign gives a piece to compare with the model");
+  // A pooled subset holding exactly the pieces of one finer subset (one
+  // direction only, one experiment only) would repeat its statistics.
+  auto drop_duplicates = [&](int Piece::*coarse, auto fine_of) {
+    std::map<int, std::map<int, int>> members;  // coarse -> finer -> count
+    std::map<int, int> size, fine_size;
+    for (const Piece& p : c.pieces) {
+      fine_size[fine_of(p)] += 1;
+      if (p.*coarse < 0) continue;
+      members[p.*coarse][fine_of(p)] += 1;
+      size[p.*coarse] += 1;
+    }
+    for (Piece& p : c.pieces) {
+      if (p.*coarse < 0) continue;
+      const auto& m = members[p.*coarse];
+      if (m.size() == 1 && fine_size[m.begin()->first] == size[p.*coarse]) p.*coarse = -1;
+    }
+  };
+  drop_duplicates(&Piece::pooled_subset, [](const Piece& p) { return p.subset; });
+  drop_duplicates(&Piece::campaign_subset,
+                  [](const Piece& p) { return p.pooled_subset >= 0 ? p.pooled_subset : p.subset; });
   c.files = files;
   return c;
 }

@@ -619,6 +619,7 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
       WhereItem w;
       w.experiment = c.subsets[s.subset].experiment;
       w.subset = c.subsets[s.subset].name;
+      if (s.kind == StatKind::kTrend) w.subset += " (early vs late runs)";
       w.statistic = s.kind;
       w.component = WhereComponent(s);
       w.z = s.z;
