@@ -350,14 +350,28 @@ NoiseFitSummary FitNoise(const std::vector<NoiseFitRun>& runs, const NoiseFitOpt
     const double khat = which == 0 ? out.k_L : out.k_R;
     const double other = which == 0 ? best.params[1] : best.params[0];
     auto g = [&](double k) { return profile(which, k, other) - best.nll - delta; };
-    auto bisect = [&](double lo, double hi) {  // g(lo) <= 0 < g(hi) or the reverse
-      const bool rising = g(hi) > 0.0;
-      for (int it = 0; it < 60 && std::abs(hi - lo) > 1e-6 * khat; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        if ((g(mid) > 0.0) == rising) hi = mid;
-        else lo = mid;
+    // Root of g between a (g <= 0, the optimum side) and b (g > 0): Illinois
+    // false position, falling back to bisection when g is not finite.
+    auto bisect = [&](double a, double b) {
+      double ga = g(a), gb = g(b);
+      int side = 0;
+      for (int it = 0; it < 100 && std::abs(b - a) > 1e-6 * khat; ++it) {
+        double c = 0.5 * (a + b);
+        if (std::isfinite(ga) && std::isfinite(gb) && gb != ga) c = b - gb * (b - a) / (gb - ga);
+        if (!(std::abs(c - a) > 1e-3 * std::abs(b - a) && std::abs(b - c) > 1e-3 * std::abs(b - a))) c = 0.5 * (a + b);
+        const double gc = g(c);
+        if (gc > 0.0) {
+          b = c, gb = gc;
+          if (side == -1) ga *= 0.5;
+          side = -1;
+        } else {
+          a = c, ga = gc;
+          if (side == 1) gb *= 0.5;
+          side = 1;
+        }
+        if (std::abs(gc) < 1e-10) break;
       }
-      return 0.5 * (lo + hi);
+      return std::abs(ga) < std::abs(gb) ? a : b;
     };
     std::array<double, 2> ci{0.0, std::numeric_limits<double>::infinity()};
     if (g(0.0) > 0.0) ci[0] = bisect(khat, 0.0);
