@@ -253,3 +253,13 @@ TEST_CASE("calibrate --refine --free scale on endpoint squares fails the quality
                          Q(kSrc / "data/examples/robot.toml") + " --side 0.75 --refine --json -");
   CHECK(ok.status == 0);
 }
+
+TEST_CASE("import optiodom takes the category from the parent folder, with or without a trailing slash", "[cli]") {
+  const auto dir = TempDir("slash");
+  const auto circ = kSrc / "data/optiodom-2020-06/circular/250620202317";
+  const auto r = RunCli("import optiodom " + Q(circ.string() + "/") + " --out " + Q(dir) + " --json -");
+  REQUIRE(r.status == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  CHECK(j["category"] == "circular");
+  CHECK(j["dataset"] == "250620202317");
+}

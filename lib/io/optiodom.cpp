@@ -137,12 +137,12 @@ TrajectoryRun ReadRun(const std::string& path, const std::string& id, const std:
 }  // namespace
 
 OptiOdomDataset ImportOptiOdom(const std::string& dir, const std::optional<std::string>& category) {
-  const fs::path folder = fs::path(dir).lexically_normal();
+  fs::path folder = fs::path(dir).lexically_normal();
+  if (folder.filename().empty()) folder = folder.parent_path();  // "DIR/" -> "DIR"
   std::error_code ec;
   if (!fs::is_directory(folder, ec)) throw InputError(dir, "not a directory");
   OptiOdomDataset ds;
   ds.id = folder.filename().string();
-  if (ds.id.empty()) ds.id = folder.parent_path().filename().string();
 
   std::string meta_path;
   std::vector<std::pair<int, std::string>> run_files;
