@@ -44,26 +44,12 @@ CalibrateInput InputFromEndpoints(const EndpointData& data, const RobotParams& r
 }
 
 namespace {
-ClusterStats ClusterOf(const std::vector<ReturnError>& errors, const std::vector<RunFlag>& flags,
-                       const std::string& direction) {
-  ClusterStats c;
-  std::vector<const ReturnError*> used;
+ClusterStats ClusterAfter(const std::vector<ReturnError>& errors, const std::vector<RunFlag>& flags,
+                          const std::string& direction) {
+  std::vector<std::pair<double, double>> used;
   for (std::size_t i = 0; i < errors.size(); ++i)
-    if (errors[i].direction == direction && flags[i].used()) used.push_back(&errors[i]);
-  c.n = static_cast<int>(used.size());
-  if (c.n == 0) return c;
-  for (const auto* e : used) {
-    c.x_cg_m += e->ex_m / c.n;
-    c.y_cg_m += e->ey_m / c.n;
-  }
-  c.r_cg_m = std::hypot(c.x_cg_m, c.y_cg_m);
-  if (c.n > 1) {
-    double ss = 0.0;
-    for (const auto* e : used) ss += std::pow(e->ex_m - c.x_cg_m, 2) + std::pow(e->ey_m - c.y_cg_m, 2);
-    c.sigma_m = std::sqrt(ss / (c.n - 1));
-    c.sem_m = c.sigma_m / std::sqrt(static_cast<double>(c.n));
-  }
-  return c;
+    if (errors[i].direction == direction && flags[i].used()) used.emplace_back(errors[i].ex_m, errors[i].ey_m);
+  return ClusterOf(used);
 }
 }  // namespace
 
@@ -80,8 +66,8 @@ CalibrateJobResult RunCalibrateJob(const CalibrateInput& input, const CalibrateJ
     a.before = Summarise(EvaluateRuns(data, input.label, input.recorded, input.recorded, options.integrator));
     a.after = Summarise(EvaluateRuns(data, input.label, r.umbmark.corrected, input.recorded, options.integrator));
     const auto after_errors = ReturnErrorsFromTrajectories(data, r.umbmark.corrected, input.recorded, options.integrator);
-    a.cw = ClusterOf(after_errors, r.umbmark.runs, "cw");
-    a.ccw = ClusterOf(after_errors, r.umbmark.runs, "ccw");
+    a.cw = ClusterAfter(after_errors, r.umbmark.runs, "cw");
+    a.ccw = ClusterAfter(after_errors, r.umbmark.runs, "ccw");
     a.E_max_syst_m = std::max(a.cw.r_cg_m, a.ccw.r_cg_m);
     a.sem_m = std::max(a.cw.sem_m, a.ccw.sem_m);
     a.second_pass_worthwhile = a.E_max_syst_m > 3.0 * a.sem_m;

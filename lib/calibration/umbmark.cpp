@@ -107,26 +107,32 @@ void ScoreRuns(std::vector<std::vector<RunFlag*>>& groups) {
 }
 
 ClusterStats Cluster(const std::vector<const RunFlag*>& runs) {
+  std::vector<std::pair<double, double>> e;
+  for (const auto* r : runs) e.emplace_back(r->ex_m, r->ey_m);
+  return ClusterOf(e);
+}
+
+}  // namespace
+
+ClusterStats ClusterOf(const std::vector<std::pair<double, double>>& errors_m) {
   ClusterStats c;
-  c.n = static_cast<int>(runs.size());
+  c.n = static_cast<int>(errors_m.size());
   if (c.n == 0) return c;
-  for (const auto* r : runs) {
-    c.x_cg_m += r->ex_m;
-    c.y_cg_m += r->ey_m;
+  for (const auto& [ex, ey] : errors_m) {
+    c.x_cg_m += ex;
+    c.y_cg_m += ey;
   }
   c.x_cg_m /= c.n;  // eq. 3.2
   c.y_cg_m /= c.n;
   c.r_cg_m = std::hypot(c.x_cg_m, c.y_cg_m);  // eq. 3.3
   if (c.n > 1) {
     double ss = 0.0;
-    for (const auto* r : runs) ss += std::pow(r->ex_m - c.x_cg_m, 2) + std::pow(r->ey_m - c.y_cg_m, 2);
+    for (const auto& [ex, ey] : errors_m) ss += std::pow(ex - c.x_cg_m, 2) + std::pow(ey - c.y_cg_m, 2);
     c.sigma_m = std::sqrt(ss / (c.n - 1));
     c.sem_m = c.sigma_m / std::sqrt(static_cast<double>(c.n));
   }
   return c;
 }
-
-}  // namespace
 
 UmbmarkSummary CalibrateUmbmark(const std::vector<ReturnError>& errors, const RobotParams& recorded,
                                 const UmbmarkOptions& options, const std::string& source) {

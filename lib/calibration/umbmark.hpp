@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/robot.hpp"
@@ -114,6 +115,10 @@ UmbmarkSummary CalibrateUmbmark(const std::vector<ReturnError>& errors, const Ro
 /// wheelbase used in eq. 4.22 when not taken from the corrected one.
 UmbmarkEstimate EstimateFromCentres(double cw_cg, double ccw_cg, bool x_axis, double side_m,
                                     double recorded_wheelbase_m, bool ed_with_corrected_wheelbase);
+
+/// Centre of gravity (eq. 3.2), its radius (eq. 3.3), sigma and SEM of a
+/// cluster of return position errors (ex, ey) [m].
+ClusterStats ClusterOf(const std::vector<std::pair<double, double>>& errors_m);
 
 /// Correction factors c_L = 2/(E_d+1) (eq. 4.31), c_R = 2/(1/E_d+1) (eq. 4.32).
 inline double CorrectionLeft(double E_d) { return 2.0 / (E_d + 1.0); }
