@@ -22,11 +22,22 @@
 //     heldout_shrink from k-fold cross-validation over runs. Candidates are
 //     ranked by held-out log-likelihood gain minus complexity_penalty_nats
 //     per parameter.
-//  4. Verdict: `none` when p >= alpha; else the top candidate if its
+//  4. Significance: the gap score G spreads its power over hundreds of
+//     statistics, so a small effect that moves one parameter (a noise
+//     correlation, say) can hide in it. Beside G, every candidate with a
+//     regular likelihood (the mean effects and correlated_noise) gives a
+//     likelihood-ratio test against the baseline (Wilks: chi^2 with as many
+//     degrees of freedom as parameters); the tests are combined by
+//     Bonferroni, p_tests = min(1, m min p_e), and with G's own p-value,
+//     p = min(1, 2 min(p_G, p_tests)), so the false-alarm rate stays at most
+//     alpha.
+//  5. Verdict: `none` when p >= alpha; else the top candidate if its
 //     heldout_shrink >= min_heldout_shrink and it leaves no significant gap
-//     (or closes >= full_shrink of it); else `unexplained`. Effects the
-//     data cannot tell apart (from the baseline, or from each other) are
-//     listed.
+//     (or closes >= full_shrink of it); else, when the likelihood-ratio tests
+//     found the gap, the significant candidate with the smallest p-value if
+//     it gains held-out evidence and leaves no significant G behind; else
+//     `unexplained`. Effects the data cannot tell apart (from the baseline,
+//     or from each other) are listed.
 //
 // Gap sizes: gap = max(0, G - G0) with G0 the median of G over the null
 // simulations (what the model's own noise produces), so shrink =
@@ -74,6 +85,9 @@ struct DiagnoseOptions {
   /// Use the refined calibration (refine.hpp) for the starting E_d, E_b.
   /// Default true.
   bool use_refine = true;
+  /// Combine G's p-value with the candidates' likelihood-ratio tests
+  /// (step 4 above). Default true; false: the gap is judged by G alone.
+  bool likelihood_tests = true;
   /// Effects to try (empty: the contract's nine).
   std::vector<sim::EffectKind> effects;
   PieceOptions pieces;
@@ -137,12 +151,23 @@ struct Candidate {
   std::map<std::string, double> param_se;  ///< standard errors (mean effects)
   double E_d = 1.0, E_b = 1.0;             ///< refitted with the effect
   bool identifiable = true;
+  /// Identifiable, but a typical-size effect stands < 3 standard errors out
+  /// beside E_d, E_b (named only on its own evidence; see `note`).
+  bool weak = false;
   double gap_after = 0.0;  ///< G after (raw score)
   double shrink = 0.0;
   double heldout_shrink = 0.0;
   double heldout_loglik_gain = 0.0;  ///< nats over the baseline, held out
   double evidence = 0.0;             ///< gain minus the complexity penalty
   int parameters = 0;
+  /// Likelihood-ratio test against the baseline on all runs (in-sample):
+  /// log-likelihood gain [nats] and its p-value (chi^2 with `parameters`
+  /// degrees of freedom; Wilks). Not tested (p = 1, tested = false) for
+  /// bump_outliers, whose rate sits on the boundary under the baseline,
+  /// and for effects the data cannot identify.
+  bool tested = false;
+  double loglik_gain = 0.0;
+  double lr_p_value = 1.0;
   std::array<double, kNumStatKinds> gap_by_kind{};
   std::string note;
 };
@@ -152,7 +177,10 @@ struct DiagnoseSummary {
   double gap_score = 0.0;       ///< G of the baseline
   double null_median = 0.0;     ///< G0
   double null_quantile_alpha = 0.0;  ///< G at the 1 - alpha quantile of the null
-  double p_value = 1.0;
+  double p_value = 1.0;         ///< combined: min(1, 2 min(score_p_value, tests_p_value))
+  double score_p_value = 1.0;   ///< G against its null simulations
+  double tests_p_value = 1.0;   ///< min(1, m min_e p_e) over the m tested candidates
+  int tests = 0;                ///< m
   double alpha = 0.01;
   int null_simulations = 0;
   bool significant = false;

@@ -62,9 +62,12 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
                      {"heldout_shrink", Num(c.heldout_shrink)},
                      {"params_se", se},
                      {"identifiable", c.identifiable},
+                     {"weakly_identifiable", c.weak},
                      {"gap_after", Num(c.gap_after)},
                      {"heldout_loglik_gain_nats", Num(c.heldout_loglik_gain)},
                      {"evidence_nats", Num(c.evidence)},
+                     {"loglik_gain_nats", Num(c.loglik_gain)},
+                     {"lr_p_value", c.tested ? Num(c.lr_p_value) : nlohmann::json(nullptr)},
                      {"parameters", c.parameters},
                      {"E_d", Num(c.E_d)},
                      {"E_b", Num(c.E_b)},
@@ -96,6 +99,9 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
            {{"score", Num(s.gap_score)},
             {"p_value", Num(s.p_value)},
             {"where", where},
+            {"score_p_value", Num(s.score_p_value)},
+            {"tests_p_value", Num(s.tests_p_value)},
+            {"tests", s.tests},
             {"alpha", s.alpha},
             {"significant", s.significant},
             {"null_simulations", s.null_simulations},
@@ -169,10 +175,16 @@ std::string DiagnoseReport(const DiagnoseSummary& s) {
                      1e3 * g.observed_rms[2], 1e3 * g.predicted_rms[2]));
   }
   line("");
-  line(fmt::format("2. Where: gap score G = {:.2f} (null median {:.2f}, {:.0f}% quantile {:.2f}); p = {:.4f} from {} "
-                   "simulations of the baseline -> {}",
-                   s.gap_score, s.null_median, 100.0 * (1.0 - s.alpha), s.null_quantile_alpha, s.p_value,
-                   s.null_simulations, s.significant ? "significant" : "not significant"));
+  line(fmt::format("2. Where: gap score G = {:.2f} (null median {:.2f}, {:.0f}% quantile {:.2f}); p = {:.4g} from {} "
+                   "simulations of the baseline",
+                   s.gap_score, s.null_median, 100.0 * (1.0 - s.alpha), s.null_quantile_alpha, s.score_p_value,
+                   s.null_simulations));
+  if (s.tests > 0)
+    line(fmt::format("   likelihood-ratio tests of the candidates: p = {:.4g} (Bonferroni over {}); combined p = {:.4g} "
+                     "-> {}",
+                     s.tests_p_value, s.tests, s.p_value, s.significant ? "significant" : "not significant"));
+  else
+    line(fmt::format("   p = {:.4g} -> {}", s.p_value, s.significant ? "significant" : "not significant"));
   for (const auto& w : s.where) {
     line(fmt::format("    {:+8.2f} SE  {:<6} {:<40} {:<11} {}", w.z,
                      w.experiment >= 0 ? fmt::format("exp {}", w.experiment + 1) : std::string("all"), w.subset,
@@ -180,7 +192,8 @@ std::string DiagnoseReport(const DiagnoseSummary& s) {
   }
   line("");
   line("3. Which: candidate effects (best first; shrink = 1 - gap after / gap before)");
-  line(fmt::format("    {:<20} {:>8} {:>9} {:>11}  {}", "effect", "shrink", "held-out", "evidence", "parameters"));
+  line(fmt::format("    {:<20} {:>8} {:>9} {:>11} {:>10}  {}", "effect", "shrink", "held-out", "evidence", "LR p",
+                   "parameters"));
   for (const auto& c : s.candidates) {
     std::string params;
     for (const auto& [k, v] : c.params) {
@@ -188,9 +201,10 @@ std::string DiagnoseReport(const DiagnoseSummary& s) {
       params += se != c.param_se.end() ? fmt::format("{} = {:.4g} +- {:.2g}  ", k, v, se->second)
                                        : fmt::format("{} = {:.4g}  ", k, v);
     }
-    if (!c.identifiable) params += "(" + c.note + ")";
-    line(fmt::format("    {:<20} {:>8.3f} {:>9.3f} {:>9.1f} n  {}", sim::EffectToString(c.effect), c.shrink,
-                     c.heldout_shrink, c.evidence, params));
+    if (!c.note.empty()) params += "(" + c.note + ")";
+    line(fmt::format("    {:<20} {:>8.3f} {:>9.3f} {:>9.1f} n {:>10}  {}", sim::EffectToString(c.effect), c.shrink,
+                     c.heldout_shrink, c.evidence, c.tested ? fmt::format("{:.3g}", c.lr_p_value) : std::string("-"),
+                     params));
   }
   line("");
   line("4. Verdict: " + s.verdict);
