@@ -263,6 +263,8 @@ int main(int argc, char** argv) {
                        {"truth", c.truth},
                        {"verdict", s.verdict},
                        {"p_value", s.p_value},
+                       {"score_p_value", s.score_p_value},
+                       {"tests_p_value", s.tests_p_value},
                        {"gap_score", s.gap_score},
                        {"seconds", dt},
                        {"robot",

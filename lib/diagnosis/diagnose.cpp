@@ -799,8 +799,16 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
       std::vector<int> joint = base_params;
       joint.insert(joint.end(), eparams.begin(), eparams.end());
       MeanFit mf = FitMean(model, p, joint, ctx.W_base, 5);
-      NoiseParams ne = FitNoise(mf.eps, ctx.bases, c.pieces, {}, ctx.noise_base, ctx.noise_fit);
-      const std::vector<Eigen::Matrix3d> We = Whiteners(ctx.bases, c.pieces, ne);
+      // turn_scrub also changes the noise's heading in spot turns relative
+      // to straight motion: its covariance bases follow the fit.
+      Context scrub_ctx;
+      if (kind == sim::EffectKind::kTurnScrub) {
+        scrub_ctx = ctx;
+        scrub_ctx.bases = ComputeBases(c, model, mf.p);
+      }
+      const Context& cx = kind == sim::EffectKind::kTurnScrub ? scrub_ctx : ctx;
+      NoiseParams ne = FitNoise(mf.eps, cx.bases, c.pieces, {}, ctx.noise_base, ctx.noise_fit);
+      const std::vector<Eigen::Matrix3d> We = Whiteners(cx.bases, c.pieces, ne);
       // Parameter standard errors with the refitted noise.
       Eigen::VectorXd r2;
       Eigen::MatrixXd J2;
@@ -813,16 +821,16 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
       }
       cd.E_d = mf.p[kParamEd];
       cd.E_b = mf.p[kParamEb];
-      lr_test(cd, TotalLogLik(ctx, mf.eps, ne));
-      const GapSummary ga = ComputeGap(c, PieceScores(mf.eps, ctx.bases, c.pieces, ne), options.gap);
+      lr_test(cd, TotalLogLik(cx, mf.eps, ne));
+      const GapSummary ga = ComputeGap(c, PieceScores(mf.eps, cx.bases, c.pieces, ne), options.gap);
       cd.gap_after = ga.score;
       cd.gap_by_kind = ga.by_kind;
       std::vector<Scores> cvs;
       double ll = 0.0;
       CrossValidate(
-          ctx, mf.eps, mf.D, We,
+          cx, mf.eps, mf.D, We,
           [&](const std::vector<double>& e, const std::vector<char>& use) {
-            return FitNoise(e, ctx.bases, c.pieces, use, ne, fold_fit);
+            return FitNoise(e, cx.bases, c.pieces, use, ne, fold_fit);
           },
           cvs, ll);
       cd.heldout_loglik_gain = ll - cv_ll_base;

@@ -168,7 +168,10 @@ Eigen::MatrixXd MeanModel::Jacobian(const ParamVector& p, const std::vector<int>
 std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanModel& model, const ParamVector& p) {
   std::vector<PieceBases> out(campaign.pieces.size());
   const std::vector<Pose2> motion = model.PredictedPieceMotion(p);
-  const double b = campaign.robot.wheelbase_m * p[kParamEb];
+  // Heading of an interval: (r - l) / b, times (1 - k) in spot turns
+  // (turn_scrub scales the wheel noise's heading effect there too).
+  const double b_plain = campaign.robot.wheelbase_m * p[kParamEb];
+  const double b_turn = b_plain / (1.0 - p[kParamScrub]);
   const double E_d = p[kParamEd];
   const double c_L = 2.0 / (E_d + 1.0), c_R = 2.0 * E_d / (E_d + 1.0);
   for (std::size_t j = 0; j < campaign.pieces.size(); ++j) {
@@ -181,6 +184,7 @@ std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanMod
     bool first_moving = true;
     Eigen::Matrix<double, 3, 2> G_last = Eigen::Matrix<double, 3, 2>::Zero();
     for (std::size_t i = pc.a; i < pc.b; ++i) {
+      const double b = r.interval_class[i] == static_cast<signed char>(sim::MotionClass::kTurn) ? b_turn : b_plain;
       const double l = (r.left[i + 1] - r.left[i]) * c_L, rr = (r.right[i + 1] - r.right[i]) * c_R;
       const double ds = 0.5 * (l + rr), dtheta = (rr - l) / b, h = 0.5 * dtheta;
       const double sinc = Sinc(h);

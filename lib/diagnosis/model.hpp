@@ -20,7 +20,7 @@
 //            + Q                                               (encoder quantisation at both ends)
 // A_* by Kelly's recursion P <- F P F^T + G_u S G_u^T over the piece's
 // encoder intervals (each an exact arc, G_u its Jacobian in the wheel
-// travels), G_xy = diag(2, 2, 0), G_theta = j j^T + e3 e3^T with
+// travels; heading (r - l) / (E_b b), times (1 - k) in spot turns), G_xy = diag(2, 2, 0), G_theta = j j^T + e3 e3^T with
 // j = (dy, -dx, -1) (heading noise at the start rotates the piece), and
 // Q from a uniform +-half-tick error of each wheel's count at both ends
 // (zero for a standstill, whose counts do not change).
