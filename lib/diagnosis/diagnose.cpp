@@ -14,6 +14,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
+#include <ceres/ceres.h>
 #include <fmt/format.h>
 
 #include "calibration/refine.hpp"
@@ -96,41 +97,87 @@ struct MeanFit {
   bool converged = false;
 };
 
-/// Gauss-Newton on the whitened piece residuals over `params` (weights W).
+/// The whitened piece residuals W_j eps_j as one Ceres cost over the free
+/// mean-model parameters `params` (the others held at `base`); the
+/// Jacobian is the model's forward differences, whitened.
+class WhitenedPieceCost final : public ceres::CostFunction {
+ public:
+  WhitenedPieceCost(const MeanModel& model, const ParamVector& base, const std::vector<int>& params,
+                    const std::vector<Eigen::Matrix3d>& W)
+      : model_(model), base_(base), params_(params), W_(W) {
+    set_num_residuals(static_cast<int>(3 * W.size()));
+    mutable_parameter_block_sizes()->push_back(static_cast<int>(params.size()));
+  }
+
+  bool Evaluate(double const* const* x, double* residuals, double** jacobians) const override {
+    ParamVector p = base_;
+    for (std::size_t k = 0; k < params_.size(); ++k) p[params_[k]] = x[0][k];
+    std::vector<double> eps;
+    model_.Residuals(p, eps);
+    for (double v : eps)
+      if (!std::isfinite(v)) return false;
+    const std::size_t n = W_.size(), np = params_.size();
+    for (std::size_t j = 0; j < n; ++j) {
+      const Eigen::Vector3d r = W_[j] * Eigen::Vector3d(eps[3 * j], eps[3 * j + 1], eps[3 * j + 2]);
+      for (int c = 0; c < 3; ++c) residuals[3 * j + static_cast<std::size_t>(c)] = r[c];
+    }
+    if (jacobians && jacobians[0]) {
+      const Eigen::MatrixXd D = model_.Jacobian(p, params_, eps);
+      if (!D.allFinite()) return false;
+      for (std::size_t j = 0; j < n; ++j) {
+        const Eigen::MatrixXd Jj = W_[j] * D.middleRows(static_cast<Eigen::Index>(3 * j), 3);
+        for (int c = 0; c < 3; ++c)
+          for (std::size_t k = 0; k < np; ++k)
+            jacobians[0][(3 * j + static_cast<std::size_t>(c)) * np + k] = Jj(c, static_cast<Eigen::Index>(k));
+      }
+    }
+    return true;
+  }
+
+ private:
+  const MeanModel& model_;
+  ParamVector base_;
+  std::vector<int> params_;
+  const std::vector<Eigen::Matrix3d>& W_;
+};
+
+/// Weighted least squares on the whitened piece residuals over `params`
+/// (weights W), by Ceres' Levenberg-Marquardt (at most `iterations`
+/// iterations; converged when the cost changes by less than 1e-10 of itself,
+/// a step of about 1e-3 standard errors).
 MeanFit FitMean(const MeanModel& model, const ParamVector& start, const std::vector<int>& params,
                 const std::vector<Eigen::Matrix3d>& W, int iterations) {
   MeanFit f;
   f.p = start;
+  if (!params.empty()) {
+    std::vector<double> x(params.size());
+    for (std::size_t k = 0; k < params.size(); ++k) x[k] = start[params[k]];
+    ceres::Problem::Options po;
+    po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+    ceres::Problem problem(po);
+    problem.AddResidualBlock(new WhitenedPieceCost(model, start, params, W), nullptr, x.data());
+    ceres::Solver::Options so;
+    so.linear_solver_type = ceres::DENSE_QR;
+    so.max_num_iterations = iterations;
+    so.function_tolerance = 1e-10;
+    so.num_threads = 1;  // the candidates already run in parallel
+    so.logging_type = ceres::SILENT;
+    so.minimizer_progress_to_stdout = false;
+    ceres::Solver::Summary summary;
+    ceres::Solve(so, &problem, &summary);
+    if (summary.IsSolutionUsable())
+      for (std::size_t k = 0; k < params.size(); ++k) f.p[params[k]] = x[k];
+    f.converged = summary.termination_type == ceres::CONVERGENCE;
+  }
+  model.Residuals(f.p, f.eps);
+  if (params.empty()) return f;
+  f.D = model.Jacobian(f.p, params, f.eps);
   Eigen::VectorXd rw;
   Eigen::MatrixXd Jw;
-  for (int it = 0; it <= iterations; ++it) {
-    model.Residuals(f.p, f.eps);
-    if (params.empty()) break;
-    f.D = model.Jacobian(f.p, params, f.eps);
-    Whiten(W, f.eps, f.D, rw, Jw);
-    Eigen::MatrixXd A = Jw.transpose() * Jw;
-    const Eigen::VectorXd g = Jw.transpose() * rw;
-    for (Eigen::Index k = 0; k < A.rows(); ++k) A(k, k) *= 1.0 + 1e-12;
-    f.cov = A.ldlt().solve(Eigen::MatrixXd::Identity(A.rows(), A.cols()));
-    if (it == iterations) break;
-    const Eigen::VectorXd delta = -A.ldlt().solve(g);
-    if (!delta.allFinite()) break;
-    double rel = 0.0;
-    for (std::size_t k = 0; k < params.size(); ++k) {
-      f.p[params[k]] += delta[static_cast<Eigen::Index>(k)];
-      const double sd = std::sqrt(std::max(f.cov(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)), 1e-300));
-      rel = std::max(rel, std::abs(delta[static_cast<Eigen::Index>(k)]) / sd);
-    }
-    if (rel < 1e-4) {
-      f.converged = true;
-      model.Residuals(f.p, f.eps);
-      f.D = model.Jacobian(f.p, params, f.eps);
-      Whiten(W, f.eps, f.D, rw, Jw);
-      Eigen::MatrixXd A2 = Jw.transpose() * Jw;
-      f.cov = A2.ldlt().solve(Eigen::MatrixXd::Identity(A2.rows(), A2.cols()));
-      break;
-    }
-  }
+  Whiten(W, f.eps, f.D, rw, Jw);
+  Eigen::MatrixXd A = Jw.transpose() * Jw;
+  for (Eigen::Index k = 0; k < A.rows(); ++k) A(k, k) *= 1.0 + 1e-12;
+  f.cov = A.ldlt().solve(Eigen::MatrixXd::Identity(A.rows(), A.cols()));
   return f;
 }
 
@@ -489,7 +536,7 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
   noise = FitNoise(eps, ctx.bases, c.pieces, {}, noise, ctx.noise_fit);
   MeanFit base;
   for (int round = 0; round < 2; ++round) {
-    base = FitMean(model, p, base_params, Whiteners(ctx.bases, c.pieces, noise), 4);
+    base = FitMean(model, p, base_params, Whiteners(ctx.bases, c.pieces, noise), 10);
     p = base.p;
     if (round == 0) ctx.bases = ComputeBases(c, model, p);
     noise = FitNoise(base.eps, ctx.bases, c.pieces, {}, noise, ctx.noise_fit);
@@ -798,7 +845,7 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
       }
       std::vector<int> joint = base_params;
       joint.insert(joint.end(), eparams.begin(), eparams.end());
-      MeanFit mf = FitMean(model, p, joint, ctx.W_base, 5);
+      MeanFit mf = FitMean(model, p, joint, ctx.W_base, 12);
       // turn_scrub also changes the noise's heading in spot turns relative
       // to straight motion: its covariance bases follow the fit.
       Context scrub_ctx;

@@ -4,7 +4,7 @@
 //
 // Steps (each timed in DiagnoseSummary::timings):
 //  1. Baseline: E_d, E_b from the refined calibration (refine.hpp, scale
-//     fixed) polished by Gauss-Newton on the piece residuals (model.hpp);
+//     fixed) polished by Ceres (Levenberg-Marquardt) on the whitened piece residuals (model.hpp);
 //     k_L, k_R (and the ground truth's sigmas when the manifest does not
 //     state them) by maximum likelihood (noise_fit.hpp). Predicted return
 //     errors (mean, covariance) per experiment and direction, and residual
@@ -17,7 +17,7 @@
 //     the data), so data from the baseline raise a false alarm at rate
 //     alpha.
 //  3. Which: every contract effect fitted on top of the baseline (mean
-//     effects: their parameters with E_d, E_b by Gauss-Newton; correlated
+//     effects: their parameters with E_d, E_b by Ceres; correlated
 //     noise and bumps: maximum likelihood), with gap after, shrink and
 //     heldout_shrink from k-fold cross-validation over runs. Candidates are
 //     ranked by held-out log-likelihood gain minus complexity_penalty_nats
