@@ -130,7 +130,7 @@ std::string PlotSvg(const std::vector<Source>& sources, const std::optional<Robo
     for (const auto& run : src.data.runs) {
       if (parts.size() >= 12) break;  // keep the figure readable
       io::SvgPanel p(x, y, size, size, fmt::format("{} run {}", src.label, run.run));
-      const RunTrack before = TrackRun(run, src.recorded, src.recorded, integ);
+      const RunTrack before = TrackRun(run, src.data.path, src.recorded, src.recorded, integ);
       std::vector<io::SvgPoint> gt, od, od2, all;
       for (std::size_t i = 0; i < run.size(); ++i) {
         if (before.has_ground_truth[i]) gt.push_back({before.ground_truth[i].x, before.ground_truth[i].y});
@@ -139,7 +139,7 @@ std::string PlotSvg(const std::vector<Source>& sources, const std::optional<Robo
       all = gt;
       all.insert(all.end(), od.begin(), od.end());
       if (params) {
-        const RunTrack after = TrackRun(run, *params, src.recorded, integ);
+        const RunTrack after = TrackRun(run, src.data.path, *params, src.recorded, integ);
         for (const auto& q : after.odometry) od2.push_back({q.x, q.y});
         all.insert(all.end(), od2.begin(), od2.end());
       }

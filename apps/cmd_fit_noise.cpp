@@ -63,6 +63,15 @@ NoiseFitInputOptions InputOptions(const FitNoiseOptions& o, const std::optional<
   return in;
 }
 
+/// Every run of a trajectory file with ground truth at its start and end.
+void AppendTrajectoryRuns(const TrajectoryData& t, const RobotParams& robot, const std::string& prefix,
+                          const NoiseFitInputOptions& in, Loaded& out) {
+  int skipped = 0;
+  auto runs = NoiseRunsFromTrajectories(t, robot, prefix, in, &skipped);
+  out.skipped += skipped;
+  out.runs.insert(out.runs.end(), runs.begin(), runs.end());
+}
+
 void AppendManifest(const std::string& path, const FitNoiseOptions& o, Loaded& out) {
   const Manifest m = io::ReadManifest(path);
   const RobotParams robot = o.robot.Resolve(m.robot);
@@ -75,10 +84,7 @@ void AppendManifest(const std::string& path, const FitNoiseOptions& o, Loaded& o
     const std::string prefix = fmt::format("exp{}:{}:", index, ExperimentKindToString(e.kind));
     io::RunFile rf = io::ReadRunFile(e.resolved_file);
     if (auto* t = std::get_if<TrajectoryData>(&rf)) {
-      int skipped = 0;
-      auto runs = NoiseRunsFromTrajectories(*t, robot, prefix, in, &skipped);
-      out.skipped += skipped;
-      out.runs.insert(out.runs.end(), runs.begin(), runs.end());
+      AppendTrajectoryRuns(*t, robot, prefix, in, out);
     } else {
       const auto& ep = std::get<EndpointData>(rf);
       if (e.kind == ExperimentKind::kBackAndForth) {
@@ -117,10 +123,7 @@ Loaded Load(const FitNoiseOptions& o) {
     const std::string prefix = o.inputs.size() > 1 ? path + ":" : "";
     io::RunFile rf = io::ReadRunFile(path);
     if (auto* t = std::get_if<TrajectoryData>(&rf)) {
-      int skipped = 0;
-      auto runs = NoiseRunsFromTrajectories(*t, robot, prefix, in, &skipped);
-      out.skipped += skipped;
-      out.runs.insert(out.runs.end(), runs.begin(), runs.end());
+      AppendTrajectoryRuns(*t, robot, prefix, in, out);
     } else {
       if (!o.distance_m)
         throw InvalidOptions(path + " holds endpoint errors: give --distance D (each run drove D forward, then D back)");

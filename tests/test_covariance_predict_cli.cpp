@@ -12,6 +12,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "support/run_cli.hpp"
+
 #include "error_models/numerical_propagation.hpp"
 
 using namespace umbmark;
@@ -19,23 +21,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int status = -1;
-  std::string out;
-};
-
-Result Run(const std::string& args) {
-  const std::string cmd = std::string(UMBMARK_EXE) + " " + args + " 2>/dev/null";
-  Result r;
-  FILE* p = popen(cmd.c_str(), "r");
-  REQUIRE(p != nullptr);
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
+testing::CliResult Run(const std::string& args) { return testing::RunCli(args); }
 
 fs::path RobotFile() {
   const fs::path p = fs::temp_directory_path() / fmt::format("umbmark_predict_robot_{}.toml", ::getpid());
@@ -47,7 +33,7 @@ fs::path RobotFile() {
 
 TEST_CASE("predict line:10,line:-10 matches numerical propagation to 1e-9", "[predict_cli]") {
   const fs::path robot = RobotFile();
-  const Result r = Run(fmt::format("predict --robot {} --kl 0.00040 --kr 0.00058 --path line:10,line:-10 --json -",
+  const auto r = Run(fmt::format("predict --robot {} --kl 0.00040 --kr 0.00058 --path line:10,line:-10 --json -",
                                    robot.string()));
   REQUIRE(r.status == 0);
   const auto j = nlohmann::json::parse(r.out);
@@ -68,7 +54,7 @@ TEST_CASE("predict line:10,line:-10 matches numerical propagation to 1e-9", "[pr
 
 TEST_CASE("predict --monte-carlo reports the contract's block", "[predict_cli]") {
   const fs::path robot = RobotFile();
-  const Result r = Run(fmt::format(
+  const auto r = Run(fmt::format(
       "predict --robot {} --kl 0.003 --kr 0.002 --path arc:3:1 --P0 0.0025,0.0025,0.0012 --monte-carlo 4000 "
       "--partitions 200 --seed 9 --threads 2 --json -",
       robot.string()));
@@ -89,7 +75,7 @@ TEST_CASE("predict --monte-carlo reports the contract's block", "[predict_cli]")
     CHECK(std::abs(mc["covariance"][a][a].get<double>() - var) < 4.0 * var * std::sqrt(2.0 / 4000));
   }
   // Same seed, same numbers, any thread count.
-  const Result r1 = Run(fmt::format(
+  const auto r1 = Run(fmt::format(
       "predict --robot {} --kl 0.003 --kr 0.002 --path arc:3:1 --P0 0.0025,0.0025,0.0012 --monte-carlo 4000 "
       "--partitions 200 --seed 9 --threads 1 --json -",
       robot.string()));

@@ -15,6 +15,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "support/run_cli.hpp"
+
 #include "core/angles.hpp"
 #include "error_models/path_spec.hpp"
 #include "simulation/wheel_noise_sim.hpp"
@@ -24,23 +26,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int status = -1;
-  std::string out;
-};
-
-Result Run(const std::string& args) {
-  const std::string cmd = std::string(UMBMARK_EXE) + " " + args + " 2>/dev/null";
-  Result r;
-  FILE* p = popen(cmd.c_str(), "r");
-  REQUIRE(p != nullptr);
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
+testing::CliResult Run(const std::string& args) { return testing::RunCli(args); }
 
 void Write(const fs::path& p, const std::string& text) {
   std::ofstream f(p);
@@ -108,7 +94,7 @@ Campaign MakeCampaign() {
 TEST_CASE("fit-noise CLI: endpoint, trajectory and manifest inputs agree; contract keys; plot", "[fit_noise_cli]") {
   const Campaign c = MakeCampaign();
   const fs::path svg = c.dir / "fig4.svg";
-  const Result ep = Run(fmt::format("fit-noise {} --robot {} --distance 10 --meas-sigma 0.0005,0.0017 --json - --plot {}",
+  const auto ep = Run(fmt::format("fit-noise {} --robot {} --distance 10 --meas-sigma 0.0005,0.0017 --json - --plot {}",
                                     c.endpoint.string(), c.robot.string(), svg.string()));
   REQUIRE(ep.status == 0);
   const auto j = nlohmann::json::parse(ep.out);
@@ -128,10 +114,10 @@ TEST_CASE("fit-noise CLI: endpoint, trajectory and manifest inputs agree; contra
 
   // Same runs as a trajectory CSV: the path comes from the wheel travel.
   // First order: Kelly's form along the samples equals the closed form.
-  const Result ep1 = Run(fmt::format("fit-noise {} --robot {} --distance 10 --meas-sigma 0.0005,0.0017 --first-order "
+  const auto ep1 = Run(fmt::format("fit-noise {} --robot {} --distance 10 --meas-sigma 0.0005,0.0017 --first-order "
                                      "--json -",
                                      c.endpoint.string(), c.robot.string()));
-  const Result tr1 = Run(fmt::format("fit-noise {} --robot {} --meas-sigma 0.0005,0.0017 --first-order --json -",
+  const auto tr1 = Run(fmt::format("fit-noise {} --robot {} --meas-sigma 0.0005,0.0017 --first-order --json -",
                                      c.trajectory.string(), c.robot.string()));
   REQUIRE(tr1.status == 0);
   const auto je1 = nlohmann::json::parse(ep1.out), jt1 = nlohmann::json::parse(tr1.out);
@@ -139,7 +125,7 @@ TEST_CASE("fit-noise CLI: endpoint, trajectory and manifest inputs agree; contra
   CHECK(jt1["k_R"].get<double>() == Approx(je1["k_R"].get<double>()).epsilon(1e-6));
   // Default (with the second-order term): the trajectory's 10 samples per
   // leg evaluate that term by a coarser midpoint rule than the closed path.
-  const Result tr = Run(fmt::format("fit-noise {} --robot {} --meas-sigma 0.0005,0.0017 --json -",
+  const auto tr = Run(fmt::format("fit-noise {} --robot {} --meas-sigma 0.0005,0.0017 --json -",
                                     c.trajectory.string(), c.robot.string()));
   REQUIRE(tr.status == 0);
   const auto jt = nlohmann::json::parse(tr.out);
@@ -147,14 +133,14 @@ TEST_CASE("fit-noise CLI: endpoint, trajectory and manifest inputs agree; contra
   CHECK(jt["k_R"].get<double>() == Approx(kR).epsilon(1e-3));
 
   // Manifest: reference noise from [ground_truth], path from distance_m.
-  const Result mf = Run(fmt::format("fit-noise {} --json -", c.manifest.string()));
+  const auto mf = Run(fmt::format("fit-noise {} --json -", c.manifest.string()));
   REQUIRE(mf.status == 0);
   const auto jm = nlohmann::json::parse(mf.out);
   CHECK(jm["k_L"].get<double>() == Approx(kL).epsilon(1e-9));
   CHECK(jm["groups"][0]["group"] == "exp1:back_and_forth:fwd_back");
 
   // Human-readable output names the goodness-of-fit table.
-  const Result text_out = Run(fmt::format("fit-noise {} --robot {} --distance 10", c.endpoint.string(), c.robot.string()));
+  const auto text_out = Run(fmt::format("fit-noise {} --robot {} --distance 10", c.endpoint.string(), c.robot.string()));
   CHECK(text_out.status == 0);
   CHECK(text_out.out.find("Goodness of fit") != std::string::npos);
   if (!std::getenv("UMBMARK_KEEP_TEST_FILES")) fs::remove_all(c.dir);
@@ -177,5 +163,18 @@ TEST_CASE("fit-noise CLI exit codes", "[fit_noise_cli]") {
   const fs::path few = c.dir / "few.csv";
   Write(few, "run,direction,ex_m,ey_m,etheta_rad\n1,fwd_back,0.001,0.01,0.001\n2,fwd_back,0.0,0.0,0.0\n");
   CHECK(Run(fmt::format("fit-noise {} --robot {} --distance 10", few.string(), c.robot.string())).status == 1);
+  // Runs without any scatter and no measurement noise: every wheel-noise
+  // covariance is singular, so the fit cannot start -- the quality gate
+  // (exit 3), not a number.
+  const fs::path same = c.dir / "same.csv";
+  std::string rows = "run,direction,ex_m,ey_m,etheta_rad\n";
+  for (int i = 1; i <= 4; ++i) rows += fmt::format("{},fwd_back,0.001,0.002,0.001\n", i);
+  Write(same, rows);
+  const auto gate =
+      Run(fmt::format("fit-noise {} --robot {} --distance 10 --meas-sigma 0,0 --json -", same.string(), c.robot.string()));
+  CHECK(gate.status == 3);
+  CHECK(gate.out.empty());
+  CHECK(gate.err.find("quality gate") != std::string::npos);
+  CHECK(gate.err.find("singular") != std::string::npos);
   fs::remove_all(c.dir);
 }

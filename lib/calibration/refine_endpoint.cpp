@@ -93,40 +93,30 @@ Weighting WeightGroup(const Group& g, const std::map<std::pair<std::size_t, int>
     w.method = "group_covariance";
     return w;
   }
-  // 2. The set's scatter, both directions, the other one mirrored.
-  {
-    Eigen::MatrixXd S = Eigen::MatrixXd::Zero(d, d);
-    double nu = 0.0;
-    for (const auto& [key, other] : groups) {
-      if (other.set != g.set || other.dim < d || other.runs.size() < 2) continue;
-      S += ScatterMatrix(other, d, other.direction != g.direction);
-      nu += static_cast<double>(other.runs.size()) - 1.0;
-    }
-    if (nu >= d + 2) {
-      w.covariance = S / (nu - d - 1);
-      w.dof = nu;
-      w.method = "mirror_pooled";
-      return w;
-    }
+  // The set's scatter, both directions, the other one mirrored.
+  Eigen::MatrixXd S = Eigen::MatrixXd::Zero(d, d);
+  double nu = 0.0;
+  for (const auto& [key, other] : groups) {
+    if (other.set != g.set || other.dim < d || other.runs.size() < 2) continue;
+    S += ScatterMatrix(other, d, other.direction != g.direction);
+    nu += static_cast<double>(other.runs.size()) - 1.0;
   }
-  // 3. The set's pooled scatter (nu >= 2) too noisy to invert: its diagonal
-  //    as weights, the full matrix kept for the sandwich covariance.
-  {
-    Eigen::MatrixXd S = Eigen::MatrixXd::Zero(d, d);
-    double nu = 0.0;
-    for (const auto& [key, other] : groups) {
-      if (other.set != g.set || other.dim < d || other.runs.size() < 2) continue;
-      S += ScatterMatrix(other, d, other.direction != g.direction);
-      nu += static_cast<double>(other.runs.size()) - 1.0;
-    }
-    if (nu >= 2.0) {
-      S /= nu;
-      w.covariance = S.diagonal().asDiagonal();
-      w.actual = S;
-      w.dof = nu;
-      w.method = "pooled_diagonal";
-      return w;
-    }
+  // 2. Enough degrees of freedom to invert it.
+  if (nu >= d + 2) {
+    w.covariance = S / (nu - d - 1);
+    w.dof = nu;
+    w.method = "mirror_pooled";
+    return w;
+  }
+  // 3. Too noisy to invert (nu >= 2): its diagonal as weights, the full
+  //    matrix kept for the sandwich covariance.
+  if (nu >= 2.0) {
+    S /= nu;
+    w.covariance = S.diagonal().asDiagonal();
+    w.actual = S;
+    w.dof = nu;
+    w.method = "pooled_diagonal";
+    return w;
   }
   // 4. Prior.
   w.covariance = Eigen::MatrixXd::Zero(d, d);

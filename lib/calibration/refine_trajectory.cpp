@@ -34,12 +34,7 @@ struct PreparedRun {
 
 PreparedRun PrepareRun(const TrajectoryRun& run, const std::string& path, const RobotParams& conversion,
                        const RobotParams& recorded, const RefineOptions& options) {
-  RunTrack track;
-  try {
-    track = TrackRun(run, conversion, recorded, options.integrator);
-  } catch (const InputError& err) {
-    throw InputError(path, err.line(), err.column(), err.message());
-  }
+  const RunTrack track = TrackRun(run, path, conversion, recorded, options.integrator);
   const WheelTravel travel = ComputeWheelTravel(run, conversion, recorded);
   for (std::size_t i = 0; i < run.size(); ++i) {
     if (!std::isfinite(travel.left_m[i]) || !std::isfinite(travel.right_m[i])) {

@@ -28,12 +28,7 @@ std::vector<ReturnError> ReturnErrorsFromTrajectories(const TrajectoryData& data
   std::vector<ReturnError> out;
   out.reserve(data.runs.size());
   for (const auto& run : data.runs) {
-    RunTrack track;
-    try {
-      track = TrackRun(run, params, recorded, integrator);
-    } catch (const InputError& err) {
-      throw InputError(data.path, err.line(), err.column(), err.message());
-    }
+    const RunTrack track = TrackRun(run, data.path, params, recorded, integrator);
     const std::size_t k = track.last_gt;
     const Pose2& gt = track.ground_truth[k];
     const Pose2& odo = track.odometry[k];

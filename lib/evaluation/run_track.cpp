@@ -10,11 +10,11 @@
 
 namespace umbmark {
 
-RunTrack TrackRun(const TrajectoryRun& run, const RobotParams& params, const RobotParams& recorded,
+RunTrack TrackRun(const TrajectoryRun& run, const std::string& file, const RobotParams& params, const RobotParams& recorded,
                   Integrator integrator) {
   const std::size_t n = run.size();
   if (n == 0 || !run.HasGroundTruth(0)) {
-    throw InputError("", run.lines.empty() ? 0 : run.lines.front(), 0,
+    throw InputError(file, run.lines.empty() ? 0 : run.lines.front(), 0,
                      "run " + run.run + " has no ground truth at its first sample");
   }
   RunTrack track;

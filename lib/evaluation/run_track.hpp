@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "core/robot.hpp"
@@ -26,8 +27,9 @@ struct RunTrack {
 
 /// Integrates odometry with `params` (ticks converted with `params`; dist_*
 /// columns rescaled relative to `recorded`) from the first ground-truth pose.
-/// Throws InputError when the run has no ground truth at its first sample.
-RunTrack TrackRun(const TrajectoryRun& run, const RobotParams& params, const RobotParams& recorded,
-                  Integrator integrator);
+/// Throws InputError naming `file` (the run's CSV) when the run has no
+/// ground truth at its first sample.
+RunTrack TrackRun(const TrajectoryRun& run, const std::string& file, const RobotParams& params,
+                  const RobotParams& recorded, Integrator integrator);
 
 }  // namespace umbmark

@@ -16,12 +16,7 @@ std::vector<RunEvaluation> EvaluateRuns(const TrajectoryData& data, const std::s
   std::vector<RunEvaluation> out;
   out.reserve(data.runs.size());
   for (const auto& run : data.runs) {
-    RunTrack track;
-    try {
-      track = TrackRun(run, params, recorded, integrator);
-    } catch (const InputError& err) {
-      throw InputError(data.path, err.line(), err.column(), err.message());
-    }
+    const RunTrack track = TrackRun(run, data.path, params, recorded, integrator);
     RunEvaluation ev;
     ev.experiment = experiment;
     ev.run = run.run;
