@@ -171,12 +171,13 @@ void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, co
       g1 = i;
     }
   if (g0 >= g1) return;
+  const std::size_t first_piece = c.pieces.size();
   auto add = [&](std::size_t a, std::size_t b, PieceType type, int sign, bool first) {
     if (b <= a) return;
     Piece p;
     p.run = run_index;
-    p.a = a;
-    p.b = b;
+    p.a = p.a_lo = p.a_hi = a;
+    p.b = p.b_lo = p.b_hi = b;
     p.type = type;
     p.sign = sign;
     p.motion_first = first;
@@ -253,6 +254,29 @@ void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, co
     cur = *end;
   }
   if (g1 > cur) add(cur, g1, PieceType::kStand, 0, false);
+  if (!o.average_standstills) return;
+  // Motions next to a true standstill (no wheel travel) are measured from /
+  // to its mean ground-truth pose.
+  for (std::size_t j = first_piece; j < c.pieces.size(); ++j) {
+    const Piece& st = c.pieces[j];
+    if (st.type != PieceType::kStand || st.travel_m > 0.0) continue;
+    int samples = 0;
+    for (std::size_t i = st.a; i <= st.b; ++i) samples += r.has_gt[i] ? 1 : 0;
+    if (samples < 2) continue;
+    const double w = 1.0 / samples;
+    if (j > first_piece && c.pieces[j - 1].b == st.a && c.pieces[j - 1].type != PieceType::kStand) {
+      Piece& before = c.pieces[j - 1];
+      before.b_lo = st.a;
+      before.b_hi = st.b;
+      before.b_weight = w;
+    }
+    if (j + 1 < c.pieces.size() && c.pieces[j + 1].a == st.b && c.pieces[j + 1].type != PieceType::kStand) {
+      Piece& after = c.pieces[j + 1];
+      after.a_lo = st.a;
+      after.a_hi = st.b;
+      after.a_weight = w;
+    }
+  }
 }
 
 struct ReturnErrorRow {
@@ -345,8 +369,8 @@ CampaignData BuildCampaign(const Manifest& manifest, const std::vector<std::vari
         c.runs.push_back(std::move(r));
         Piece p;
         p.run = static_cast<int>(c.runs.size()) - 1;
-        p.a = 0;
-        p.b = c.runs.back().t.size() - 1;
+        p.a = p.a_lo = p.a_hi = 0;
+        p.b = p.b_lo = p.b_hi = c.runs.back().t.size() - 1;
         p.type = PieceType::kReturn;
         p.components = c.runs.back().has_heading ? 3 : 2;
         p.subset = subsets.Get(static_cast<int>(e), c.runs.back().direction + ", return error");

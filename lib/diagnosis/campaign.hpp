@@ -8,7 +8,8 @@
 // long motions split into pieces of at most max_piece_length_m of travel
 // (max_piece_angle_rad of heading for turns). For each piece the observed
 // relative motion Rel(GT_a, GT_b) = GT_a^-1 GT_b is compared with the
-// model's prediction Rel(P_a, P_b): frame-free (no start-frame
+// model's prediction Rel(P_a, P_b) (at a standstill, GT and P are the mean
+// poses over its samples, so the ground truth's noise averages down): frame-free (no start-frame
 // re-expression needed) and, under the baseline model, nearly independent
 // from piece to piece (wheel noise of disjoint stretches; only the ground
 // truth's noise at a shared boundary sample couples neighbours).
@@ -37,6 +38,14 @@ const char* PieceTypeToString(PieceType t);
 struct Piece {
   int run = 0;            ///< index into CampaignData::runs
   std::size_t a = 0, b = 0;  ///< sample indices (ground truth at both)
+  /// Ground-truth samples whose mean pose stands for the start / end:
+  /// [a_lo, a_hi] and [b_lo, b_hi] (those with ground truth; a_lo = a_hi = a
+  /// otherwise). A motion that starts or ends at a standstill is measured
+  /// from / to the standstill's mean pose -- the robot is still, so the
+  /// ground truth's noise there averages down -- and `a_weight`, `b_weight`
+  /// (1 / samples averaged) scale that noise's variance.
+  std::size_t a_lo = 0, a_hi = 0, b_lo = 0, b_hi = 0;
+  double a_weight = 1.0, b_weight = 1.0;
   PieceType type = PieceType::kStand;
   /// straight / arc: +1 forward, -1 backward; turn: +1 ccw, -1 cw; else 0.
   int sign = 0;
@@ -105,6 +114,9 @@ struct PieceOptions {
   double max_piece_angle_rad = 1.8;
   /// Cross-validation folds over runs (>= 2). Default 5.
   int folds = 5;
+  /// Measure motions from / to the mean ground-truth pose of the adjacent
+  /// standstills (see Piece). Default true.
+  bool average_standstills = true;
   sim::MotionOptions motion;  ///< stand_eps_m is set from the encoder tick
 
   std::string Check() const;

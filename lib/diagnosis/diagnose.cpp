@@ -350,34 +350,39 @@ void SimulateNull(const Context& ctx, const std::vector<NullPiece>& np, const Ei
       has_spare = true;
       return z0;
     };
-    int prev_run = -1;
-    std::size_t prev_b = 0;
-    // Boundary state: world-frame ground-truth noise and count errors.
-    double nb_x = 0, nb_y = 0, nb_t = 0, qb_l = 0, qb_r = 0;
+    // Boundary noise (world-frame ground truth averaged over the boundary's
+    // samples, count errors), drawn once per boundary of a run and shared by
+    // the pieces that meet there.
+    struct Boundary {
+      double x, y, t, ql, qr;
+    };
+    std::map<std::pair<std::size_t, std::size_t>, Boundary> boundaries;
+    int boundary_run = -1;
+    auto boundary = [&](const Piece& p, std::size_t lo, std::size_t hi, double weight, bool draw_counts_left,
+                        bool draw_counts_right, const Boundary* carry) {
+      const DiagRun& run = c.runs[p.run];
+      if (p.run != boundary_run) {
+        boundaries.clear();
+        boundary_run = p.run;
+      }
+      const auto key = std::make_pair(lo, hi);
+      if (const auto it = boundaries.find(key); it != boundaries.end()) return it->second;
+      const double sw = std::sqrt(weight);
+      Boundary nb;
+      nb.x = sw * sxy * normal();
+      nb.y = sw * sxy * normal();
+      nb.t = sw * sth * normal();
+      nb.ql = draw_counts_left || !carry ? (gen.Uniform() - 0.5) * kSqrt12 * run.q_sd_left[lo] : carry->ql;
+      nb.qr = draw_counts_right || !carry ? (gen.Uniform() - 0.5) * kSqrt12 * run.q_sd_right[lo] : carry->qr;
+      boundaries.emplace(key, nb);
+      return nb;
+    };
     for (std::size_t j = 0; j < n; ++j) {
       const Piece& p = c.pieces[j];
-      const DiagRun& run = c.runs[p.run];
-      double na_x, na_y, na_t, qa_l, qa_r;
-      if (p.run == prev_run && p.a == prev_b) {
-        na_x = nb_x;
-        na_y = nb_y;
-        na_t = nb_t;
-        qa_l = qb_l;
-        qa_r = qb_r;
-      } else {
-        na_x = sxy * normal();
-        na_y = sxy * normal();
-        na_t = sth * normal();
-        qa_l = (gen.Uniform() - 0.5) * kSqrt12 * run.q_sd_left[p.a];
-        qa_r = (gen.Uniform() - 0.5) * kSqrt12 * run.q_sd_right[p.a];
-      }
-      nb_x = sxy * normal();
-      nb_y = sxy * normal();
-      nb_t = sth * normal();
-      qb_l = np[j].moves_left ? (gen.Uniform() - 0.5) * kSqrt12 * run.q_sd_left[p.b] : qa_l;
-      qb_r = np[j].moves_right ? (gen.Uniform() - 0.5) * kSqrt12 * run.q_sd_right[p.b] : qa_r;
-      prev_run = p.run;
-      prev_b = p.b;
+      const Boundary ba = boundary(p, p.a_lo, p.a_hi, p.a_weight, true, true, nullptr);
+      const Boundary bb = boundary(p, p.b_lo, p.b_hi, p.b_weight, np[j].moves_left, np[j].moves_right, &ba);
+      const double na_x = ba.x, na_y = ba.y, na_t = ba.t, qa_l = ba.ql, qa_r = ba.qr;
+      const double nb_x = bb.x, nb_y = bb.y, nb_t = bb.t, qb_l = bb.ql, qb_r = bb.qr;
       const Eigen::Vector3d z(normal(), normal(), normal());
       Eigen::Vector3d e = np[j].wheel_chol * z;
       const double ct = std::cos(np[j].theta_a), st = std::sin(np[j].theta_a);

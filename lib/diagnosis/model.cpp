@@ -33,6 +33,27 @@ inline Pose2 Advance(const Pose2& q, double l, double r, double wheelbase, doubl
   return {q.x + chord * std::cos(heading), q.y + chord * std::sin(heading), q.theta + dtheta};
 }
 
+/// Mean of poses[lo..hi] over the samples with use(i): positions averaged,
+/// headings averaged as increments from the first one (no wrap-around).
+template <typename PoseAt, typename Use>
+Pose2 MeanPose(std::size_t lo, std::size_t hi, const PoseAt& pose_at, const Use& use) {
+  if (lo == hi) return pose_at(lo);
+  Pose2 first, sum{0.0, 0.0, 0.0};
+  bool any = false;
+  int n = 0;
+  for (std::size_t i = lo; i <= hi; ++i) {
+    if (!use(i)) continue;
+    const Pose2 q = pose_at(i);
+    if (!any) first = q;
+    any = true;
+    sum.x += q.x;
+    sum.y += q.y;
+    sum.theta += WrapAngle(q.theta - first.theta);
+    ++n;
+  }
+  return {sum.x / n, sum.y / n, first.theta + sum.theta / n};
+}
+
 inline Pose2 Relative(const Pose2& a, const Pose2& b) {
   const double c = std::cos(a.theta), s = std::sin(a.theta);
   const double dx = b.x - a.x, dy = b.y - a.y;
@@ -57,7 +78,9 @@ MeanModel::MeanModel(const CampaignData& campaign) : campaign_(campaign) {
   for (std::size_t j = 0; j < campaign.pieces.size(); ++j) {
     const Piece& pc = campaign.pieces[j];
     const DiagRun& r = campaign.runs[pc.run];
-    observed_[j] = Relative(r.gt[pc.a], r.gt[pc.b]);
+    auto gt = [&](std::size_t i) { return r.gt[i]; };
+    auto has = [&](std::size_t i) { return static_cast<bool>(r.has_gt[i]); };
+    observed_[j] = Relative(MeanPose(pc.a_lo, pc.a_hi, gt, has), MeanPose(pc.b_lo, pc.b_hi, gt, has));
     pieces_of_run_[pc.run].push_back(static_cast<int>(j));
   }
 }
@@ -132,9 +155,10 @@ std::vector<Pose2> MeanModel::PredictedPieceMotion(const ParamVector& p) const {
       const double c = std::cos(q.theta), s = std::sin(q.theta);
       return Pose2{q.x + c * dx - s * dy, q.y + s * dx + c * dy, q.theta};
     };
+    auto has = [&](std::size_t i) { return static_cast<bool>(r.has_gt[i]); };
     for (int j : pieces_of_run_[run]) {
       const Piece& pc = campaign_.pieces[j];
-      out[j] = Relative(predicted(pc.a), predicted(pc.b));
+      out[j] = Relative(MeanPose(pc.a_lo, pc.a_hi, predicted, has), MeanPose(pc.b_lo, pc.b_hi, predicted, has));
     }
   }
   return out;
@@ -239,10 +263,12 @@ std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanMod
     B.A_R = P_R;
     B.A_LR = P_LR;
     B.Q = P_Q;
-    B.G_xy = Eigen::Vector3d(2.0, 2.0, 0.0).asDiagonal();
+    // Ground-truth noise at both ends, each averaged over its samples.
+    const double wa = pc.a_weight, wb = pc.b_weight;
+    B.G_xy = Eigen::Vector3d(wa + wb, wa + wb, 0.0).asDiagonal();
     const Eigen::Vector3d jv(motion[j].y, -motion[j].x, -1.0);
-    B.G_theta = jv * jv.transpose();
-    B.G_theta(2, 2) += 1.0;
+    B.G_theta = wa * jv * jv.transpose();
+    B.G_theta(2, 2) += wb;
   }
   return out;
 }

@@ -21,7 +21,8 @@
 // A_* by Kelly's recursion P <- F P F^T + G_u S G_u^T over the piece's
 // encoder intervals (each an exact arc, G_u its Jacobian in the wheel
 // travels; heading (r - l) / (E_b b), times (1 - k) in spot turns), G_xy = diag(2, 2, 0), G_theta = j j^T + e3 e3^T with
-// j = (dy, -dx, -1) (heading noise at the start rotates the piece), and
+// j = (dy, -dx, -1) (heading noise at the start rotates the piece), each
+// end's term times 1 / samples averaged there (Piece::a_weight, b_weight), and
 // Q from a uniform +-half-tick error of each wheel's count at both ends
 // (zero for a standstill, whose counts do not change).
 #pragma once
