@@ -132,6 +132,45 @@ TEST_CASE("diagnose model: replays every mean effect exactly (noise-free)", "[di
   CHECK(nominal > 1e-2);
 }
 
+TEST_CASE("diagnose campaign: motions are measured from/to the standstills' mean pose", "[diagnose]") {
+  // No wheel noise, no quantisation, 1 mm ground-truth noise: a straight
+  // leg between two standstills of N_a, N_b samples scatters by
+  // sigma^2 (1/N_a + 1/N_b) along the track, not 2 sigma^2.
+  Small s = MakeSmall(13, 10, 20, false, false);
+  s.sim.truth.k_L = s.sim.truth.k_R = 0.0;
+  s.sim.ground_truth = GroundTruthNoise{1e-3, 1e-9};
+  s.sim.pause_s = 1.0;  // 10 samples at 10 Hz
+  PieceOptions po;
+  po.max_piece_length_m = 3.0;  // every 2 m leg one piece
+  const sim::SimulatedCampaign sc = sim::SimulateCampaign(s.manifest, s.sim);
+  const CampaignData c = BuildCampaign(sc.manifest, sc.data, po);
+  const MeanModel model(c);
+  std::vector<double> eps;
+  model.Residuals(TrueParams(s), eps);
+  double sum_sq = 0.0, sum_expected = 0.0;
+  int averaged = 0;
+  for (std::size_t j = 0; j < c.pieces.size(); ++j) {
+    const Piece& p = c.pieces[j];
+    if (p.type != PieceType::kStraight || p.a_lo == p.a_hi || p.b_lo == p.b_hi) continue;
+    ++averaged;
+    const DiagRun& r = c.runs[p.run];
+    int na = 0, nb = 0;
+    for (std::size_t i = p.a_lo; i <= p.a_hi; ++i) na += r.has_gt[i];
+    for (std::size_t i = p.b_lo; i <= p.b_hi; ++i) nb += r.has_gt[i];
+    REQUIRE(na >= 5);
+    CHECK(p.a_hi == p.a);  // the standstill ends where the motion starts
+    CHECK(p.b_lo == p.b);
+    CHECK_THAT(p.a_weight, WithinRel(1.0 / na, 1e-12));
+    CHECK_THAT(p.b_weight, WithinRel(1.0 / nb, 1e-12));
+    sum_sq += eps[3 * j] * eps[3 * j];
+    sum_expected += 1e-6 * (p.a_weight + p.b_weight);
+  }
+  REQUIRE(averaged >= 100);  // 4 legs x 20 squares + 2 legs x 20 back-and-forth
+  // Mean square over >= 100 pieces: within 4 sd of a chi^2 mean (sqrt(2/n)).
+  CHECK_THAT(sum_sq / sum_expected, WithinAbs(1.0, 4.0 * std::sqrt(2.0 / averaged)));
+  CHECK(sum_sq / averaged < 0.5 * 2e-6);  // far below single samples' 2 sigma^2
+}
+
 TEST_CASE("diagnose model: piece covariance matches Monte Carlo scatter", "[diagnose]") {
   // At the true parameters the whitened scores of many noisy runs have unit
   // variance and no correlation (eq. 4 noise, ground-truth noise and
