@@ -69,6 +69,10 @@ Command SetupDiagnose(CLI::App& parent) {
   app->add_option("--piece-length", d.pieces.max_piece_length_m,
                   "Longest piece of a leg or arc compared with the model [m] (default 1)")
       ->check(CLI::PositiveNumber);
+  app->add_flag("!--no-likelihood-tests", d.likelihood_tests,
+               "Judge the gap by the gap score alone (default: combined with the candidates' likelihood-ratio tests)");
+  app->add_flag("!--no-standstill-averaging", d.pieces.average_standstills,
+                "Measure motions from/to single ground-truth samples (default: the adjacent standstills' mean pose)");
   app->add_option("--seed", d.seed, "Seed of the null simulations (default 1)");
   app->add_option("--threads", d.threads, "Threads (default 2)")->check(CLI::Range(1, 256));
   app->add_option("--where", d.where_top, "Discrepancies listed under 'where' (default 12)")->check(CLI::NonNegativeNumber);

@@ -415,7 +415,18 @@ TEST_CASE("umbmark diagnose: contract JSON, report, plot", "[diagnose][cli]") {
   // --json - writes JSON alone.
   r = testing::RunCli("diagnose " + Q(manifest) + " --null-sims 20 --folds 2 --effects time_offset --json -");
   REQUIRE(r.status == 0);
-  CHECK(nlohmann::json::parse(r.out)["verdict"]["effect"] == "time_offset");
+  const auto one = nlohmann::json::parse(r.out);
+  CHECK(one["verdict"]["effect"] == "time_offset");
+  // The combined p-value: min(1, 2 min(p_G, tests' Bonferroni p)); with
+  // --no-likelihood-tests the gap score's own.
+  const double pg = one["gap"]["score_p_value"], pt = one["gap"]["tests_p_value"];
+  CHECK(one["gap"]["tests"] == 1);
+  CHECK_THAT(one["gap"]["p_value"].get<double>(), WithinRel(std::min(1.0, 2.0 * std::min(pg, pt)), 1e-9));
+  r = testing::RunCli("diagnose " + Q(manifest) +
+                      " --null-sims 20 --folds 2 --effects time_offset --no-likelihood-tests --json -");
+  REQUIRE(r.status == 0);
+  const auto alone = nlohmann::json::parse(r.out);
+  CHECK_THAT(alone["gap"]["p_value"].get<double>(), WithinRel(alone["gap"]["score_p_value"].get<double>(), 1e-12));
   // Usage and input errors.
   CHECK(testing::RunCli("diagnose " + Q(manifest) + " --effects warp").status == 2);
   CHECK(testing::RunCli("diagnose " + Q(dir / "missing.toml")).status == 2);
