@@ -31,6 +31,7 @@
 // Usage: bench_diagnose [--per-class N] [--clean N] [--seed S] [--threads T]
 //                       [--null-sims B] [--extended] [--classes a,b,...]
 //                       [--json FILE] [--write-dir DIR] [--only-case I]
+//                       [--pause S]  (standstill between motions, default 1 s)
 // --write-dir also writes every campaign (manifest + CSV; truth.json beside,
 // not inside) so the same cases can be diagnosed through the CLI.
 #include <algorithm>
@@ -69,6 +70,7 @@ struct Args {
   std::string json;
   std::string write_dir;
   int only_case = -1;
+  double pause_s = 1.0;
 };
 
 Args Parse(int argc, char** argv) {
@@ -91,6 +93,7 @@ Args Parse(int argc, char** argv) {
     else if (k == "--json") a.json = next();
     else if (k == "--write-dir") a.write_dir = next();
     else if (k == "--only-case") a.only_case = std::stoi(next());
+    else if (k == "--pause") a.pause_s = std::stod(next());
     else if (k == "--classes") {
       std::string s = next();
       std::size_t p = 0;
@@ -120,7 +123,7 @@ double U(std::mt19937_64& g, double lo, double hi) { return std::uniform_real_di
 double Sign(std::mt19937_64& g) { return U(g, 0.0, 1.0) < 0.5 ? -1.0 : 1.0; }
 double LogU(std::mt19937_64& g, double lo, double hi) { return std::exp(U(g, std::log(lo), std::log(hi))); }
 
-Case MakeCase(const std::string& truth, std::uint64_t seed, bool extended) {
+Case MakeCase(const std::string& truth, std::uint64_t seed, bool extended, double pause_s) {
   std::mt19937_64 g(seed);
   Case c;
   c.truth = truth;
@@ -150,7 +153,7 @@ Case MakeCase(const std::string& truth, std::uint64_t seed, bool extended) {
   o.sample_rate_hz = std::round(U(g, 20.0, 50.0));
   o.speed_m_s = U(g, 0.2, 0.5);
   o.turn_rate_rad_s = U(g, 0.5, 1.5);
-  o.pause_s = 1.0;
+  o.pause_s = pause_s;
   o.free_radius_m = U(g, 0.8, 1.5);
   sim::Effects& fx = o.effects;
   const auto kind = sim::EffectFromString(truth);
@@ -205,7 +208,7 @@ int main(int argc, char** argv) {
     const int count = classes[ci] == "none" ? args.clean : args.per_class;
     for (int i = 0; i < count; ++i)
       cases.push_back(MakeCase(classes[ci], args.seed * 1000003ull + ci * 10007ull + static_cast<std::uint64_t>(i),
-                               args.extended));
+                               args.extended, args.pause_s));
   }
 
   diag::DiagnoseOptions dopt;

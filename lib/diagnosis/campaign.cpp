@@ -202,9 +202,21 @@ void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, co
     c.pieces.push_back(p);
   };
   std::size_t cur = g0;
-  for (const auto& m : r.motions) {
-    const std::size_t s0 = m.FirstSample(), s1 = m.EndSample();
-    if (s1 <= cur || s0 >= g1) continue;
+  for (std::size_t mi = 0; mi < r.motions.size(); ++mi) {
+    const sim::MotionSegment& m = r.motions[mi];
+    // Back to back with a neighbouring motion (no pause between): the
+    // interval in which one ends and the next begins holds parts of both, no
+    // single constant-curvature step; the two intervals at the junction stay
+    // out of the pieces.
+    const bool joined_before = mi > 0 && r.motions[mi - 1].last_interval + 1 == m.first_interval;
+    const bool joined_after = mi + 1 < r.motions.size() && m.last_interval + 1 == r.motions[mi + 1].first_interval;
+    const std::size_t s0 = m.FirstSample() + (joined_before ? 1 : 0);
+    const std::size_t s1 = m.EndSample() - (joined_after ? 1 : 0);
+    if (s1 <= s0 || s1 <= cur || s0 >= g1) {
+      if (joined_after) cur = std::max(cur, std::min(m.EndSample() + 1, g1));
+      continue;
+    }
+    if (joined_before) cur = std::max(cur, std::min(s0, g1));
     const auto start = s0 <= cur ? std::optional<std::size_t>(cur) : NearestWithGt(r, s0, cur, s1 - 1);
     if (!start) continue;
     if (*start > cur) add(cur, *start, PieceType::kStand, 0, false);
@@ -244,14 +256,15 @@ void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, co
       first = false;
       prev = *at;
     }
-    // End of the motion: its first still sample (or the nearest with ground truth).
-    const auto end = NearestWithGt(r, std::min(s1, g1), prev + 1, g1);
+    // End of the motion: its first still sample, or the sample before the
+    // junction with the next motion (or the nearest with ground truth).
+    const auto end = NearestWithGt(r, std::min(s1, g1), prev + 1, joined_after ? std::min(s1, g1) : g1);
     if (!end) {
-      cur = prev;
+      cur = joined_after ? std::min(s1 + 2, g1) : prev;
       continue;
     }
     add(prev, *end, type, m.sign, first);
-    cur = *end;
+    cur = joined_after ? std::max(*end, std::min(s1 + 2, g1)) : *end;
   }
   if (g1 > cur) add(cur, g1, PieceType::kStand, 0, false);
   if (!o.average_standstills) return;

@@ -49,6 +49,11 @@ std::vector<MotionSegment> SegmentMotions(const std::vector<double>& cum_left, c
     return std::abs(cum_left[i + 1] - cum_left[i]) > options.stand_eps_m ||
            std::abs(cum_right[i + 1] - cum_right[i]) > options.stand_eps_m;
   };
+  // Sign of a wheel's travel in interval i (0: still).
+  auto sign = [&](const std::vector<double>& cum, std::size_t i) {
+    const double d = cum[i + 1] - cum[i];
+    return d > options.stand_eps_m ? 1 : d < -options.stand_eps_m ? -1 : 0;
+  };
   std::size_t i = 0;
   while (i < intervals) {
     if (!moving(i)) {
@@ -59,8 +64,16 @@ std::vector<MotionSegment> SegmentMotions(const std::vector<double>& cum_left, c
     m.first_interval = i;
     std::size_t last = i;
     std::size_t j = i + 1;
+    // Each wheel's direction so far (0 until it moves): a wheel that turns
+    // the other way starts the next motion (a leg followed by a turn with no
+    // pause, a reversal).
+    int dir_l = sign(cum_left, i), dir_r = sign(cum_right, i);
     while (j < intervals) {
       if (moving(j)) {
+        const int sl = sign(cum_left, j), sr = sign(cum_right, j);
+        if ((sl != 0 && dir_l != 0 && sl != dir_l) || (sr != 0 && dir_r != 0 && sr != dir_r)) break;
+        if (dir_l == 0) dir_l = sl;
+        if (dir_r == 0) dir_r = sr;
         last = j;
         ++j;
         continue;

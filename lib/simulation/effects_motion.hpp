@@ -8,8 +8,11 @@
 //
 // Interval i runs from sample i to sample i + 1. An interval is still when
 // neither wheel moved more than stand_eps_m. A motion is a maximal run of
-// moving intervals; still stretches shorter than min_stand_intervals inside
-// it belong to it (a slow wheel may skip an encoder tick). A motion is
+// moving intervals in which neither wheel reverses its direction; still
+// stretches shorter than min_stand_intervals inside it belong to it (a slow
+// wheel may skip an encoder tick). So a leg followed by a spot turn without
+// a pause, or a reversal, are two motions "back to back" (the next starts at
+// the interval after the previous one's last). A motion is
 //   straight  when its nominal heading change |R - L| / b <= straight_max_rad,
 //   turn      when |L + R| / 2 <= turn_max_ratio * |R - L| / 2 (the axle centre
 //             barely moves compared with the wheels),
