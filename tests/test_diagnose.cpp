@@ -171,6 +171,59 @@ TEST_CASE("diagnose campaign: motions are measured from/to the standstills' mean
   CHECK(sum_sq / averaged < 0.5 * 2e-6);  // far below single samples' 2 sigma^2
 }
 
+TEST_CASE("diagnose model: legs and turns back to back (no pause) replay exactly", "[diagnose]") {
+  // No standstill between motions: the junction intervals (one motion
+  // ending, the next starting inside one sample interval) stay out of the
+  // pieces, and every piece is reproduced to rounding, effects included.
+  Small s = MakeSmall(5, 2, 2, false, false);
+  s.sim.pause_s = 0.0;
+  s.sim.truth.k_L = s.sim.truth.k_R = 0.0;
+  s.sim.ground_truth = GroundTruthNoise{0.0, 0.0};
+  s.sim.effects.scale_s = 0.02;
+  s.sim.effects.scrub_k = 0.05;
+  s.sim.effects.asymmetry_a = -0.015;
+  s.sim.effects.castor_kappa = 0.01;
+  s.sim.effects.drift_r = 3e-4;
+  s.sim.effects.gt_dx = 0.03;
+  s.sim.effects.gt_dy = -0.02;
+  s.sim.effects.time_tau = 0.037;  // samples near a junction show it (PoseAt splits the interval)
+  const CampaignData c = Build(s);
+  int turns = 0, stands = 0, junctions = 0;
+  for (const DiagRun& r : c.runs) junctions += static_cast<int>(r.junctions.size());
+  CHECK(junctions > 10);  // leg/turn junctions inside a sample interval (some fall on a sample)
+  for (const Piece& p : c.pieces) {
+    turns += p.type == PieceType::kTurn;
+    stands += p.type == PieceType::kStand;
+  }
+  CHECK(turns == 2 * 2 * 4);  // every spot turn of the 4 squares found
+  CHECK(stands <= 2 * 6);     // only at the starts and ends of runs
+  const MeanModel model(c);
+  std::vector<double> eps;
+  model.Residuals(TrueParams(s), eps);
+  double worst = 0.0;
+  std::size_t worst_piece = 0;
+  for (std::size_t i = 0; i < eps.size(); ++i)
+    if (std::abs(eps[i]) > worst) {
+      worst = std::abs(eps[i]);
+      worst_piece = i / 3;
+    }
+  INFO("worst piece " << worst_piece << ": " << PieceTypeToString(c.pieces[worst_piece].type));
+  CHECK(worst < 1e-8);
+}
+
+TEST_CASE("diagnose: no pauses between motions: clean campaigns raise no alarm", "[diagnose]") {
+  int alarms = 0;
+  for (int i = 0; i < 4; ++i) {
+    Small s = MakeSmall(140 + static_cast<std::uint64_t>(i), 4, 8);
+    s.sim.pause_s = 0.0;
+    DiagnoseOptions o = Fast(3 + static_cast<std::uint64_t>(i));
+    const DiagnoseSummary d = Diagnose(Build(s), o);
+    alarms += d.verdict != "none";
+  }
+  // At alpha = 1 %, P(>= 2 alarms of 4) < 6e-4.
+  CHECK(alarms <= 1);
+}
+
 TEST_CASE("diagnose model: piece covariance matches Monte Carlo scatter", "[diagnose]") {
   // At the true parameters the whitened scores of many noisy runs have unit
   // variance and no correlation (eq. 4 noise, ground-truth noise and

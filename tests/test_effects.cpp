@@ -10,6 +10,7 @@
 #include "core/angles.hpp"
 #include "simulation/campaign_sim.hpp"
 #include "simulation/effects.hpp"
+#include "simulation/effects_motion.hpp"
 
 using namespace umbmark;
 using namespace umbmark::sim;
@@ -359,6 +360,42 @@ TEST_CASE("outside effects: gt_yaw_misalignment and floor_slope", "[effects]") {
     CHECK_THAT(Last(run).y, WithinAbs(0.01 * 2.0 * kDist, 1e-9));
     CHECK_THAT(Last(run).x, WithinAbs(0.0, 1e-9));
   }
+}
+
+TEST_CASE("motion segmentation: back-to-back legs, turns and reversals are separate motions", "[effects]") {
+  // 10 intervals forward, 5 of a ccw spot turn, 10 backward, no pause; then
+  // an arc in which the left wheel pauses for one interval (still one motion).
+  std::vector<double> L{0.0}, R{0.0};
+  auto step = [&](double dl, double dr, int n) {
+    for (int i = 0; i < n; ++i) {
+      L.push_back(L.back() + dl);
+      R.push_back(R.back() + dr);
+    }
+  };
+  step(0.01, 0.01, 10);
+  step(-0.005, 0.005, 5);
+  step(-0.01, -0.01, 10);
+  step(0.0, 0.0, 3);
+  step(0.01, 0.02, 4);
+  step(0.0, 0.02, 1);
+  step(0.01, 0.02, 4);
+  const auto m = SegmentMotions(L, R, 0.3);
+  REQUIRE(m.size() == 4);
+  CHECK(m[0].first_interval == 0);
+  CHECK(m[0].last_interval == 9);
+  CHECK(m[0].cls == MotionClass::kStraight);
+  CHECK(m[0].sign == 1);
+  CHECK(m[1].first_interval == 10);
+  CHECK(m[1].last_interval == 14);
+  CHECK(m[1].cls == MotionClass::kTurn);
+  CHECK(m[1].sign == 1);
+  CHECK(m[2].first_interval == 15);
+  CHECK(m[2].last_interval == 24);
+  CHECK(m[2].cls == MotionClass::kStraight);
+  CHECK(m[2].sign == -1);
+  CHECK(m[3].first_interval == 28);
+  CHECK(m[3].last_interval == 36);
+  CHECK(m[3].cls == MotionClass::kArc);
 }
 
 TEST_CASE("simulate: encoder ticks are whole counts of true rotation; controller stops on the target", "[effects]") {

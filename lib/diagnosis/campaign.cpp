@@ -1,11 +1,14 @@
 // The diagnosis' view of a campaign: runs, motions, pieces (see campaign.hpp).
 #include "diagnosis/campaign.hpp"
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 
+#include <Eigen/Dense>
 #include <fmt/format.h>
 
 #include "core/angles.hpp"
@@ -115,6 +118,65 @@ void AnnotateIntervals(DiagRun& r) {
       const double tl = IntervalTravel(r, m.last_interval), tp = IntervalTravel(r, m.last_interval - 1);
       if (tp > 0.0) r.window_end[m.last_interval] = static_cast<float>(std::min(1.0, tl / tp));
     }
+  }
+}
+
+/// Junctions of back-to-back motions (see DiagRun::Junction): of the two
+/// intervals at the meeting point, the one whose travel is a positive mix of
+/// A's and B's directions (taken from their neighbouring intervals) is
+/// split; the time of each part follows each motion's speed there.
+void FindJunctions(DiagRun& r) {
+  const std::size_t intervals = r.interval_class.size();
+  r.junction_of.assign(intervals, -1);
+  r.junctions.clear();
+  auto travel = [&](std::size_t i) { return Eigen::Vector2d(r.left[i + 1] - r.left[i], r.right[i + 1] - r.right[i]); };
+  for (std::size_t k = 1; k < r.motions.size(); ++k) {
+    const sim::MotionSegment& A = r.motions[k - 1];
+    const sim::MotionSegment& B = r.motions[k];
+    if (A.last_interval + 1 != B.first_interval) continue;
+    // Directions and speeds from the neighbours of the junction (or the
+    // motions' totals when they are short).
+    const std::size_t ia = A.last_interval > A.first_interval ? A.last_interval - 1 : A.last_interval;
+    const std::size_t ib = B.first_interval < B.last_interval ? B.first_interval + 1 : B.first_interval;
+    Eigen::Vector2d ua = travel(ia), ub = travel(ib);
+    if (ia == A.last_interval) ua = Eigen::Vector2d(A.left_m, A.right_m);
+    if (ib == B.first_interval) ub = Eigen::Vector2d(B.left_m, B.right_m);
+    const double va = ua.norm() / std::max(r.t[ia + 1] - r.t[ia], 1e-12);
+    const double vb = ub.norm() / std::max(r.t[ib + 1] - r.t[ib], 1e-12);
+    if (!(ua.norm() > 0.0 && ub.norm() > 0.0 && va > 0.0 && vb > 0.0)) continue;
+    ua.normalize();
+    ub.normalize();
+    Eigen::Matrix2d U;
+    U << ua, ub;
+    if (std::abs(U.determinant()) < 1e-6) continue;  // same direction: nothing to split
+    int best = -1;
+    double best_mix = 1e-6;
+    Eigen::Vector2d best_ab(0.0, 0.0);
+    for (std::size_t i : {A.last_interval, B.first_interval}) {
+      const Eigen::Vector2d ab = U.lu().solve(travel(i));
+      if (ab[0] < -1e-12 || ab[1] < -1e-12) continue;
+      const double mix = std::min(ab[0], ab[1]) / std::max(ab[0] + ab[1], 1e-300);
+      if (mix > best_mix) {
+        best_mix = mix;
+        best = static_cast<int>(i);
+        best_ab = ab;
+      }
+    }
+    if (best < 0) continue;
+    DiagRun::Junction j;
+    j.interval = static_cast<std::size_t>(best);
+    j.left_m = best_ab[0] * ua[0];
+    j.right_m = best_ab[0] * ua[1];
+    const double ta = best_ab[0] / va, tb = best_ab[1] / vb;
+    j.time_fraction = ta / (ta + tb);
+    j.class_a = static_cast<signed char>(A.cls);
+    j.class_b = static_cast<signed char>(B.cls);
+    j.kick = r.kick[B.first_interval];
+    r.kick[B.first_interval] = 0;
+    r.window_start[j.interval] = 0.0f;
+    r.window_end[j.interval] = 1.0f;
+    r.junction_of[j.interval] = static_cast<int>(r.junctions.size());
+    r.junctions.push_back(j);
   }
 }
 
@@ -378,6 +440,7 @@ CampaignData BuildCampaign(const Manifest& manifest, const std::vector<std::vari
         r.q_sd_left.assign(r.t.size(), 0.0);
         r.q_sd_right.assign(r.t.size(), 0.0);
         AnnotateIntervals(r);
+        FindJunctions(r);
         const int fold = fold_of(r.direction);
         c.runs.push_back(std::move(r));
         Piece p;
@@ -428,6 +491,7 @@ CampaignData BuildCampaign(const Manifest& manifest, const std::vector<std::vari
           r.q_sd_right.assign(r.t.size(), 0.0);
         }
         AnnotateIntervals(r);
+        FindJunctions(r);
         const int fold = fold_of(r.direction);
         c.runs.push_back(std::move(r));
         const std::size_t before = c.pieces.size();

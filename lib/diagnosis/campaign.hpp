@@ -81,6 +81,22 @@ struct DiagRun {
   std::vector<signed char> interval_class;
   std::vector<signed char> kick;
   std::vector<float> window_start, window_end;
+  /// Junctions of motions back to back (no pause): the interval in which
+  /// motion A ends and B begins is two steps, A's direction then B's. For
+  /// such an interval i, junctions holds {i, ...}: the nominal travel of
+  /// A's part, the fraction of the interval's time it takes (at each
+  /// motion's speed), the two classes and B's castor kick sign (applied
+  /// between the parts; kick[i] is then 0).
+  struct Junction {
+    std::size_t interval = 0;
+    double left_m = 0.0, right_m = 0.0;  ///< A's part
+    double time_fraction = 0.5;
+    signed char class_a = 0, class_b = 0;
+    signed char kick = 0;
+  };
+  std::vector<Junction> junctions;
+  /// Index into `junctions` per interval (-1: a plain interval).
+  std::vector<int> junction_of;
   /// Encoder quantisation per sample and wheel: the cumulative travel above
   /// is the count plus the expected fraction of a tick the wheel has turned
   /// beyond it (contract: counts are whole ticks of true rotation, and the

@@ -85,24 +85,55 @@ MeanModel::MeanModel(const CampaignData& campaign) : campaign_(campaign) {
   }
 }
 
+namespace {
+
+/// True wheel travel of a nominal step (dl, dr): diameters, scale,
+/// backward asymmetry, drift of the right wheel.
+inline void TrueTravel(const TrueFactors& f, double drift, double dl, double dr, double& l, double& r) {
+  l = dl * f.c_L * f.scale * (dl < 0.0 ? f.back : 1.0);
+  r = dr * f.c_R * f.scale * drift * (dr < 0.0 ? f.back : 1.0);
+}
+
+inline double HeadingFactor(const TrueFactors& f, signed char cls) {
+  return cls == static_cast<signed char>(sim::MotionClass::kTurn) ? f.scrub : 1.0;
+}
+
+/// The pose after fraction `u` in [0, 1] of interval i's time from `q`
+/// (u = 1: the whole interval): a junction's two parts in turn (B's castor
+/// kick between them), else the interval's one step within its active window.
+Pose2 AdvanceInterval(const DiagRun& r, std::size_t i, const TrueFactors& f, double drift, double kappa, Pose2 q,
+                      double u) {
+  const double dl = r.left[i + 1] - r.left[i], dr = r.right[i + 1] - r.right[i];
+  double l, rr;
+  if (const int jx = r.junction_of.empty() ? -1 : r.junction_of[i]; jx >= 0) {
+    const DiagRun::Junction& j = r.junctions[static_cast<std::size_t>(jx)];
+    const double fa = j.time_fraction;
+    const double ua = fa > 0.0 ? std::min(1.0, u / fa) : 1.0;
+    TrueTravel(f, drift, ua * j.left_m, ua * j.right_m, l, rr);
+    q = Advance(q, l, rr, f.wheelbase, HeadingFactor(f, j.class_a));
+    if (u <= fa) return q;
+    if (j.kick != 0) q.theta += kappa * j.kick;
+    const double ub = fa < 1.0 ? std::min(1.0, (u - fa) / (1.0 - fa)) : 1.0;
+    TrueTravel(f, drift, ub * (dl - j.left_m), ub * (dr - j.right_m), l, rr);
+    return Advance(q, l, rr, f.wheelbase, HeadingFactor(f, j.class_b));
+  }
+  if (r.kick[i] != 0) q.theta += kappa * r.kick[i];
+  const double w0 = r.window_start[i], w1 = r.window_end[i];
+  const double frac = u >= 1.0 ? 1.0 : u <= w0 || w1 <= w0 ? 0.0 : std::min(1.0, (u - w0) / (w1 - w0));
+  TrueTravel(f, drift, frac * dl, frac * dr, l, rr);
+  return Advance(q, l, rr, f.wheelbase, HeadingFactor(f, r.interval_class[i]));
+}
+
+}  // namespace
+
 void MeanModel::ReplayRun(int run, const ParamVector& p, std::vector<Pose2>& poses) const {
   const DiagRun& r = campaign_.runs[run];
   const TrueFactors f = Factors(p, campaign_.robot.wheelbase_m);
   const double drift = 1.0 + p[kParamDrift] * r.campaign_index;
-  const double kappa = p[kParamKappa];
   const std::size_t n = r.t.size();
   poses.resize(n);
-  Pose2 q;
-  poses[0] = q;
-  for (std::size_t i = 0; i + 1 < n; ++i) {
-    const double dl = r.left[i + 1] - r.left[i], dr = r.right[i + 1] - r.right[i];
-    const double l = dl * f.c_L * f.scale * (dl < 0.0 ? f.back : 1.0);
-    const double rr = dr * f.c_R * f.scale * drift * (dr < 0.0 ? f.back : 1.0);
-    if (r.kick[i] != 0) q.theta += kappa * r.kick[i];
-    const double hf = r.interval_class[i] == static_cast<signed char>(sim::MotionClass::kTurn) ? f.scrub : 1.0;
-    q = Advance(q, l, rr, f.wheelbase, hf);
-    poses[i + 1] = q;
-  }
+  poses[0] = Pose2{};
+  for (std::size_t i = 0; i + 1 < n; ++i) poses[i + 1] = AdvanceInterval(r, i, f, drift, p[kParamKappa], poses[i], 1.0);
 }
 
 Pose2 MeanModel::PoseAt(int run, const ParamVector& p, const std::vector<Pose2>& poses, double t) const {
@@ -113,19 +144,13 @@ Pose2 MeanModel::PoseAt(int run, const ParamVector& p, const std::vector<Pose2>&
   const std::size_t i = static_cast<std::size_t>(std::upper_bound(r.t.begin(), r.t.end(), t) - r.t.begin()) - 1;
   if (i + 1 >= n) return poses.back();
   const double u = (t - r.t[i]) / (r.t[i + 1] - r.t[i]);
-  const double w0 = r.window_start[i], w1 = r.window_end[i];
-  if (u <= w0 || w1 <= w0) return poses[i];
-  if (u >= w1) return poses[i + 1];
-  const double frac = (u - w0) / (w1 - w0);
   const TrueFactors f = Factors(p, campaign_.robot.wheelbase_m);
   const double drift = 1.0 + p[kParamDrift] * r.campaign_index;
-  const double dl = r.left[i + 1] - r.left[i], dr = r.right[i + 1] - r.right[i];
-  const double l = dl * f.c_L * f.scale * (dl < 0.0 ? f.back : 1.0);
-  const double rr = dr * f.c_R * f.scale * drift * (dr < 0.0 ? f.back : 1.0);
-  Pose2 q = poses[i];
-  if (r.kick[i] != 0) q.theta += p[kParamKappa] * r.kick[i];
-  const double hf = r.interval_class[i] == static_cast<signed char>(sim::MotionClass::kTurn) ? f.scrub : 1.0;
-  return Advance(q, frac * l, frac * rr, f.wheelbase, hf);
+  // Before the wheels move in the interval nothing has happened, not even
+  // the castor kick.
+  const bool junction = !r.junction_of.empty() && r.junction_of[i] >= 0;
+  if (!junction && (u <= r.window_start[i] || r.window_end[i] <= r.window_start[i])) return poses[i];
+  return AdvanceInterval(r, i, f, drift, p[kParamKappa], poses[i], u);
 }
 
 std::vector<Pose2> MeanModel::PredictRun(int run, const ParamVector& p) const {
