@@ -68,10 +68,21 @@ std::vector<MotionSegment> SegmentMotions(const std::vector<double>& cum_left, c
     // the other way starts the next motion (a leg followed by a turn with no
     // pause, a reversal).
     int dir_l = sign(cum_left, i), dir_r = sign(cum_right, i);
+    // A reversal counts when it lasts min_stand_intervals intervals (a
+    // wheel jittering by a tick does not end a motion).
+    auto reverses = [&](std::size_t k) {
+      const int sl = sign(cum_left, k), sr = sign(cum_right, k);
+      return (sl != 0 && dir_l != 0 && sl != dir_l) || (sr != 0 && dir_r != 0 && sr != dir_r);
+    };
+    auto lasting_reversal = [&](std::size_t k) {
+      for (std::size_t q = k; q < k + static_cast<std::size_t>(options.min_stand_intervals); ++q)
+        if (q >= intervals || !reverses(q)) return false;
+      return true;
+    };
     while (j < intervals) {
       if (moving(j)) {
         const int sl = sign(cum_left, j), sr = sign(cum_right, j);
-        if ((sl != 0 && dir_l != 0 && sl != dir_l) || (sr != 0 && dir_r != 0 && sr != dir_r)) break;
+        if (lasting_reversal(j)) break;
         if (dir_l == 0) dir_l = sl;
         if (dir_r == 0) dir_r = sr;
         last = j;

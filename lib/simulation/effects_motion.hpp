@@ -8,9 +8,10 @@
 //
 // Interval i runs from sample i to sample i + 1. An interval is still when
 // neither wheel moved more than stand_eps_m. A motion is a maximal run of
-// moving intervals in which neither wheel reverses its direction; still
-// stretches shorter than min_stand_intervals inside it belong to it (a slow
-// wheel may skip an encoder tick). So a leg followed by a spot turn without
+// moving intervals in which neither wheel reverses its direction for
+// min_stand_intervals intervals or more (a tick of jitter is no reversal);
+// still stretches shorter than that inside it belong to it (a slow wheel
+// may skip an encoder tick). So a leg followed by a spot turn without
 // a pause, or a reversal, are two motions "back to back" (the next starts at
 // the interval after the previous one's last). A motion is
 //   straight  when its nominal heading change |R - L| / b <= straight_max_rad,
