@@ -102,12 +102,8 @@ ParamVector TrueParams(const Small& s) {
   return p;
 }
 
-}  // namespace
-
-TEST_CASE("diagnose model: replays every mean effect exactly (noise-free)", "[diagnose]") {
-  // All mean effects at once, no noise, wheel travel as distances: the
-  // model's pieces must match the simulator's ground truth to rounding.
-  Small s = MakeSmall(3, 2, 2, true, false);
+/// No wheel or ground-truth noise, every mean effect of the contract.
+void NoiseFreeWithAllMeanEffects(Small& s) {
   s.sim.truth.k_L = s.sim.truth.k_R = 0.0;
   s.sim.ground_truth = GroundTruthNoise{0.0, 0.0};
   s.sim.effects.scale_s = 0.02;
@@ -118,6 +114,15 @@ TEST_CASE("diagnose model: replays every mean effect exactly (noise-free)", "[di
   s.sim.effects.gt_dx = 0.03;
   s.sim.effects.gt_dy = -0.02;
   s.sim.effects.time_tau = 0.037;
+}
+
+}  // namespace
+
+TEST_CASE("diagnose model: replays every mean effect exactly (noise-free)", "[diagnose]") {
+  // All mean effects at once, no noise, wheel travel as distances: the
+  // model's pieces must match the simulator's ground truth to rounding.
+  Small s = MakeSmall(3, 2, 2, true, false);
+  NoiseFreeWithAllMeanEffects(s);
   const CampaignData c = Build(s);
   const MeanModel model(c);
   std::vector<double> eps;
@@ -177,16 +182,7 @@ TEST_CASE("diagnose model: legs and turns back to back (no pause) replay exactly
   // pieces, and every piece is reproduced to rounding, effects included.
   Small s = MakeSmall(5, 2, 2, false, false);
   s.sim.pause_s = 0.0;
-  s.sim.truth.k_L = s.sim.truth.k_R = 0.0;
-  s.sim.ground_truth = GroundTruthNoise{0.0, 0.0};
-  s.sim.effects.scale_s = 0.02;
-  s.sim.effects.scrub_k = 0.05;
-  s.sim.effects.asymmetry_a = -0.015;
-  s.sim.effects.castor_kappa = 0.01;
-  s.sim.effects.drift_r = 3e-4;
-  s.sim.effects.gt_dx = 0.03;
-  s.sim.effects.gt_dy = -0.02;
-  s.sim.effects.time_tau = 0.037;  // samples near a junction show it (PoseAt splits the interval)
+  NoiseFreeWithAllMeanEffects(s);  // time_offset: samples near a junction show it (PoseAt splits it)
   const CampaignData c = Build(s);
   int turns = 0, stands = 0, junctions = 0;
   for (const DiagRun& r : c.runs) junctions += static_cast<int>(r.junctions.size());
