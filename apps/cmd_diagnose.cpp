@@ -10,7 +10,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "core/errors.hpp"
-#include "diagnosis/campaign.hpp"
+#include "diagnosis/pieces.hpp"
 #include "diagnosis/diagnose.hpp"
 #include "io/atomic_write.hpp"
 #include "io/svg_plot.hpp"

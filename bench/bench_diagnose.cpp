@@ -49,7 +49,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/angles.hpp"
-#include "diagnosis/campaign.hpp"
+#include "diagnosis/pieces.hpp"
 #include "diagnosis/diagnose.hpp"
 #include "io/atomic_write.hpp"
 #include "simulation/campaign_sim.hpp"

@@ -13,11 +13,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "diagnosis/campaign.hpp"
+#include "diagnosis/pieces.hpp"
 #include "diagnosis/diagnose.hpp"
 #include "diagnosis/gap_stats.hpp"
 #include "diagnosis/model.hpp"
-#include "diagnosis/noise_fit.hpp"
+#include "diagnosis/piece_noise.hpp"
 #include "simulation/campaign_sim.hpp"
 #include "support/run_cli.hpp"
 

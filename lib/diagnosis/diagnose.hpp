@@ -2,27 +2,27 @@
 // the contract's effects causes it, and how far the gap shrinks once that
 // effect is modelled.
 //
-// Steps (each timed in DiagnoseSummary::timings):
-//  1. Baseline: E_d, E_b from the refined calibration (refine.hpp, scale
+// Steps (each timed in DiagnoseSummary::timings; one file per stage):
+//  1. Baseline (baseline.hpp, mean_fit.hpp, return_check.hpp): E_d, E_b from the refined calibration (refine.hpp, scale
 //     fixed) polished by Ceres (Levenberg-Marquardt) on the whitened piece residuals (model.hpp);
 //     k_L, k_R (and the ground truth's sigmas when the manifest does not
-//     state them) by maximum likelihood (noise_fit.hpp). Predicted return
+//     state them) by maximum likelihood (piece_noise.hpp). Predicted return
 //     errors (mean, covariance) per experiment and direction, and residual
 //     growth per segment type.
-//  2. Where: the gap statistics (gap_stats.hpp), ranked by |z|; the gap
+//  2. Where (where.hpp, null_distribution.hpp): the gap statistics (gap_stats.hpp), ranked by |z|; the gap
 //     score G and its p-value from a parametric bootstrap of the fitted
 //     baseline itself (null_simulations campaigns of piece residuals drawn
 //     from the baseline's noise model -- wheel noise per piece, ground-truth
 //     noise per boundary sample, encoder quantisation -- each refitted like
 //     the data), so data from the baseline raise a false alarm at rate
 //     alpha.
-//  3. Which: every contract effect fitted on top of the baseline (mean
+//  3. Which (candidates.hpp, cross_validation.hpp): every contract effect fitted on top of the baseline (mean
 //     effects: their parameters with E_d, E_b by Ceres; correlated
 //     noise and bumps: maximum likelihood), with gap after, shrink and
 //     heldout_shrink from k-fold cross-validation over runs. Candidates are
 //     ranked by held-out log-likelihood gain minus complexity_penalty_nats
 //     per parameter.
-//  4. Significance: the gap score G spreads its power over hundreds of
+//  4. Significance (verdict.hpp): the gap score G spreads its power over hundreds of
 //     statistics, so a small effect that moves one parameter (a noise
 //     correlation, say) can hide in it. Beside G, every candidate with a
 //     regular likelihood (the mean effects and correlated_noise) gives a
@@ -31,7 +31,7 @@
 //     Bonferroni, p_tests = min(1, m min p_e), and with G's own p-value,
 //     p = min(1, 2 min(p_G, p_tests)), so the false-alarm rate stays at most
 //     alpha.
-//  5. Verdict: `none` when p >= alpha; else the top candidate if its
+//  5. Verdict (verdict.hpp): `none` when p >= alpha; else the top candidate if its
 //     heldout_shrink >= min_heldout_shrink and it leaves no significant gap
 //     (or closes >= full_shrink of it); else, when the likelihood-ratio tests
 //     found the gap, the significant candidate with the smallest p-value if
@@ -55,10 +55,13 @@
 #include <Eigen/Core>
 #include <nlohmann/json_fwd.hpp>
 
-#include "diagnosis/campaign.hpp"
+#include "diagnosis/candidates.hpp"
 #include "diagnosis/gap_stats.hpp"
 #include "diagnosis/model.hpp"
-#include "diagnosis/noise_fit.hpp"
+#include "diagnosis/piece_noise.hpp"
+#include "diagnosis/pieces.hpp"
+#include "diagnosis/return_check.hpp"
+#include "diagnosis/where.hpp"
 #include "simulation/effects.hpp"
 
 namespace umbmark::diag {
@@ -96,34 +99,6 @@ struct DiagnoseOptions {
   std::string Check() const;
 };
 
-/// One localised discrepancy.
-struct WhereItem {
-  int experiment = 0;  ///< 0-based
-  std::string subset;
-  StatKind statistic = StatKind::kMean;
-  std::string component;  ///< heading, along-track, lateral, or "a x b" for correlations
-  double z = 0.0;
-  int n = 0;
-};
-
-/// Predicted vs observed return errors of one experiment and direction.
-struct ReturnPrediction {
-  int experiment = 0;
-  std::string direction;
-  int runs = 0;
-  Eigen::Vector3d observed_mean = Eigen::Vector3d::Zero(), predicted_mean = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d observed_cov = Eigen::Matrix3d::Zero(), predicted_cov = Eigen::Matrix3d::Zero();
-};
-
-/// Residual growth per segment type: RMS of the piece residuals, observed
-/// and predicted by the baseline.
-struct GrowthRow {
-  PieceType type = PieceType::kStraight;
-  int pieces = 0;
-  double mean_travel_m = 0.0;
-  Eigen::Vector3d observed_rms = Eigen::Vector3d::Zero(), predicted_rms = Eigen::Vector3d::Zero();
-};
-
 struct BaselineSummary {
   double E_d = 1.0, E_b = 1.0;
   double k_L = 0.0, k_R = 0.0;
@@ -143,33 +118,6 @@ struct BaselineSummary {
   double return_k_L = 0.0, return_k_R = 0.0;
   std::array<double, 2> return_k_L_ci{0.0, 0.0}, return_k_R_ci{0.0, 0.0};
   std::string return_fit_note;
-};
-
-struct Candidate {
-  sim::EffectKind effect = sim::EffectKind::kScaleError;
-  std::map<std::string, double> params;
-  std::map<std::string, double> param_se;  ///< standard errors (mean effects)
-  double E_d = 1.0, E_b = 1.0;             ///< refitted with the effect
-  bool identifiable = true;
-  /// Identifiable, but a typical-size effect stands < 3 standard errors out
-  /// beside E_d, E_b (named only on its own evidence; see `note`).
-  bool weak = false;
-  double gap_after = 0.0;  ///< G after (raw score)
-  double shrink = 0.0;
-  double heldout_shrink = 0.0;
-  double heldout_loglik_gain = 0.0;  ///< nats over the baseline, held out
-  double evidence = 0.0;             ///< gain minus the complexity penalty
-  int parameters = 0;
-  /// Likelihood-ratio test against the baseline on all runs (in-sample):
-  /// log-likelihood gain [nats] and its p-value (chi^2 with `parameters`
-  /// degrees of freedom; Wilks). Not tested (p = 1, tested = false) for
-  /// bump_outliers, whose rate sits on the boundary under the baseline,
-  /// and for effects the data cannot identify.
-  bool tested = false;
-  double loglik_gain = 0.0;
-  double lr_p_value = 1.0;
-  std::array<double, kNumStatKinds> gap_by_kind{};
-  std::string note;
 };
 
 struct DiagnoseSummary {

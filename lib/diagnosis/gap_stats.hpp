@@ -31,8 +31,8 @@
 #include <string>
 #include <vector>
 
-#include "diagnosis/campaign.hpp"
-#include "diagnosis/noise_fit.hpp"
+#include "diagnosis/pieces.hpp"
+#include "diagnosis/piece_noise.hpp"
 
 namespace umbmark::diag {
 

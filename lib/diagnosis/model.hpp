@@ -32,7 +32,7 @@
 
 #include <Eigen/Core>
 
-#include "diagnosis/campaign.hpp"
+#include "diagnosis/pieces.hpp"
 
 namespace umbmark::diag {
 

@@ -7,7 +7,7 @@
 //   v <- v + I^-1 s,  s_m = 1/2 sum_j (eps^T C^-1 B_m C^-1 eps - tr C^-1 B_m),
 //   I_mn = 1/2 sum_j tr(C^-1 B_m C^-1 B_n))
 // converges in a few steps; bounds keep k^2, sigma^2 >= 0 and |rho| < 1.
-// By default the fit is trimmed (NoiseFitOptions::robust): an
+// By default the fit is trimmed (PieceNoiseFitOptions::robust): an
 // unmodelled effect concentrated on some pieces (the spot turns, say) must
 // show as a gap, not as a huge k.
 // This is the same estimator `fit-noise` needs (Chong & Kleeman's k_L, k_R
@@ -57,7 +57,7 @@ struct BumpMixture {
 };
 BumpMixture PieceMixture(const PieceBases& B, const NoiseParams& n);
 
-struct NoiseFitOptions {
+struct PieceNoiseFitOptions {
   /// Estimate sigma_xy, sigma_theta (else fixed at the start values).
   bool fit_ground_truth = false;
   /// Estimate c = rho k_L k_R (correlated_noise).
@@ -80,11 +80,11 @@ struct NoiseFitOptions {
 
 /// Maximum-likelihood noise parameters on the pieces with use[j] (all when
 /// `use` is empty), from `start`. eps: residuals (3 per piece).
-NoiseParams FitNoise(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
+NoiseParams FitPieceNoise(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
                      const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start,
-                     const NoiseFitOptions& options);
+                     const PieceNoiseFitOptions& options);
 
-/// As FitNoise, plus bump_outliers' rate and sigma_b (mixture likelihood,
+/// As FitPieceNoise, plus bump_outliers' rate and sigma_b (mixture likelihood,
 /// Nelder-Mead over log k_L^2, log k_R^2, log rate, log sigma_b^2; ground
 /// truth noise fixed at `start`'s). The search is bounded to physical
 /// bumps: rate in [1e-4, 2] per metre, sigma_b in [0.01, 100] mm.

@@ -1,5 +1,5 @@
-// The diagnosis' view of a campaign: runs, motions, pieces (see campaign.hpp).
-#include "diagnosis/campaign.hpp"
+// The diagnosis' view of a campaign: runs, motions, pieces (see pieces.hpp).
+#include "diagnosis/pieces.hpp"
 
 #include <Eigen/Dense>
 

@@ -1,5 +1,5 @@
-// Maximum-likelihood noise parameters (see noise_fit.hpp).
-#include "diagnosis/noise_fit.hpp"
+// Maximum-likelihood noise parameters (see piece_noise.hpp).
+#include "diagnosis/piece_noise.hpp"
 
 #include <algorithm>
 #include <array>
@@ -172,7 +172,7 @@ void AccumulateFisher(const double* eps, const PieceBases& B, const NoiseParams&
     }
 }
 
-void Clamp(NoiseParams& n, const NoiseFitOptions& o) {
+void Clamp(NoiseParams& n, const PieceNoiseFitOptions& o) {
   n.kL2 = std::max(n.kL2, o.min_k2);
   n.kR2 = std::max(n.kR2, o.min_k2);
   n.sxy2 = std::max(n.sxy2, o.min_sigma_xy2);
@@ -199,9 +199,9 @@ double PieceLogLik(const double* eps, int components, const PieceBases& B, const
 
 namespace {
 
-NoiseParams FitNoiseOnce(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
+NoiseParams FitPieceNoiseOnce(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
                          const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start,
-                         const NoiseFitOptions& options) {
+                         const PieceNoiseFitOptions& options) {
   std::vector<int> active = {0, 1};
   if (options.correlated) active.push_back(2);
   if (options.fit_ground_truth) {
@@ -302,10 +302,10 @@ double Mahalanobis(const double* e, int d, const PieceBases& B, const NoiseParam
 
 }  // namespace
 
-NoiseParams FitNoise(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
+NoiseParams FitPieceNoise(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
                      const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start,
-                     const NoiseFitOptions& options) {
-  NoiseParams n = FitNoiseOnce(eps, bases, pieces, use, start, options);
+                     const PieceNoiseFitOptions& options) {
+  NoiseParams n = FitPieceNoiseOnce(eps, bases, pieces, use, start, options);
   if (!options.robust) return n;
   // Trimmed likelihood: drop the pieces beyond the chi^2 99.9 % quantile of
   // the current fit and refit, until the kept set is stable. Under the model
@@ -319,9 +319,9 @@ NoiseParams FitNoise(const std::vector<double>& eps, const std::vector<PieceBase
       keep[j] = Used(use, j) && Mahalanobis(&eps[3 * j], d, bases[j], n) <= kTrimChi2[d];
     }
     if (keep == prev) break;
-    NoiseFitOptions o = options;
+    PieceNoiseFitOptions o = options;
     o.max_iterations = std::min(options.max_iterations, 20);
-    n = FitNoiseOnce(eps, bases, pieces, keep, n, o);
+    n = FitPieceNoiseOnce(eps, bases, pieces, keep, n, o);
     prev = keep;
   }
   NoiseParams out = n;

@@ -1,0 +1,113 @@
+// Baseline of the diagnosis (see baseline.hpp).
+#include "diagnosis/baseline.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <variant>
+
+#include <fmt/format.h>
+
+#include "calibration/refine.hpp"
+
+namespace umbmark::diag {
+
+const std::vector<int>& BaselineParams() {
+  static const std::vector<int> params = {kParamEd, kParamEb};
+  return params;
+}
+
+BaselineStart StartBaseline(const CampaignData& c, bool use_refine) {
+  BaselineStart s;
+  s.p = NominalParams();
+  s.description = "nominal (E_d = E_b = 1)";
+  if (!use_refine) return s;
+  try {
+    RefineOptions ro;
+    ro.scale = ScaleMode::kFixed;
+    std::vector<TrajectoryRunSet> tsets;
+    std::vector<SquareRunSet> ssets;
+    for (std::size_t e = 0; e < c.experiments.size(); ++e) {
+      if (const auto* t = std::get_if<TrajectoryData>(&c.files[e])) {
+        tsets.push_back({c.robot, t});
+      } else {
+        SquareRunSet sq;
+        sq.side_m = c.experiments[e].side_m;
+        sq.recorded = c.robot;
+        sq.source = c.experiments[e].file;
+        for (const auto& r : std::get<EndpointData>(c.files[e]).runs) {
+          ReturnError re;
+          re.run = r.run;
+          re.direction = r.direction;
+          re.ex_m = r.ex_m;
+          re.ey_m = r.ey_m;
+          re.etheta_rad = r.etheta_rad;
+          sq.errors.push_back(re);
+        }
+        ssets.push_back(sq);
+      }
+    }
+    const RefineSummary rs = tsets.empty() ? RefineFromReturnErrors(ssets, c.robot, ro)
+                                           : RefineFromTrajectories(tsets, c.robot, ro);
+    if (std::isfinite(rs.E_d) && std::isfinite(rs.E_b) && rs.E_d > 0.5 && rs.E_d < 2.0 && rs.E_b > 0.5 &&
+        rs.E_b < 2.0) {
+      s.p[kParamEd] = rs.E_d;
+      s.p[kParamEb] = rs.E_b;
+      s.description = fmt::format("refined calibration ({}): E_d = {:.6f}, E_b = {:.6f}",
+                                  tsets.empty() ? "return errors" : "trajectories", rs.E_d, rs.E_b);
+      s.refined = true;
+    }
+  } catch (const std::exception& e) {
+    s.notes.push_back(std::string("refined calibration unavailable, starting from the nominal robot: ") + e.what());
+  }
+  return s;
+}
+
+BaselineFit FitBaseline(const CampaignData& c, const MeanModel& model, const BaselineStart& start,
+                        const BaselineFitOptions& options) {
+  BaselineFit b;
+  ParamVector p = start.p;
+  NoiseParams noise;
+  b.ground_truth_known = c.ground_truth.has_value();
+  const bool gt_known = b.ground_truth_known;
+  b.noise_fit.fit_ground_truth = !gt_known;
+  // Floors: 1 micrometre / 1 microradian keep noise-free ground truth usable.
+  noise.sxy2 = gt_known ? std::max(c.ground_truth->sigma_xy_m * c.ground_truth->sigma_xy_m, 1e-12) : 1e-8;
+  noise.sth2 = gt_known ? std::max(c.ground_truth->sigma_theta_rad * c.ground_truth->sigma_theta_rad, 1e-12) : 1e-6;
+  b.noise_fit.min_sigma_xy2 = 1e-12;
+  b.noise_fit.min_sigma_theta2 = 1e-12;
+  std::vector<double> eps;
+  model.Residuals(p, eps);
+  b.bases = ComputeBases(c, model, p);
+  noise = FitPieceNoise(eps, b.bases, c.pieces, {}, noise, b.noise_fit);
+  MeanFit base;
+  for (int round = 0; round < options.rounds; ++round) {
+    base = FitMean(model, p, BaselineParams(), Whiteners(b.bases, c.pieces, noise), options.mean);
+    p = base.p;
+    if (round == 0) b.bases = ComputeBases(c, model, p);
+    noise = FitPieceNoise(base.eps, b.bases, c.pieces, {}, noise, b.noise_fit);
+  }
+  if (start.refined && base.cov.rows() == 2) {
+    // The calibration and the model's best fit on the pieces should agree
+    // when the model is right; far apart, systematic effects are at work.
+    const ParamVector& p0 = start.p;
+    const double zd = (p[kParamEd] - p0[kParamEd]) / std::sqrt(std::max(base.cov(0, 0), 1e-300));
+    const double zb = (p[kParamEb] - p0[kParamEb]) / std::sqrt(std::max(base.cov(1, 1), 1e-300));
+    if (std::max(std::abs(zd), std::abs(zb)) > 5.0)
+      b.notes.push_back(fmt::format(
+          "the refined calibration (E_d = {:.6f}, E_b = {:.6f}) and the baseline's best fit on the pieces (E_d = "
+          "{:.6f}, E_b = {:.6f}) differ by {:.0f} and {:.0f} standard errors: the two weigh the runs differently, "
+          "which matters only when the runs leave the model",
+          p0[kParamEd], p0[kParamEb], p[kParamEd], p[kParamEb], zd, zb));
+  }
+  b.p = p;
+  b.noise = noise;
+  b.eps = base.eps;
+  b.cov = base.cov;
+  b.W = Whiteners(b.bases, c.pieces, noise);
+  // Jacobian at the final point for the null refits and cross-validation.
+  b.D = model.Jacobian(p, BaselineParams(), b.eps);
+  return b;
+}
+
+}  // namespace umbmark::diag

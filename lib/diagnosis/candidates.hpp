@@ -1,0 +1,81 @@
+// Stage "candidates" of the diagnosis: every effect of the contract fitted
+// on top of the baseline -- mean effects (model.hpp) with E_d, E_b jointly by
+// weighted least squares, correlated_noise and bump_outliers by maximum
+// likelihood (piece_noise.hpp) -- with its identifiability against E_d, E_b,
+// the gap it leaves, its in-sample likelihood-ratio test and its held-out
+// evidence (cross_validation.hpp).
+#pragma once
+
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "diagnosis/baseline.hpp"
+#include "diagnosis/cross_validation.hpp"
+#include "diagnosis/gap_stats.hpp"
+#include "simulation/effects.hpp"
+
+namespace umbmark::diag {
+
+struct Candidate {
+  sim::EffectKind effect = sim::EffectKind::kScaleError;
+  std::map<std::string, double> params;
+  std::map<std::string, double> param_se;  ///< standard errors (mean effects)
+  double E_d = 1.0, E_b = 1.0;             ///< refitted with the effect
+  bool identifiable = true;
+  /// Identifiable, but a typical-size effect stands < 3 standard errors out
+  /// beside E_d, E_b (named only on its own evidence; see `note`).
+  bool weak = false;
+  double gap_after = 0.0;  ///< G after (raw score)
+  double shrink = 0.0;
+  double heldout_shrink = 0.0;
+  double heldout_loglik_gain = 0.0;  ///< nats over the baseline, held out
+  double evidence = 0.0;             ///< gain minus the complexity penalty
+  int parameters = 0;
+  /// Likelihood-ratio test against the baseline on all runs (in-sample):
+  /// log-likelihood gain [nats] and its p-value (chi^2 with `parameters`
+  /// degrees of freedom; Wilks). Not tested (p = 1, tested = false) for
+  /// bump_outliers, whose rate sits on the boundary under the baseline,
+  /// and for effects the data cannot identify.
+  bool tested = false;
+  double loglik_gain = 0.0;
+  double lr_p_value = 1.0;
+  std::array<double, kNumStatKinds> gap_by_kind{};
+  std::string note;
+};
+
+/// Mean-model parameters of an effect (empty for the noise effects).
+std::vector<int> EffectParams(sim::EffectKind k);
+
+/// gap = max(0, G - G0): what the model's own noise does not produce.
+double Gap(double score, double null_median);
+
+/// 1 - after / before, 0 without a gap, floored at -1 (an effect that makes
+/// the gap more than twice as large is simply "much worse").
+double Shrink(double after, double before);
+
+struct CandidateOptions {
+  /// Effects to fit (in this order).
+  std::vector<sim::EffectKind> effects;
+  /// Held-out log-likelihood an effect must gain per parameter. Default 2 nats.
+  double complexity_penalty_nats = 2.0;
+  /// Threads (>= 1); results do not depend on them. Default 2.
+  int threads = 2;
+  GapOptions gap;
+};
+
+struct CandidateFits {
+  std::vector<Candidate> candidates;  ///< in CandidateOptions::effects' order
+  /// Each mean effect's whitened footprint with what E_d, E_b explain
+  /// removed (empty for the noise effects); tells effects apart.
+  std::vector<Eigen::MatrixXd> projected;
+};
+
+/// gap_score: G of the baseline; null_median: G0.
+CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const BaselineFit& baseline,
+                            const Folds& folds, double gap_score, double null_median, const CandidateOptions& options);
+
+}  // namespace umbmark::diag

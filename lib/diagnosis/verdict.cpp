@@ -1,0 +1,160 @@
+// Significance and verdict of the diagnosis (see verdict.hpp).
+#include "diagnosis/verdict.hpp"
+
+#include <algorithm>
+
+#include <Eigen/Dense>
+#include <fmt/format.h>
+
+namespace umbmark::diag {
+
+namespace {
+
+/// Combined p-value of G and the likelihood-ratio tests.
+void Significance(const CandidateFits& fits, double score_p_value, const VerdictOptions& options, Verdict& out) {
+  {
+    double min_p = 1.0;
+    out.tests = 0;
+    for (const Candidate& cd : fits.candidates)
+      if (cd.tested) {
+        ++out.tests;
+        min_p = std::min(min_p, cd.lr_p_value);
+      }
+    out.tests_p_value = std::min(1.0, out.tests * min_p);
+    out.p_value = options.likelihood_tests && out.tests > 0
+                      ? std::min(1.0, 2.0 * std::min(score_p_value, out.tests_p_value))
+                      : score_p_value;
+    out.significant = out.p_value < options.alpha;
+  }
+}
+
+/// Ranks the candidates and names the verdict with its reason.
+void Decide(const CandidateFits& fits, double score_p_value, double null_quantile_alpha, const VerdictOptions& options,
+            Verdict& out) {
+  // Level of each route: half of alpha each when both are combined.
+  const double route_alpha = options.likelihood_tests && out.tests > 0 ? 0.5 * options.alpha : options.alpha;
+  const bool found_by_tests = options.likelihood_tests && out.tests > 0 && out.tests_p_value < route_alpha;
+  std::vector<std::size_t> rank(fits.candidates.size());
+  for (std::size_t i = 0; i < rank.size(); ++i) rank[i] = i;
+  // Best first: effects that close most of the held-out gap with positive
+  // evidence, by evidence; then the others by evidence; unidentifiable last.
+  // A winner must also leave no significant gap behind, unless it closes
+  // nearly all of it (a tiny misfit of a huge effect still scores high).
+  auto qualifies = [&](const Candidate& cd) {
+    return cd.identifiable && cd.evidence > 0.0 && cd.heldout_shrink >= options.min_heldout_shrink &&
+           (cd.gap_after <= null_quantile_alpha || cd.heldout_shrink >= options.full_shrink);
+  };
+  // Found by its own likelihood-ratio test (the gap G may be too diffuse to
+  // see it): significant after Bonferroni, gains held out, and leaves no
+  // significant G.
+  auto found_alone = [&](const Candidate& cd) {
+    return found_by_tests && cd.identifiable && cd.tested && out.tests * cd.lr_p_value < route_alpha &&
+           cd.evidence > 0.0 && cd.gap_after <= null_quantile_alpha;
+  };
+  std::stable_sort(rank.begin(), rank.end(), [&](std::size_t a, std::size_t b) {
+    if (fits.candidates[a].identifiable != fits.candidates[b].identifiable) return fits.candidates[a].identifiable;
+    if (qualifies(fits.candidates[a]) != qualifies(fits.candidates[b])) return qualifies(fits.candidates[a]);
+    return fits.candidates[a].evidence > fits.candidates[b].evidence;
+  });
+  if (out.significant && !rank.empty() && !qualifies(fits.candidates[rank.front()])) {
+    // No candidate closes the gap G measures: the likelihood-ratio route.
+    std::size_t best = rank.size();
+    for (std::size_t k = 0; k < rank.size(); ++k)
+      if (found_alone(fits.candidates[rank[k]]) && (best == rank.size() || fits.candidates[rank[k]].lr_p_value < fits.candidates[rank[best]].lr_p_value))
+        best = k;
+    if (best < rank.size()) std::rotate(rank.begin(), rank.begin() + static_cast<std::ptrdiff_t>(best),
+                                        rank.begin() + static_cast<std::ptrdiff_t>(best) + 1);
+  }
+  for (std::size_t i : rank) out.candidates.push_back(fits.candidates[i]);
+  const std::string p_text =
+      options.likelihood_tests && out.tests > 0
+          ? fmt::format("p = {:.3g}: gap score p = {:.3g}, likelihood-ratio tests p = {:.3g} (Bonferroni over {})",
+                        out.p_value, score_p_value, out.tests_p_value, out.tests)
+          : fmt::format("p = {:.3g}", out.p_value);
+  if (!out.significant) {
+    out.verdict = "none";
+    out.reason = fmt::format("the gap is not significant ({} >= alpha = {})", p_text, options.alpha);
+  } else {
+    const Candidate* best = out.candidates.empty() || !out.candidates.front().identifiable ? nullptr : &out.candidates.front();
+    if (best && qualifies(*best)) {
+      out.verdict = sim::EffectToString(best->effect);
+      out.reason = fmt::format(
+          "{} closes {:.0f}% of the gap on held-out runs (held-out log-likelihood +{:.1f} nats over the baseline)",
+          out.verdict, 100.0 * best->heldout_shrink, best->heldout_loglik_gain);
+    } else if (best && found_alone(*best)) {
+      out.verdict = sim::EffectToString(best->effect);
+      out.reason = fmt::format(
+          "{} is significant on its own likelihood-ratio test (+{:.1f} nats, p = {:.3g}, {} tests) and gains {:.1f} "
+          "nats on held-out runs; the gap score alone (p = {:.3g}) spreads it over too many statistics to see it, "
+          "and none remains with the effect (G = {:.1f} <= {:.1f})",
+          out.verdict, best->loglik_gain, best->lr_p_value, out.tests, best->heldout_loglik_gain, score_p_value,
+          best->gap_after, null_quantile_alpha);
+    } else {
+      out.verdict = "unexplained";
+      out.reason =
+          !best ? fmt::format("significant gap ({}) and no identifiable candidate", p_text)
+          : best->heldout_shrink < options.min_heldout_shrink || best->evidence <= 0.0
+              ? fmt::format("significant gap ({}); the best candidate, {}, closes only {:.0f}% of it on "
+                            "held-out runs",
+                            p_text, sim::EffectToString(best->effect), 100.0 * best->heldout_shrink)
+              : fmt::format("significant gap ({}); the best candidate, {}, closes {:.0f}% of it on held-out "
+                            "runs but leaves a significant gap (G = {:.1f} > {:.1f})",
+                            p_text, sim::EffectToString(best->effect), 100.0 * best->heldout_shrink,
+                            best->gap_after, null_quantile_alpha);
+    }
+  }
+}
+
+/// What the data cannot tell apart: effects from the baseline, or from
+/// each other (footprints, or held-out evidence).
+void Indistinguishable(const CandidateFits& fits, const VerdictOptions& options, Verdict& out) {
+  for (const Candidate& cd : out.candidates)
+    if (!cd.identifiable && cd.note.find("baseline") != std::string::npos)
+      out.indistinguishable.push_back(fmt::format("{} cannot be told apart from the baseline with these experiments: {}",
+                                                  sim::EffectToString(cd.effect),
+                                                  cd.note.substr(cd.note.find("indistinguishable"))));
+    else if (cd.weak && sim::EffectToString(cd.effect) != out.verdict)
+      out.indistinguishable.push_back(
+          fmt::format("{} can hardly be told apart from the baseline with these experiments: {}",
+                      sim::EffectToString(cd.effect), cd.note.substr(cd.note.find("mostly"))));
+  for (std::size_t a = 0; a < fits.candidates.size(); ++a)
+    for (std::size_t b = a + 1; b < fits.candidates.size(); ++b) {
+      if (!fits.candidates[a].identifiable || !fits.candidates[b].identifiable) continue;
+      if (fits.projected[a].size() == 0 || fits.projected[b].size() == 0) continue;
+      // Largest canonical correlation between the two effects' footprints
+      // (after removing what E_d, E_b explain).
+      const Eigen::HouseholderQR<Eigen::MatrixXd> qa(fits.projected[a]), qb(fits.projected[b]);
+      const Eigen::MatrixXd Qa = qa.householderQ() * Eigen::MatrixXd::Identity(fits.projected[a].rows(), fits.projected[a].cols());
+      const Eigen::MatrixXd Qb = qb.householderQ() * Eigen::MatrixXd::Identity(fits.projected[b].rows(), fits.projected[b].cols());
+      const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Qa.transpose() * Qb);
+      const double cc = svd.singularValues().size() > 0 ? svd.singularValues()[0] : 0.0;
+      if (cc > 0.95)
+        out.indistinguishable.push_back(fmt::format(
+            "{} and {} leave nearly the same footprint on these data (canonical correlation {:.3f})",
+            sim::EffectToString(fits.candidates[a].effect), sim::EffectToString(fits.candidates[b].effect), cc));
+    }
+  if (out.significant && !out.candidates.empty() && out.candidates.front().identifiable) {
+    const Candidate& top = out.candidates.front();
+    for (std::size_t i = 1; i < out.candidates.size(); ++i) {
+      const Candidate& o = out.candidates[i];
+      if (!o.identifiable || o.heldout_shrink < options.min_heldout_shrink) continue;
+      if (top.evidence - o.evidence < 2.0)
+        out.indistinguishable.push_back(fmt::format(
+            "{} and {} explain the gap about equally well on held-out runs ({:.1f} vs {:.1f} nats)",
+            sim::EffectToString(top.effect), sim::EffectToString(o.effect), top.evidence, o.evidence));
+    }
+  }
+}
+
+}  // namespace
+
+Verdict DecideVerdict(const CandidateFits& fits, double score_p_value, double null_quantile_alpha,
+                      const VerdictOptions& options) {
+  Verdict out;
+  Significance(fits, score_p_value, options, out);
+  Decide(fits, score_p_value, null_quantile_alpha, options, out);
+  Indistinguishable(fits, options, out);
+  return out;
+}
+
+}  // namespace umbmark::diag

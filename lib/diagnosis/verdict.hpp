@@ -1,0 +1,49 @@
+// Stage "verdict" of the diagnosis.
+//  Significance: the gap score G spreads its power over hundreds of
+//  statistics, so a small effect that moves one parameter (a noise
+//  correlation, say) can hide in it. Beside G, every candidate with a
+//  regular likelihood gives a likelihood-ratio test against the baseline
+//  (Wilks); the tests are combined by Bonferroni, p_tests = min(1, m min
+//  p_e), and with G's own p-value, p = min(1, 2 min(p_G, p_tests)), so the
+//  false-alarm rate stays at most alpha.
+//  Verdict: `none` when p >= alpha; else the top candidate if it closes
+//  enough of the held-out gap and leaves no significant gap; else the
+//  likelihood-ratio route; else `unexplained`. Effects the data cannot tell
+//  apart are listed.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "diagnosis/candidates.hpp"
+
+namespace umbmark::diag {
+
+struct VerdictOptions {
+  /// False-alarm rate. Default 0.01.
+  double alpha = 0.01;
+  /// A winner closes at least this fraction of the held-out gap. Default 0.5.
+  double min_heldout_shrink = 0.5;
+  /// ...and leaves no significant gap unless it closes this much. Default 0.9.
+  double full_shrink = 0.9;
+  /// Combine G with the likelihood-ratio tests. Default true.
+  bool likelihood_tests = true;
+};
+
+struct Verdict {
+  double p_value = 1.0;        ///< combined
+  double tests_p_value = 1.0;  ///< Bonferroni over the tested candidates
+  int tests = 0;
+  bool significant = false;
+  std::vector<Candidate> candidates;  ///< ranked, best first
+  std::string verdict;                ///< effect name | none | unexplained
+  std::string reason;
+  std::vector<std::string> indistinguishable;
+};
+
+/// score_p_value: G against its null; null_quantile_alpha: G at the null's
+/// 1 - alpha quantile.
+Verdict DecideVerdict(const CandidateFits& fits, double score_p_value, double null_quantile_alpha,
+                      const VerdictOptions& options);
+
+}  // namespace umbmark::diag
