@@ -19,8 +19,8 @@
 #include "common.hpp"
 #include "core/angles.hpp"
 #include "core/errors.hpp"
-#include "error_models/noise_fit.hpp"
-#include "error_models/noise_fit_data.hpp"
+#include "error_models/wheel_noise_fit.hpp"
+#include "error_models/wheel_noise_fit_data.hpp"
 #include "io/atomic_write.hpp"
 #include "io/data_file.hpp"
 #include "io/manifest.hpp"
@@ -41,7 +41,7 @@ struct FitNoiseOptions {
 };
 
 struct Loaded {
-  std::vector<NoiseFitRun> runs;
+  std::vector<WheelNoiseFitRun> runs;
   std::vector<std::string> sources;
   int skipped = 0;
   double sigma_xy = 0.0, sigma_theta = 0.0;
@@ -144,7 +144,7 @@ nlohmann::json JsonMatrix(const PoseCovariance& P) {
 
 /// Figure 4 of Chong & Kleeman: run scatter with 95% ellipses, observed
 /// (solid) and fitted (dashed), for ex-ey, ex-etheta, ey-etheta.
-std::string PlotSvg(const NoiseFitSummary& s) {
+std::string PlotSvg(const WheelNoiseFitSummary& s) {
   const bool centred = s.groups.size() > 1;
   const double scale95 = std::sqrt(-2.0 * std::log(0.05));  // 2-D 95% ellipse: sqrt(chi^2_2(0.95))
   const double unit[3] = {1e3, 1e3, 1e3};                      // mm, mm, mrad
@@ -191,11 +191,11 @@ std::string PlotSvg(const NoiseFitSummary& s) {
 int RunFitNoise(const FitNoiseOptions& o) {
   Loaded data = Load(o);
   if (data.runs.empty()) throw InputError(o.inputs.front(), "no run with ground truth at its start and end");
-  NoiseFitOptions fo;
+  WheelNoiseFitOptions fo;
   fo.restricted = o.reml;
-  NoiseFitSummary s;
+  WheelNoiseFitSummary s;
   try {
-    s = FitNoise(data.runs, fo);
+    s = FitWheelNoise(data.runs, fo);
   } catch (const InputError& e) {
     throw InputError(o.inputs.front(), e.message());
   }

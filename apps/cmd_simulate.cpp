@@ -16,6 +16,7 @@
 #include "common.hpp"
 #include "core/errors.hpp"
 #include "io/atomic_write.hpp"
+#include "io/campaign_writer.hpp"
 #include "io/data_file.hpp"
 #include "io/manifest.hpp"
 #include "simulation/campaign_sim.hpp"
@@ -66,7 +67,7 @@ int RunSimulate(SimulateOptions o) {
   const std::vector<std::string> comment = {
       fmt::format("synthetic campaign written by umbmark simulate from {} (seed {})",
                   fs::path(o.manifest).filename().string(), o.seed)};
-  const std::string manifest_path = sim::WriteCampaign(campaign, o.out, comment);
+  const std::string manifest_path = io::WriteCampaign(campaign.manifest, campaign.data, o.out, comment);
   const nlohmann::json truth = sim::CampaignTruthJson(campaign, o.sim);
   const std::string truth_path = o.truth_out.empty() ? (fs::path(o.out) / "truth.json").string() : o.truth_out;
   io::WriteFileAtomically(truth_path, truth.dump(2) + "\n");

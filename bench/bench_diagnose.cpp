@@ -52,6 +52,7 @@
 #include "diagnosis/pieces.hpp"
 #include "diagnosis/diagnose.hpp"
 #include "io/atomic_write.hpp"
+#include "io/campaign_writer.hpp"
 #include "simulation/campaign_sim.hpp"
 #include "simulation/effects.hpp"
 
@@ -229,7 +230,7 @@ int main(int argc, char** argv) {
     const sim::SimulatedCampaign campaign = sim::SimulateCampaign(c.manifest, c.sim);
     if (!args.write_dir.empty()) {
       const std::string dir = fmt::format("{}/{:03d}_{}", args.write_dir, i, c.truth);
-      sim::WriteCampaign(campaign, dir + "/campaign");
+      io::WriteCampaign(campaign.manifest, campaign.data, dir + "/campaign");
       io::WriteFileAtomically(dir + "/truth.json", sim::CampaignTruthJson(campaign, c.sim).dump(2) + "\n");
     }
     // Blind: the diagnosis sees the manifest and the data only.

@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "simulation/monte_carlo.hpp"
-#include "simulation/wheel_noise_sim.hpp"
+#include "simulation/monte_carlo_kernel.hpp"
 
 using namespace umbmark;
 

@@ -18,6 +18,7 @@
 #include "diagnosis/gap_stats.hpp"
 #include "diagnosis/model.hpp"
 #include "diagnosis/piece_noise.hpp"
+#include "io/campaign_writer.hpp"
 #include "simulation/campaign_sim.hpp"
 #include "support/run_cli.hpp"
 
@@ -439,7 +440,7 @@ TEST_CASE("umbmark diagnose: contract JSON, report, plot", "[diagnose][cli]") {
   Small s = MakeSmall(81, 3, 6);
   s.sim.effects.time_tau = 0.06;
   const sim::SimulatedCampaign c = sim::SimulateCampaign(s.manifest, s.sim);
-  const std::string manifest = sim::WriteCampaign(c, (dir / "campaign").string());
+  const std::string manifest = io::WriteCampaign(c.manifest, c.data, (dir / "campaign").string());
   auto r = testing::RunCli("diagnose " + Q(manifest) + " --null-sims 100 --folds 3 --json " + Q(dir / "d.json") +
                            " --plot " + Q(dir / "gap.svg"));
   INFO(r.err);

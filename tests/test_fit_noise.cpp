@@ -9,11 +9,11 @@
 #include <vector>
 
 #include "core/angles.hpp"
-#include "error_models/noise_fit.hpp"
+#include "error_models/wheel_noise_fit.hpp"
 #include "error_models/path_covariance.hpp"
 #include "error_models/second_order.hpp"
 #include "error_models/trajectory_covariance.hpp"
-#include "simulation/wheel_noise_sim.hpp"
+#include "simulation/monte_carlo_kernel.hpp"
 
 using namespace umbmark;
 
@@ -34,7 +34,7 @@ struct Campaign {
 };
 
 /// n runs of `path`, return errors measured by a noisy reference, as fit input.
-std::vector<NoiseFitRun> SimulateCampaign(const std::vector<PathSegment>& spec, const std::string& group, int n,
+std::vector<WheelNoiseFitRun> SimulateCampaign(const std::vector<PathSegment>& spec, const std::string& group, int n,
                                           std::uint64_t seed, const Campaign& c, double extra_ey_sigma = 0.0) {
   sim::SimulationModel m;
   m.nominal.wheelbase_m = kB;
@@ -44,19 +44,19 @@ std::vector<NoiseFitRun> SimulateCampaign(const std::vector<PathSegment>& spec, 
   const auto path = ToWheelSegments(spec, kB);
   const sim::SimPlan plan = sim::CompilePlan(m, path, c.partitions);
   std::vector<Pose2> truth(static_cast<std::size_t>(n));
-  sim::SimulateRuns(plan, seed, 0, n, truth.data());
+  sim::SimulateFinalPoses(plan, seed, 0, n, truth.data());
   const PathCovarianceSummary pc = PredictPathCovariance(path, kB, WheelNoise{}, PoseCovariance::Zero());
   const SecondOrderBasis q2 = SecondOrderHeadingBasis(path, kB);
   std::mt19937_64 rng(seed ^ 0x5eedull);
   std::normal_distribution<double> N01;
-  std::vector<NoiseFitRun> runs;
+  std::vector<WheelNoiseFitRun> runs;
   for (int i = 0; i < n; ++i) {
     // The reference measures the start and the end pose, each with its own noise.
     const Pose2 start{c.sigma_xy * N01(rng), c.sigma_xy * N01(rng), c.sigma_theta * N01(rng)};
     const Pose2& t = truth[static_cast<std::size_t>(i)];
     const Pose2 end{t.x + c.sigma_xy * N01(rng), t.y + c.sigma_xy * N01(rng), t.theta + c.sigma_theta * N01(rng)};
     const Pose2 rel = RelativeTo(start, end);
-    NoiseFitRun r;
+    WheelNoiseFitRun r;
     r.group = group;
     r.run = std::to_string(i + 1);
     r.error = Eigen::Vector3d(rel.x - plan.odometry_final.x, rel.y - plan.odometry_final.y + extra_ey_sigma * N01(rng),
@@ -74,7 +74,7 @@ std::vector<NoiseFitRun> SimulateCampaign(const std::vector<PathSegment>& spec, 
 
 TEST_CASE("60 runs of 10 m forward and back: k_L and k_R recovered", "[fit_noise]") {
   const auto runs = SimulateCampaign(BackAndForthPath(10.0), "fwd_back", 60, 7, Campaign{});
-  const NoiseFitSummary s = FitNoise(runs);
+  const WheelNoiseFitSummary s = FitWheelNoise(runs);
   INFO(s.BriefReport());
   // One campaign: 60 runs pin each k to roughly +-25% (the interval
   // half-widths; k_L and k_R are negatively correlated, their sum is
@@ -85,17 +85,17 @@ TEST_CASE("60 runs of 10 m forward and back: k_L and k_R recovered", "[fit_noise
   CHECK(s.k_R == Approx(kTrueKR).epsilon(0.35));
   CHECK(s.k_L_ci[1] / s.k_L_ci[0] < 3.0);
   // The optimum is a minimum and the interval ends sit at the chi^2 threshold.
-  const double nll = NoiseNegLogLikelihood(runs, s.k_L, s.k_R);
+  const double nll = WheelNoiseNegLogLikelihood(runs, s.k_L, s.k_R);
   CHECK(nll == Approx(s.neg_log_likelihood).epsilon(1e-9));
   for (double f : {0.9, 1.1}) {
-    CHECK(NoiseNegLogLikelihood(runs, f * s.k_L, s.k_R) > nll);
-    CHECK(NoiseNegLogLikelihood(runs, s.k_L, f * s.k_R) > nll);
+    CHECK(WheelNoiseNegLogLikelihood(runs, f * s.k_L, s.k_R) > nll);
+    CHECK(WheelNoiseNegLogLikelihood(runs, s.k_L, f * s.k_R) > nll);
   }
   // At the upper bound of k_L, minimising over k_R gives NLL_min + 1.92.
   double best_profile = INFINITY;
   for (int i = -400; i <= 400; ++i) {
     const double kR = s.k_R * std::exp(0.002 * i);
-    best_profile = std::min(best_profile, NoiseNegLogLikelihood(runs, s.k_L_ci[1], kR));
+    best_profile = std::min(best_profile, WheelNoiseNegLogLikelihood(runs, s.k_L_ci[1], kR));
   }
   CHECK(best_profile - nll == Approx(0.5 * 3.841458820694124).epsilon(1e-3));
   // The systematic offset is absorbed by the group mean, not read as noise.
@@ -113,7 +113,7 @@ TEST_CASE("95% intervals cover the truth in 90-98% of 200 campaigns", "[fit_nois
   const int seeds = 200;
   for (int seed = 1; seed <= seeds; ++seed) {
     const auto runs = SimulateCampaign(BackAndForthPath(10.0), "fwd_back", 60, 1000 + seed, Campaign{});
-    const NoiseFitSummary s = FitNoise(runs);
+    const WheelNoiseFitSummary s = FitWheelNoise(runs);
     cover_L += s.k_L_ci[0] <= kTrueKL && kTrueKL <= s.k_L_ci[1];
     cover_R += s.k_R_ci[0] <= kTrueKR && kTrueKR <= s.k_R_ci[1];
     sum_L += s.k_L;
@@ -139,13 +139,13 @@ TEST_CASE("ignoring the reference's noise biases k; modelling it does not", "[fi
   c.sigma_xy = 0.002;  // a poor reference (2 mm, 0.3 deg)
   c.sigma_theta = Deg2Rad(0.3);
   auto runs = SimulateCampaign(BackAndForthPath(10.0), "fwd_back", 400, 99, c);
-  const NoiseFitSummary with = FitNoise(runs);
+  const WheelNoiseFitSummary with = FitWheelNoise(runs);
   CHECK(with.k_L_ci[0] <= kTrueKL);
   CHECK(with.k_L_ci[1] >= kTrueKL);
   CHECK(with.k_R_ci[0] <= kTrueKR);
   CHECK(with.k_R_ci[1] >= kTrueKR);
   for (auto& r : runs) r.measurement.setZero();
-  const NoiseFitSummary without = FitNoise(runs);
+  const WheelNoiseFitSummary without = FitWheelNoise(runs);
   // The reference noise is then attributed to the wheels: k_L is pushed up.
   CHECK(without.k_L > with.k_L_ci[1]);
 }
@@ -154,11 +154,11 @@ TEST_CASE("mixed path shapes and groups: squares both ways plus back-and-forth",
   Campaign c;
   c.offset.setZero();
   c.E_d = 1.0005;  // distinct cw / ccw systematic means (legs of 2 m bend little)
-  std::vector<NoiseFitRun> runs;
+  std::vector<WheelNoiseFitRun> runs;
   for (const auto& r : SimulateCampaign(SquarePath(2.0, true), "square:cw", 40, 5, c)) runs.push_back(r);
   for (const auto& r : SimulateCampaign(SquarePath(2.0, false), "square:ccw", 40, 6, c)) runs.push_back(r);
   for (const auto& r : SimulateCampaign(BackAndForthPath(2.0), "fwd_back", 40, 8, c)) runs.push_back(r);
-  const NoiseFitSummary s = FitNoise(runs);
+  const WheelNoiseFitSummary s = FitWheelNoise(runs);
   INFO(s.BriefReport());
   CHECK(s.groups.size() == 3);
   CHECK(s.k_L_ci[0] <= kTrueKL);
@@ -176,7 +176,7 @@ TEST_CASE("mixed path shapes and groups: squares both ways plus back-and-forth",
     m.truth.E_d = c.E_d;
     const sim::SimPlan plan = sim::CompilePlan(m, ToWheelSegments(specs[g], kB), 1);
     Pose2 truth;
-    sim::SimulateRuns(plan, 1, 0, 1, &truth);
+    sim::SimulateFinalPoses(plan, 1, 0, 1, &truth);
     const Eigen::Vector3d expected(truth.x - plan.odometry_final.x, truth.y - plan.odometry_final.y,
                                    truth.theta - plan.odometry_final.theta);
     const PoseCovariance& S = s.predicted_run_covariance[40 * g];
@@ -187,7 +187,7 @@ TEST_CASE("mixed path shapes and groups: squares both ways plus back-and-forth",
 
 TEST_CASE("trajectory input: Kelly's covariance from the ticks gives the same fit as the path", "[fit_noise]") {
   auto runs = SimulateCampaign(BackAndForthPath(10.0), "fwd_back", 60, 7, Campaign{});
-  const NoiseFitSummary a = FitNoise(runs);
+  const WheelNoiseFitSummary a = FitWheelNoise(runs);
   // Replace each run's basis by Kelly's form along sampled wheel travel (as
   // the encoders would log it): the same path, so the same fit.
   WheelTravel travel;
@@ -198,7 +198,7 @@ TEST_CASE("trajectory input: Kelly's covariance from the ticks gives the same fi
   }
   const TrajectoryCovarianceSummary kelly = TrajectoryCovariance(travel, kB);
   for (auto& r : runs) r.basis = kelly.motion;
-  const NoiseFitSummary b = FitNoise(runs);
+  const WheelNoiseFitSummary b = FitWheelNoise(runs);
   CHECK(b.k_L == Approx(a.k_L).epsilon(1e-6));
   CHECK(b.k_R == Approx(a.k_R).epsilon(1e-6));
 }
@@ -207,7 +207,7 @@ TEST_CASE("goodness of fit flags an unmodelled off-track error", "[fit_noise]") 
   // Extra white noise on ey only (e.g. wheel misalignment or outliers): the
   // wheel model cannot produce it without also inflating other elements.
   const auto runs = SimulateCampaign(BackAndForthPath(10.0), "fwd_back", 200, 3, Campaign{}, 0.03);
-  const NoiseFitSummary s = FitNoise(runs);
+  const WheelNoiseFitSummary s = FitWheelNoise(runs);
   double worst = 0.0;
   for (const auto& g : s.goodness_of_fit) worst = std::max(worst, std::abs(g.z));
   CHECK(worst > 4.0);
@@ -216,9 +216,9 @@ TEST_CASE("goodness of fit flags an unmodelled off-track error", "[fit_noise]") 
 TEST_CASE("fit-noise rejects data that cannot identify the model", "[fit_noise]") {
   auto runs = SimulateCampaign(BackAndForthPath(10.0), "fwd_back", 3, 1, Campaign{});
   runs[2].group = "other";
-  CHECK_THROWS_AS(FitNoise(runs), InputError);  // group with a single run
-  CHECK_THROWS_AS(FitNoise({}), InputError);
-  NoiseFitOptions bad;
+  CHECK_THROWS_AS(FitWheelNoise(runs), InputError);  // group with a single run
+  CHECK_THROWS_AS(FitWheelNoise({}), InputError);
+  WheelNoiseFitOptions bad;
   bad.confidence = 1.5;
-  CHECK_THROWS_AS(FitNoise(runs, bad), InvalidOptions);
+  CHECK_THROWS_AS(FitWheelNoise(runs, bad), InvalidOptions);
 }

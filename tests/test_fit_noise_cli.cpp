@@ -19,7 +19,7 @@
 
 #include "core/angles.hpp"
 #include "error_models/path_spec.hpp"
-#include "simulation/wheel_noise_sim.hpp"
+#include "simulation/monte_carlo_kernel.hpp"
 
 using namespace umbmark;
 namespace fs = std::filesystem;

@@ -20,10 +20,10 @@
 #include <random>
 #include <vector>
 
-#include "calibration/refine_stats.hpp"
+#include "stats/distributions.hpp"
 #include "calibration/umbmark.hpp"
 #include "core/angles.hpp"
-#include "simulation/commanded_square.hpp"
+#include "model/commanded_square.hpp"
 
 using namespace umbmark;
 using Catch::Matchers::WithinAbs;

@@ -14,7 +14,7 @@
 #include "core/runs.hpp"
 #include "evaluation/return_error.hpp"
 #include "kinematics/diff_drive.hpp"
-#include "simulation/commanded_square.hpp"
+#include "model/commanded_square.hpp"
 
 namespace umbmark::test {
 

@@ -82,7 +82,7 @@ TEST_CASE("simulate: files read back with the contract's readers", "[simulate]")
   const auto dir = testing::TempDir("simulate");
   CampaignSimOptions o = Small();
   const SimulatedCampaign c = SimulateCampaign(SmallManifest(), o);
-  const std::string manifest_path = WriteCampaign(c, dir.string());
+  const std::string manifest_path = io::WriteCampaign(c.manifest, c.data, dir.string());
   const Manifest m = io::ReadManifest(manifest_path);
   REQUIRE(m.experiments.size() == 2);
   REQUIRE(m.ground_truth);
@@ -118,7 +118,7 @@ TEST_CASE("simulate: endpoint squares are the trajectories' return errors", "[si
     CHECK(runs[i].ey_m == errors[i].ey_m);
   }
   const auto dir = testing::TempDir("simulate-ep");
-  const std::string path = WriteCampaign(ep, dir.string());
+  const std::string path = io::WriteCampaign(ep.manifest, ep.data, dir.string());
   const Manifest m = io::ReadManifest(path);
   const io::RunFile rf = io::ReadRunFile(m.experiments[0].resolved_file);
   REQUIRE(std::holds_alternative<EndpointData>(rf));

@@ -11,11 +11,11 @@
 #include "core/angles.hpp"
 #include "error_models/path_covariance.hpp"
 #include "kinematics/diff_drive.hpp"
-#include "simulation/commanded_square.hpp"
+#include "model/commanded_square.hpp"
 #include "simulation/fast_math.hpp"
 #include "simulation/monte_carlo.hpp"
 #include "simulation/rng.hpp"
-#include "simulation/wheel_noise_sim.hpp"
+#include "simulation/monte_carlo_kernel.hpp"
 
 using namespace umbmark;
 using namespace umbmark::sim;
@@ -143,7 +143,7 @@ TEST_CASE("kernel equals a scalar libm re-implementation on the same streams", "
   for (std::size_t c = 0; c < paths.size(); ++c) {
     const SimPlan plan = CompilePlan(BasicModel(0.4, 0.01, 0.02), paths[c], partitions[c]);
     std::vector<Pose2> out(21);
-    SimulateRuns(plan, 99, 5, 21, out.data());
+    SimulateFinalPoses(plan, 99, 5, 21, out.data());
     for (int i = 0; i < 21; ++i) {
       const Pose2 ref = ScalarReferenceRun(plan, 99, static_cast<std::uint64_t>(5 + i));
       CHECK(out[static_cast<std::size_t>(i)].x == Approx(ref.x).margin(1e-12));
@@ -160,7 +160,7 @@ TEST_CASE("zero noise reproduces the exact arc for any partition count", "[simul
   for (int p : {1, 7, 1000}) {
     const SimPlan plan = CompilePlan(BasicModel(0.4, 0.0, 0.0), path, p);
     Pose2 out;
-    SimulateRuns(plan, 1, 0, 1, &out);
+    SimulateFinalPoses(plan, 1, 0, 1, &out);
     CHECK(out.x == Approx(exact.x).margin(1e-12));
     CHECK(out.y == Approx(exact.y).margin(1e-12));
     CHECK(out.theta == Approx(exact.theta).margin(1e-12));
@@ -175,7 +175,7 @@ TEST_CASE("true vs nominal parameters: E_d, E_b and scale follow the contract", 
   const auto square = ToWheelSegments(SquarePath(4.0, /*clockwise=*/true), b);
   const SimPlan plan = CompilePlan(m, square, 50);
   Pose2 out;
-  SimulateRuns(plan, 3, 0, 1, &out);
+  SimulateFinalPoses(plan, 3, 0, 1, &out);
   // Independent reference: the calibration module's commanded square.
   const double c_L = 2.0 / (m.truth.E_d + 1.0), c_R = 2.0 / (1.0 / m.truth.E_d + 1.0);
   const Pose2 ref =
@@ -188,7 +188,7 @@ TEST_CASE("true vs nominal parameters: E_d, E_b and scale follow the contract", 
   SimulationModel ms = BasicModel(0.34, 0.0, 0.0);
   ms.truth.scale = 0.015;
   Pose2 line;
-  SimulateRuns(CompilePlan(ms, {{10.0, 10.0}}, 10), 3, 0, 1, &line);
+  SimulateFinalPoses(CompilePlan(ms, {{10.0, 10.0}}, 10), 3, 0, 1, &line);
   CHECK(line.x == Approx(10.15).epsilon(1e-13));
 }
 
@@ -243,11 +243,11 @@ TEST_CASE("all SIMD kernels give identical bits", "[simulator]") {
   const SimPlan plan = CompilePlan(BasicModel(0.4, 0.01, 0.02), {{3.0, 1.0}, {0.0, 2.0}, {-0.6, 0.6}}, 50);
   const std::string best = SimKernelName();
   std::vector<Pose2> ref(37);
-  SimulateRuns(plan, 123, 3, 37, ref.data());
+  SimulateFinalPoses(plan, 123, 3, 37, ref.data());
   for (const std::string& k : SimKernelsAvailable()) {
     REQUIRE(SelectSimKernel(k));
     std::vector<Pose2> out(37);
-    SimulateRuns(plan, 123, 3, 37, out.data());
+    SimulateFinalPoses(plan, 123, 3, 37, out.data());
     for (std::size_t i = 0; i < out.size(); ++i) {
       INFO("kernel " << k << " run " << i);
       CHECK(out[i].x == ref[i].x);
@@ -262,8 +262,8 @@ TEST_CASE("all SIMD kernels give identical bits", "[simulator]") {
 TEST_CASE("every run depends only on (seed, run index): lanes, blocks, threads", "[simulator]") {
   const SimPlan plan = CompilePlan(BasicModel(0.4, 0.003, 0.002), {{3.0, 1.0}}, 100);
   std::vector<Pose2> all(40), part(3);
-  SimulateRuns(plan, 5, 0, 40, all.data());
-  SimulateRuns(plan, 5, 17, 3, part.data());
+  SimulateFinalPoses(plan, 5, 0, 40, all.data());
+  SimulateFinalPoses(plan, 5, 17, 3, part.data());
   for (int i = 0; i < 3; ++i) {
     CHECK(part[static_cast<std::size_t>(i)].x == all[static_cast<std::size_t>(17 + i)].x);
     CHECK(part[static_cast<std::size_t>(i)].theta == all[static_cast<std::size_t>(17 + i)].theta);
@@ -274,7 +274,7 @@ TEST_CASE("every run depends only on (seed, run index): lanes, blocks, threads",
   CHECK(tr[1].truth.size() == 10);
   // Different seeds differ.
   Pose2 other;
-  SimulateRuns(plan, 6, 17, 1, &other);
+  SimulateFinalPoses(plan, 6, 17, 1, &other);
   CHECK(other.x != part[0].x);
 
   MonteCarloOptions o;

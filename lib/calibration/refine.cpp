@@ -18,7 +18,7 @@
 #include <fmt/format.h>
 
 #include "calibration/refine_internal.hpp"
-#include "calibration/refine_stats.hpp"
+#include "stats/distributions.hpp"
 
 namespace umbmark {
 

@@ -5,7 +5,7 @@
 // Two inputs:
 //  - Return errors of UMBmark squares (endpoint CSV, or trajectories reduced
 //    to their return errors): the exact commanded-square model
-//    (simulation/commanded_square.hpp) predicts every run's return error;
+//    (model/commanded_square.hpp) predicts every run's return error;
 //    every run is a residual, weighted by the run-to-run scatter of its
 //    (set, direction) group (rules and small-sample corrections:
 //    refine_endpoint.cpp; choices and their checks: docs/refine.md).

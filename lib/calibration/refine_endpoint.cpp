@@ -36,7 +36,7 @@
 #include "calibration/refine.hpp"
 #include "calibration/refine_internal.hpp"
 #include "calibration/refine_residuals.hpp"
-#include "simulation/commanded_square.hpp"
+#include "model/commanded_square.hpp"
 
 namespace umbmark {
 

@@ -16,8 +16,8 @@
 #include "calibration/refine_params.hpp"
 #include "core/angles.hpp"
 #include "kinematics/diff_drive.hpp"
-#include "kinematics/pose2.hpp"
-#include "simulation/commanded_square.hpp"
+#include "core/pose2.hpp"
+#include "model/commanded_square.hpp"
 
 namespace umbmark {
 

@@ -9,10 +9,11 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "core/robot.hpp"
-#include "kinematics/pose2.hpp"
+#include "core/pose2.hpp"
 
 namespace umbmark {
 
@@ -58,6 +59,9 @@ struct TrajectoryData {
   std::string path;
   std::vector<TrajectoryRun> runs;
 };
+
+/// The data of one experiment: return errors or logged trajectories.
+using ExperimentData = std::variant<EndpointData, TrajectoryData>;
 
 /// Experiment kinds of the campaign manifest.
 enum class ExperimentKind { kSquare, kBackAndForth, kFree };

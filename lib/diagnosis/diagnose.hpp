@@ -109,7 +109,7 @@ struct BaselineSummary {
   std::vector<GrowthRow> growth;
   int pieces = 0, runs = 0;
   /// Cross-check: k_L, k_R from the runs' return errors alone by the
-  /// fit-noise estimator (error_models/noise_fit.hpp: systematic mean per
+  /// fit-noise estimator (error_models/wheel_noise_fit.hpp: systematic mean per
   /// experiment and direction, Kelly's covariance along each run, the
   /// ground truth's noise), with 95 % profile intervals. Absent when that
   /// fit cannot run (too few runs per group); a disagreement with the piece

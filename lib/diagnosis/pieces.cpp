@@ -17,7 +17,7 @@
 #include "io/manifest.hpp"
 #include "kinematics/diff_drive.hpp"
 #include "kinematics/odometry.hpp"
-#include "simulation/commanded_square.hpp"
+#include "model/commanded_square.hpp"
 
 namespace umbmark::diag {
 

@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "core/runs.hpp"
-#include "kinematics/pose2.hpp"
+#include "core/pose2.hpp"
 #include "simulation/effects_motion.hpp"
 
 namespace umbmark::diag {

@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 
 #include "core/angles.hpp"
-#include "error_models/noise_fit.hpp"
+#include "error_models/wheel_noise_fit.hpp"
 #include "error_models/trajectory_covariance.hpp"
 #include "kinematics/odometry.hpp"
 
@@ -22,7 +22,7 @@ namespace {
 void PredictReturns(const CampaignData& c, const MeanModel& model, const BaselineFit& b, ReturnCheck& out) {
   const ParamVector& p = b.p;
   const NoiseParams& noise = b.noise;
-  std::vector<NoiseFitRun> fit_runs;
+  std::vector<WheelNoiseFitRun> fit_runs;
   std::map<std::pair<int, std::string>, std::vector<int>> groups;
   for (std::size_t r = 0; r < c.runs.size(); ++r) groups[{c.runs[r].experiment, c.runs[r].direction}].push_back(static_cast<int>(r));
   const WheelNoise wn{std::sqrt(noise.kL2), std::sqrt(noise.kR2)};
@@ -58,7 +58,7 @@ void PredictReturns(const CampaignData& c, const MeanModel& model, const Baselin
       wt.left_m.assign(r.left.begin() + static_cast<std::ptrdiff_t>(g0), r.left.begin() + static_cast<std::ptrdiff_t>(g1 + 1));
       wt.right_m.assign(r.right.begin() + static_cast<std::ptrdiff_t>(g0), r.right.begin() + static_cast<std::ptrdiff_t>(g1 + 1));
       const TrajectoryCovarianceSummary tc = TrajectoryCovariance(wt, c.robot.wheelbase_m * p[kParamEb]);
-      NoiseFitRun fr;
+      WheelNoiseFitRun fr;
       fr.group = fmt::format("exp{}:{}", r.experiment + 1, r.direction);
       fr.run = r.id;
       fr.error = eo;
@@ -85,7 +85,7 @@ void PredictReturns(const CampaignData& c, const MeanModel& model, const Baselin
     out.returns.push_back(rp);
   }
   try {
-    const NoiseFitSummary nf = umbmark::FitNoise(fit_runs);
+    const WheelNoiseFitSummary nf = umbmark::FitWheelNoise(fit_runs);
     out.return_fit = true;
     out.return_k_L = nf.k_L;
     out.return_k_R = nf.k_R;

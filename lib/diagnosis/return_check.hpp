@@ -1,7 +1,7 @@
 // Stage "return-error check" of the diagnosis: the fitted baseline seen the
 // way a calibration engineer sees a campaign -- predicted vs observed return
 // errors (mean, covariance) per experiment and direction, a cross-check of
-// k_L, k_R by the return-error noise estimator (error_models/noise_fit.hpp),
+// k_L, k_R by the return-error noise estimator (error_models/wheel_noise_fit.hpp),
 // and the residual growth per segment type.
 #pragma once
 

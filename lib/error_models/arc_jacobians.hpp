@@ -18,7 +18,7 @@
 
 #include <Eigen/Core>
 
-#include "kinematics/pose2.hpp"
+#include "core/pose2.hpp"
 
 namespace umbmark {
 

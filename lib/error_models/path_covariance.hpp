@@ -11,7 +11,7 @@
 
 #include "error_models/path_spec.hpp"
 #include "error_models/wheel_noise.hpp"
-#include "kinematics/pose2.hpp"
+#include "core/pose2.hpp"
 
 namespace umbmark {
 

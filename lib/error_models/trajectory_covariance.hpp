@@ -16,7 +16,7 @@
 
 #include "error_models/wheel_noise.hpp"
 #include "kinematics/odometry.hpp"
-#include "kinematics/pose2.hpp"
+#include "core/pose2.hpp"
 
 namespace umbmark {
 

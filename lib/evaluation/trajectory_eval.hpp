@@ -9,7 +9,7 @@
 #include "core/robot.hpp"
 #include "core/runs.hpp"
 #include "kinematics/diff_drive.hpp"
-#include "kinematics/pose2.hpp"
+#include "core/pose2.hpp"
 
 namespace umbmark {
 

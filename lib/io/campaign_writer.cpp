@@ -1,9 +1,15 @@
-// Writers for trajectory CSV and campaign manifests (see campaign_writer.hpp).
+// Writers for trajectory and endpoint CSV and campaign manifests, and the
+// whole campaign directory (see campaign_writer.hpp).
 #include "io/campaign_writer.hpp"
 
 #include <cmath>
+#include <filesystem>
+#include <set>
 
 #include <fmt/format.h>
+
+#include "core/errors.hpp"
+#include "io/atomic_write.hpp"
 
 namespace umbmark::io {
 
@@ -73,6 +79,52 @@ std::string FormatManifest(const Manifest& manifest, const std::vector<std::stri
     out += "file = " + TomlString(e.file) + "\n";
   }
   return out;
+}
+
+std::string FormatEndpointCsv(const EndpointData& data, const std::vector<std::string>& comment) {
+  std::string out;
+  for (const auto& line : comment) out += "# " + line + "\n";
+  out += "run,direction,ex_m,ey_m,etheta_rad\n";
+  for (const auto& r : data.runs) {
+    out += fmt::format("{},{},{},{},", r.run, r.direction, r.ex_m, r.ey_m);
+    if (r.etheta_rad) out += fmt::format("{}", *r.etheta_rad);
+    out += "\n";
+  }
+  return out;
+}
+
+std::string WriteCampaign(const Manifest& manifest, const std::vector<ExperimentData>& data, const std::string& dir,
+                          const std::vector<std::string>& comment) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) throw InputError(dir, "cannot create output directory: " + ec.message());
+  if (data.size() != manifest.experiments.size())
+    throw InputError(manifest.path, fmt::format("{} experiments but {} data sets to write", manifest.experiments.size(), data.size()));
+  std::set<std::string> names = {"campaign.toml"};
+  for (std::size_t e = 0; e < manifest.experiments.size(); ++e) {
+    const std::string& file = manifest.experiments[e].file;
+    const fs::path rel = fs::path(file).lexically_normal();
+    if (rel.is_absolute() || rel.empty() || *rel.begin() == "..")
+      throw InputError(manifest.path,
+                       fmt::format("experiment {}: file '{}' must be a relative path inside the output directory",
+                                   e + 1, file));
+    if (!names.insert(rel.string()).second)
+      throw InputError(manifest.path,
+                       fmt::format("experiment {}: file '{}' is used twice (or is campaign.toml)", e + 1, file));
+  }
+  for (std::size_t e = 0; e < manifest.experiments.size(); ++e) {
+    const fs::path target = fs::path(dir) / manifest.experiments[e].file;
+    fs::create_directories(target.parent_path(), ec);
+    const auto& d = data[e];
+    if (const auto* t = std::get_if<TrajectoryData>(&d))
+      WriteFileAtomically(target.string(), FormatTrajectoryCsv(*t, comment));
+    else
+      WriteFileAtomically(target.string(), FormatEndpointCsv(std::get<EndpointData>(d), comment));
+  }
+  const std::string manifest_path = (fs::path(dir) / "campaign.toml").string();
+  WriteFileAtomically(manifest_path, FormatManifest(manifest, comment));
+  return manifest_path;
 }
 
 }  // namespace umbmark::io

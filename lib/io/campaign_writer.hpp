@@ -1,5 +1,5 @@
-// Writers for the contract's trajectory CSV and campaign manifest, used by
-// `import optiodom` and `simulate`. Numbers are written in shortest
+// Writers for the contract's trajectory and endpoint CSV and campaign
+// manifest, used by `import optiodom` and `simulate`. Numbers are written in shortest
 // round-trip form, so reading back gives the same doubles.
 #pragma once
 
@@ -18,5 +18,16 @@ std::string FormatTrajectoryCsv(const TrajectoryData& data, const std::vector<st
 /// Campaign manifest TOML text for `manifest` (experiment `file` entries are
 /// written as given, relative to the manifest).
 std::string FormatManifest(const Manifest& manifest, const std::vector<std::string>& comment = {});
+
+/// Endpoint CSV text (run,direction,ex_m,ey_m,etheta_rad).
+std::string FormatEndpointCsv(const EndpointData& data, const std::vector<std::string>& comment = {});
+
+/// Writes a campaign into `dir` (created if missing): `campaign.toml` and one
+/// file per experiment (data[e] for manifest.experiments[e], named by its
+/// `file`), all atomically. Returns the manifest path. Throws InputError
+/// when a file cannot be written, two experiments name the same file, or
+/// data and experiments differ in number.
+std::string WriteCampaign(const Manifest& manifest, const std::vector<ExperimentData>& data, const std::string& dir,
+                          const std::vector<std::string>& comment = {});
 
 }  // namespace umbmark::io

@@ -22,7 +22,7 @@
 #include <string>
 #include <string_view>
 
-#include "kinematics/pose2.hpp"
+#include "core/pose2.hpp"
 
 namespace umbmark {
 

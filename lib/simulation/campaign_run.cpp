@@ -65,28 +65,28 @@ Pose2 AdvancePose(const Pose2& p, double l, double r, double wheelbase, double h
 
 }  // namespace
 
-SimulatedRun SimulateRun(const RunPlan& plan, const RunTruth& truth, std::uint64_t seed, std::uint64_t run_index,
+SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::uint64_t seed, std::uint64_t run_index,
                          const std::string& run_id, const std::string& direction) {
   const Effects& fx = truth.effects;
-  if (!(truth.true_wheelbase_m > 0.0)) throw InvalidOptions("SimulateRun: true wheelbase must be > 0");
+  if (!(truth.true_wheelbase_m > 0.0)) throw InvalidOptions("SimulateLoggedRun: true wheelbase must be > 0");
   double total = 0.0;
   for (const auto& m : plan.motions) {
     if (!(m.duration_s >= 0.0) || !std::isfinite(m.duration_s))
-      throw InvalidOptions(fmt::format("SimulateRun: motion duration {} must be finite and >= 0", m.duration_s));
+      throw InvalidOptions(fmt::format("SimulateLoggedRun: motion duration {} must be finite and >= 0", m.duration_s));
     total += m.duration_s;
   }
   std::vector<double> ts = plan.sample_times;
   if (ts.empty()) {
-    if (!(plan.sample_rate_hz > 0.0)) throw InvalidOptions("SimulateRun: sample_rate_hz must be > 0");
+    if (!(plan.sample_rate_hz > 0.0)) throw InvalidOptions("SimulateLoggedRun: sample_rate_hz must be > 0");
     const double dt = 1.0 / plan.sample_rate_hz;
     const auto k = static_cast<std::size_t>(std::ceil(total / dt - 1e-9));
     ts.resize(k + 1);
     for (std::size_t j = 0; j <= k; ++j) ts[j] = static_cast<double>(j) * dt;
   }
-  if (ts.front() != 0.0) throw InvalidOptions("SimulateRun: the first sample time must be 0");
+  if (ts.front() != 0.0) throw InvalidOptions("SimulateLoggedRun: the first sample time must be 0");
   for (std::size_t j = 1; j < ts.size(); ++j)
-    if (!(ts[j] > ts[j - 1])) throw InvalidOptions("SimulateRun: sample times must increase strictly");
-  if (ts.back() < total - 1e-9) throw InvalidOptions("SimulateRun: the samples end before the plan does");
+    if (!(ts[j] > ts[j - 1])) throw InvalidOptions("SimulateLoggedRun: sample times must increase strictly");
+  if (ts.back() < total - 1e-9) throw InvalidOptions("SimulateLoggedRun: the samples end before the plan does");
 
   NormalSource wheel_rng(StreamSeed(seed, run_index, kCampaignStreamWheelNoise));
   NormalSource bump_rng(StreamSeed(seed, run_index, kCampaignStreamBumps));

@@ -50,7 +50,7 @@
 #include <vector>
 
 #include "core/runs.hpp"
-#include "kinematics/pose2.hpp"
+#include "core/pose2.hpp"
 #include "simulation/effects.hpp"
 #include "simulation/effects_motion.hpp"
 
@@ -109,7 +109,7 @@ struct SimulatedRun {
 
 /// Executes `plan` on `truth`. `run_index` is the run's index in the campaign
 /// (random streams). Throws InvalidOptions for an inconsistent plan.
-SimulatedRun SimulateRun(const RunPlan& plan, const RunTruth& truth, std::uint64_t seed, std::uint64_t run_index,
+SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::uint64_t seed, std::uint64_t run_index,
                          const std::string& run_id, const std::string& direction);
 
 }  // namespace umbmark::sim

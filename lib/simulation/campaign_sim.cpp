@@ -1,10 +1,8 @@
 // Campaign simulator (see campaign_sim.hpp): plans per experiment kind, the
-// true robot per run, and the writers.
+// true robot per run, and the truth as JSON.
 #include "simulation/campaign_sim.hpp"
 
 #include <cmath>
-#include <filesystem>
-#include <set>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -12,8 +10,6 @@
 #include "core/angles.hpp"
 #include "core/errors.hpp"
 #include "evaluation/return_error.hpp"
-#include "io/atomic_write.hpp"
-#include "io/campaign_writer.hpp"
 #include "kinematics/odometry.hpp"
 #include "simulation/campaign_run.hpp"
 #include "simulation/effects_motion.hpp"
@@ -239,7 +235,7 @@ SimulatedCampaign SimulateCampaign(const Manifest& manifest, const CampaignSimOp
       const double drift = 1.0 + options.effects.drift_r * static_cast<double>(run_index);
       truth.true_per_tick_left = truth.nominal_per_tick_left * c_L * scale;
       truth.true_per_tick_right = truth.nominal_per_tick_right * c_R * scale * drift;
-      SimulatedRun sr = SimulateRun(pr.plan, truth, options.seed, run_index, pr.id, pr.direction);
+      SimulatedRun sr = SimulateLoggedRun(pr.plan, truth, options.seed, run_index, pr.id, pr.direction);
       out.bumps[e].push_back(sr.bumps_left + sr.bumps_right);
       data.runs.push_back(std::move(sr.run));
       ++run_index;
@@ -262,50 +258,6 @@ SimulatedCampaign SimulateCampaign(const Manifest& manifest, const CampaignSimOp
     }
   }
   return out;
-}
-
-std::string FormatEndpointCsv(const EndpointData& data, const std::vector<std::string>& comment) {
-  std::string out;
-  for (const auto& line : comment) out += "# " + line + "\n";
-  out += "run,direction,ex_m,ey_m,etheta_rad\n";
-  for (const auto& r : data.runs) {
-    out += fmt::format("{},{},{},{},", r.run, r.direction, r.ex_m, r.ey_m);
-    if (r.etheta_rad) out += fmt::format("{}", *r.etheta_rad);
-    out += "\n";
-  }
-  return out;
-}
-
-std::string WriteCampaign(const SimulatedCampaign& campaign, const std::string& dir,
-                          const std::vector<std::string>& comment) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir)) throw InputError(dir, "cannot create output directory: " + ec.message());
-  std::set<std::string> names = {"campaign.toml"};
-  for (std::size_t e = 0; e < campaign.manifest.experiments.size(); ++e) {
-    const std::string& file = campaign.manifest.experiments[e].file;
-    const fs::path rel = fs::path(file).lexically_normal();
-    if (rel.is_absolute() || rel.empty() || *rel.begin() == "..")
-      throw InputError(campaign.manifest.path,
-                       fmt::format("experiment {}: file '{}' must be a relative path inside the output directory",
-                                   e + 1, file));
-    if (!names.insert(rel.string()).second)
-      throw InputError(campaign.manifest.path,
-                       fmt::format("experiment {}: file '{}' is used twice (or is campaign.toml)", e + 1, file));
-  }
-  for (std::size_t e = 0; e < campaign.manifest.experiments.size(); ++e) {
-    const fs::path target = fs::path(dir) / campaign.manifest.experiments[e].file;
-    fs::create_directories(target.parent_path(), ec);
-    const auto& d = campaign.data[e];
-    if (const auto* t = std::get_if<TrajectoryData>(&d))
-      io::WriteFileAtomically(target.string(), io::FormatTrajectoryCsv(*t, comment));
-    else
-      io::WriteFileAtomically(target.string(), FormatEndpointCsv(std::get<EndpointData>(d), comment));
-  }
-  const std::string manifest_path = (fs::path(dir) / "campaign.toml").string();
-  io::WriteFileAtomically(manifest_path, io::FormatManifest(campaign.manifest, comment));
-  return manifest_path;
 }
 
 nlohmann::json CampaignTruthJson(const SimulatedCampaign& campaign, const CampaignSimOptions& options) {

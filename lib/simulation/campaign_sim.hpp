@@ -3,7 +3,7 @@
 // E_d, E_b, wheel noise k_L, k_R, encoder ticks, ground truth with
 // measurement noise) with any of the contract's effects (effects.hpp), and
 // returns the campaign in the contract's formats (manifest + trajectory or
-// endpoint CSV per experiment).
+// endpoint CSV per experiment; io/campaign_writer.hpp writes them).
 //
 // The true robot relative to the manifest's [robot] (what the odometry uses):
 //   D_L,true = c_L D_L (1 + s),  D_R,true = c_R D_R (1 + s) (1 + r i),
@@ -92,7 +92,7 @@ struct CampaignSimOptions {
 struct SimulatedCampaign {
   Manifest manifest;  ///< experiments with `file` as in the input manifest
   /// Per experiment: the trajectory or endpoint data written to its file.
-  std::vector<std::variant<EndpointData, TrajectoryData>> data;
+  std::vector<ExperimentData> data;
   GroundTruthNoise ground_truth_noise;  ///< what was applied
   int total_runs = 0;
   std::uint64_t seed = 0;
@@ -108,16 +108,6 @@ struct SimulatedCampaign {
 /// ticks_per_rev).
 SimulatedCampaign SimulateCampaign(const Manifest& manifest, const CampaignSimOptions& options,
                                    const std::vector<std::optional<TrajectoryData>>& free_templates = {});
-
-/// Writes `campaign` into `dir` (created if missing): `campaign.toml` and one
-/// file per experiment, named by its `file`, all atomically. Returns the
-/// manifest path. Throws InputError when a file cannot be written or two
-/// experiments name the same file.
-std::string WriteCampaign(const SimulatedCampaign& campaign, const std::string& dir,
-                          const std::vector<std::string>& comment = {});
-
-/// Endpoint CSV text (run,direction,ex_m,ey_m,etheta_rad).
-std::string FormatEndpointCsv(const EndpointData& data, const std::vector<std::string>& comment = {});
 
 /// The truth behind a campaign (seed, true robot, effects with their
 /// parameters, ground-truth noise, run counts) as JSON.

@@ -10,7 +10,7 @@
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
-#include "simulation/wheel_noise_sim.hpp"
+#include "simulation/monte_carlo_kernel.hpp"
 
 namespace umbmark::sim {
 
@@ -41,7 +41,7 @@ MonteCarloSummary RunMonteCarlo(const SimPlan& plan, const MonteCarloOptions& op
   // Reference: the noise-free true final pose (the plan with zero noise is
   // not needed; the first run is close enough and deterministic).
   Pose2 ref;
-  SimulateRuns(plan, options.seed, 0, 1, &ref);
+  SimulateFinalPoses(plan, options.seed, 0, 1, &ref);
   const Eigen::Vector3d r0(ref.x, ref.y, ref.theta);
 
   std::vector<BlockSums> sums(static_cast<std::size_t>(nblocks));
@@ -53,7 +53,7 @@ MonteCarloSummary RunMonteCarlo(const SimPlan& plan, const MonteCarloOptions& op
     for (std::int64_t k = next.fetch_add(1); k < nblocks; k = next.fetch_add(1)) {
       const std::int64_t first = k * block;
       const std::int64_t n = std::min(block, runs - first);
-      SimulateRuns(plan, options.seed, first, n, poses.data());
+      SimulateFinalPoses(plan, options.seed, first, n, poses.data());
       BlockSums& s = sums[static_cast<std::size_t>(k)];
       for (std::int64_t i = 0; i < n; ++i) {
         const Pose2& p = poses[static_cast<std::size_t>(i)];

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "error_models/wheel_noise.hpp"
-#include "kinematics/pose2.hpp"
-#include "simulation/sim_model.hpp"
+#include "core/pose2.hpp"
+#include "simulation/monte_carlo_plan.hpp"
 
 namespace umbmark::sim {
 

@@ -1,4 +1,4 @@
-// Turns the contract's data files into fit-noise runs (noise_fit.hpp):
+// Turns the contract's data files into fit-noise runs (wheel_noise_fit.hpp):
 //  - endpoint CSV + the commanded path of every run (e.g. D forward then D
 //    back, `--distance D`): the covariance basis from the closed forms
 //    along that path;
@@ -15,7 +15,7 @@
 
 #include "core/robot.hpp"
 #include "core/runs.hpp"
-#include "error_models/noise_fit.hpp"
+#include "error_models/wheel_noise_fit.hpp"
 #include "error_models/path_spec.hpp"
 
 namespace umbmark {
@@ -30,14 +30,14 @@ struct NoiseFitInputOptions {
 
 /// One run per endpoint row; `path` is what every run drove (wheelbase_m
 /// resolves turn segments). Rows without etheta use the x-y block.
-std::vector<NoiseFitRun> NoiseRunsFromEndpoints(const EndpointData& data, const std::vector<PathSegment>& path,
+std::vector<WheelNoiseFitRun> NoiseRunsFromEndpoints(const EndpointData& data, const std::vector<PathSegment>& path,
                                                 double wheelbase_m, const std::string& group_prefix,
                                                 const NoiseFitInputOptions& options);
 
 /// One run per trajectory run that has ground truth at its first and last
 /// sample (others are counted in *skipped). Throws InputError (data.path)
 /// when ticks cannot be converted (no ticks_per_rev).
-std::vector<NoiseFitRun> NoiseRunsFromTrajectories(const TrajectoryData& data, const RobotParams& robot,
+std::vector<WheelNoiseFitRun> NoiseRunsFromTrajectories(const TrajectoryData& data, const RobotParams& robot,
                                                    const std::string& group_prefix,
                                                    const NoiseFitInputOptions& options, int* skipped = nullptr);
 

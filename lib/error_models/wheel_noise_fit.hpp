@@ -38,12 +38,12 @@
 
 #include "error_models/second_order.hpp"
 #include "error_models/wheel_noise.hpp"
-#include "kinematics/pose2.hpp"
+#include "core/pose2.hpp"
 
 namespace umbmark {
 
 /// One run's data for the fit.
-struct NoiseFitRun {
+struct WheelNoiseFitRun {
   std::string group;  ///< systematic-mean group (e.g. "fwd_back" or "exp2:cw")
   std::string run;    ///< run id (for reports)
   Eigen::Vector3d error = Eigen::Vector3d::Zero();  ///< [ex, ey, etheta] (etheta wrapped)
@@ -62,7 +62,7 @@ struct NoiseFitRun {
 ///   M = diag(2 s_xy^2, 2 s_xy^2, s_th^2) + s_th^2 u u^T,  u = [y, -x, -1].
 PoseCovariance MeasurementCovariance(double sigma_xy_m, double sigma_theta_rad, const Pose2& relative);
 
-struct NoiseFitOptions {
+struct WheelNoiseFitOptions {
   /// Confidence level of the profile-likelihood intervals, in (0, 1).
   double confidence = 0.95;
   /// L-BFGS iteration limit of each optimisation (>= 10).
@@ -85,7 +85,7 @@ struct CovarianceElementCheck {
   int runs = 0;              ///< runs that enter this element
 };
 
-struct NoiseFitSummary {
+struct WheelNoiseFitSummary {
   double k_L = 0.0, k_R = 0.0;                     ///< [m^1/2]
   std::array<double, 2> k_L_ci{0.0, 0.0};          ///< profile interval (high may be +inf)
   std::array<double, 2> k_R_ci{0.0, 0.0};
@@ -109,10 +109,10 @@ struct NoiseFitSummary {
 /// "") when the data cannot identify the model (fewer than groups + 2 runs,
 /// a group with a single run, non-finite errors), and QualityGateError when
 /// the solver fails to converge or the likelihood is not finite at the fit.
-NoiseFitSummary FitNoise(const std::vector<NoiseFitRun>& runs, const NoiseFitOptions& options = {});
+WheelNoiseFitSummary FitWheelNoise(const std::vector<WheelNoiseFitRun>& runs, const WheelNoiseFitOptions& options = {});
 
 /// Negative log-likelihood (constants dropped) at given k with the group
 /// means profiled out; +inf when some S_i is not positive definite.
-double NoiseNegLogLikelihood(const std::vector<NoiseFitRun>& runs, double k_L, double k_R);
+double WheelNoiseNegLogLikelihood(const std::vector<WheelNoiseFitRun>& runs, double k_L, double k_R);
 
 }  // namespace umbmark

@@ -1,5 +1,5 @@
 // The Monte Carlo engine's run simulator: executes a compiled SimPlan
-// (sim_model.hpp) for a range of runs and returns each run's true final
+// (monte_carlo_plan.hpp) for a range of runs and returns each run's true final
 // pose, or its trace. Each run is a function of (plan, seed, run index) only.
 //
 // Kernel: runs are simulated kSimLanes at a time, one per SIMD lane, with
@@ -22,8 +22,8 @@
 #include <string>
 #include <vector>
 
-#include "kinematics/pose2.hpp"
-#include "simulation/sim_model.hpp"
+#include "core/pose2.hpp"
+#include "simulation/monte_carlo_plan.hpp"
 
 namespace umbmark::sim {
 
@@ -43,7 +43,7 @@ bool SelectSimKernel(const std::string& name);
 
 /// True final pose (start frame, theta continuous) of runs first_run ..
 /// first_run + count - 1, written to out[0 .. count-1].
-void SimulateRuns(const SimPlan& plan, std::uint64_t seed, std::int64_t first_run, std::int64_t count, Pose2* out);
+void SimulateFinalPoses(const SimPlan& plan, std::uint64_t seed, std::int64_t first_run, std::int64_t count, Pose2* out);
 
 /// One run recorded along the way.
 struct RunTrace {
@@ -64,7 +64,7 @@ struct RunTrace {
 };
 
 /// Traces of runs first_run .. first_run + count - 1 (same numbers as
-/// SimulateRuns). record_every >= 1.
+/// SimulateFinalPoses). record_every >= 1.
 std::vector<RunTrace> SimulateTraces(const SimPlan& plan, std::uint64_t seed, std::int64_t first_run,
                                      std::int64_t count, int record_every);
 

@@ -1,5 +1,5 @@
 // Exact model of the commanded UMBmark square (see commanded_square.hpp).
-#include "simulation/commanded_square.hpp"
+#include "model/commanded_square.hpp"
 
 #include "core/angles.hpp"
 

@@ -1,6 +1,6 @@
 // Compiles a commanded path into the per-segment numbers the Monte Carlo
-// kernel executes; see sim_model.hpp.
-#include "simulation/sim_model.hpp"
+// kernel executes; see monte_carlo_plan.hpp.
+#include "simulation/monte_carlo_plan.hpp"
 
 #include <cmath>
 

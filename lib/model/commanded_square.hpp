@@ -35,7 +35,7 @@
 #include <vector>
 
 #include "kinematics/diff_drive.hpp"
-#include "kinematics/pose2.hpp"
+#include "core/pose2.hpp"
 
 namespace umbmark {
 

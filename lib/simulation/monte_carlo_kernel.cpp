@@ -1,5 +1,5 @@
 // Monte Carlo run kernel: kSimLanes runs per call, vectorised across runs;
-// see wheel_noise_sim.hpp for the model and the numerics.
+// see monte_carlo_kernel.hpp for the model and the numerics.
 //
 // Floating-point contraction (a*b+c -> fma) is switched off for this file so
 // that the baseline, AVX2 and AVX-512 builds of the kernel give identical
@@ -11,7 +11,7 @@
 #pragma GCC optimize("fp-contract=off", "no-trapping-math")
 #endif
 
-#include "simulation/wheel_noise_sim.hpp"
+#include "simulation/monte_carlo_kernel.hpp"
 
 #include <cmath>
 #include <algorithm>
@@ -329,7 +329,7 @@ bool SelectSimKernel(const std::string& name) {
   return false;
 }
 
-void SimulateRuns(const SimPlan& plan, std::uint64_t seed, std::int64_t first_run, std::int64_t count, Pose2* out) {
+void SimulateFinalPoses(const SimPlan& plan, std::uint64_t seed, std::int64_t first_run, std::int64_t count, Pose2* out) {
   const Eigen::Matrix3d sqrt_p0 = CovarianceSqrt(plan.initial_covariance);
   const BlockFn fn = TheKernel().fn;
   BlockState b;

@@ -1,6 +1,6 @@
 // Maximum-likelihood fit of k_L, k_R with profile-likelihood intervals and a
-// goodness-of-fit table; see noise_fit.hpp.
-#include "error_models/noise_fit.hpp"
+// goodness-of-fit table; see wheel_noise_fit.hpp.
+#include "error_models/wheel_noise_fit.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -27,7 +27,7 @@ PoseCovariance MeasurementCovariance(double sigma_xy_m, double sigma_theta_rad, 
   return M;
 }
 
-std::string NoiseFitOptions::Check() const {
+std::string WheelNoiseFitOptions::Check() const {
   if (!(confidence > 0.0 && confidence < 1.0)) return fmt::format("confidence = {} must be in (0, 1)", confidence);
   if (max_iterations < 10) return fmt::format("max_iterations = {} must be >= 10", max_iterations);
   return {};
@@ -42,10 +42,10 @@ struct Grouping {
   std::vector<int> count, count_theta;
 };
 
-Grouping MakeGroups(const std::vector<NoiseFitRun>& runs) {
+Grouping MakeGroups(const std::vector<WheelNoiseFitRun>& runs) {
   Grouping g;
   std::map<std::string, int> index;
-  for (const NoiseFitRun& r : runs) {
+  for (const WheelNoiseFitRun& r : runs) {
     auto [it, inserted] = index.emplace(r.group, static_cast<int>(g.names.size()));
     if (inserted) {
       g.names.push_back(r.group);
@@ -62,7 +62,7 @@ Grouping MakeGroups(const std::vector<NoiseFitRun>& runs) {
 /// Profiled negative log-likelihood (group means by GLS) for k_L^2 = qL,
 /// k_R^2 = qR. Returns false when some S_i is not positive definite.
 template <typename T>
-bool ProfiledNll(const std::vector<NoiseFitRun>& runs, const Grouping& grp, const T& qL, const T& qR, T* nll,
+bool ProfiledNll(const std::vector<WheelNoiseFitRun>& runs, const Grouping& grp, const T& qL, const T& qR, T* nll,
                  std::vector<Eigen::Matrix<T, 3, 1>>* means = nullptr, bool restricted = false) {
   using M3 = Eigen::Matrix<T, 3, 3>;
   using V3 = Eigen::Matrix<T, 3, 1>;
@@ -72,7 +72,7 @@ bool ProfiledNll(const std::vector<NoiseFitRun>& runs, const Grouping& grp, cons
   std::vector<M3> W(G, M3::Zero());
   std::vector<V3> b(G, V3::Zero());
   for (std::size_t i = 0; i < n; ++i) {
-    const NoiseFitRun& r = runs[i];
+    const WheelNoiseFitRun& r = runs[i];
     const SecondOrderBasis& q2 = r.second_order;
     const M3 S = qL * r.basis.A_L.cast<T>() + qR * r.basis.A_R.cast<T>() + (qL * qL) * q2.LL.cast<T>() +
                  (qL * qR) * q2.LR.cast<T>() + (qR * qR) * q2.RR.cast<T>() + r.measurement.cast<T>();
@@ -120,9 +120,9 @@ bool ProfiledNll(const std::vector<NoiseFitRun>& runs, const Grouping& grp, cons
 
 /// NLL as a function of (log k_L, log k_R).
 struct NllCost {
-  const std::vector<NoiseFitRun>* runs;
+  const std::vector<WheelNoiseFitRun>* runs;
   const Grouping* grp;
-  bool restricted = false;  ///< REML (see NoiseFitOptions::restricted)
+  bool restricted = false;  ///< REML (see WheelNoiseFitOptions::restricted)
 
   template <typename T>
   bool operator()(const T* p, T* cost) const {
@@ -251,20 +251,20 @@ double NormalQuantile(double p) {
 
 }  // namespace
 
-double NoiseNegLogLikelihood(const std::vector<NoiseFitRun>& runs, double k_L, double k_R) {
+double WheelNoiseNegLogLikelihood(const std::vector<WheelNoiseFitRun>& runs, double k_L, double k_R) {
   const Grouping grp = MakeGroups(runs);
   double nll = 0.0;
   if (!ProfiledNll(runs, grp, k_L * k_L, k_R * k_R, &nll)) return std::numeric_limits<double>::infinity();
   return nll;
 }
 
-std::string NoiseFitSummary::BriefReport() const {
+std::string WheelNoiseFitSummary::BriefReport() const {
   return fmt::format("k_L = {:.4g} m^1/2 [{:.4g}, {:.4g}], k_R = {:.4g} m^1/2 [{:.4g}, {:.4g}] ({:.0f}% profile "
                      "likelihood), {} runs in {} groups",
                      k_L, k_L_ci[0], k_L_ci[1], k_R, k_R_ci[0], k_R_ci[1], 100 * confidence, runs, groups.size());
 }
 
-NoiseFitSummary FitNoise(const std::vector<NoiseFitRun>& runs, const NoiseFitOptions& options) {
+WheelNoiseFitSummary FitWheelNoise(const std::vector<WheelNoiseFitRun>& runs, const WheelNoiseFitOptions& options) {
   if (auto e = options.Check(); !e.empty()) throw InvalidOptions(e);
   // 1. Check the data can identify the model.
   const Grouping grp = MakeGroups(runs);
@@ -273,7 +273,7 @@ NoiseFitSummary FitNoise(const std::vector<NoiseFitRun>& runs, const NoiseFitOpt
   for (std::size_t g = 0; g < G; ++g)
     if (grp.count[g] < 2)
       throw InputError("", fmt::format("group '{}' has a single run; its systematic mean would absorb it", grp.names[g]));
-  for (const NoiseFitRun& r : runs) {
+  for (const WheelNoiseFitRun& r : runs) {
     if (!r.error.head<2>().allFinite() || (r.has_theta && !std::isfinite(r.error(2))))
       throw InputError("", fmt::format("run {}: return error is not finite", r.run));
   }
@@ -317,7 +317,7 @@ NoiseFitSummary FitNoise(const std::vector<NoiseFitRun>& runs, const NoiseFitOpt
   if (!best.ok)
     throw QualityGateError(fmt::format("fit-noise: the maximum-likelihood solver did not converge ({})", best.message));
 
-  NoiseFitSummary out;
+  WheelNoiseFitSummary out;
   out.k_L = std::exp(best.params[0]);
   out.k_R = std::exp(best.params[1]);
   out.neg_log_likelihood = best.nll;
@@ -399,7 +399,7 @@ NoiseFitSummary FitNoise(const std::vector<NoiseFitRun>& runs, const NoiseFitOpt
   std::array<int, 6> cnt{};
   std::array<std::vector<int>, 6> groups_seen;
   for (std::size_t i = 0; i < n; ++i) {
-    const NoiseFitRun& r = runs[i];
+    const WheelNoiseFitRun& r = runs[i];
     const PoseCovariance S = r.basis.Evaluate(fitted) + r.second_order.Covariance(fitted) + r.measurement;
     Eigen::Vector3d res = r.error - mu[static_cast<std::size_t>(grp.of_run[i])];
     if (!r.has_theta) res(2) = std::numeric_limits<double>::quiet_NaN();

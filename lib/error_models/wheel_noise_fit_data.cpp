@@ -1,5 +1,5 @@
-// Data files -> fit-noise runs; see noise_fit_data.hpp.
-#include "error_models/noise_fit_data.hpp"
+// Data files -> fit-noise runs; see wheel_noise_fit_data.hpp.
+#include "error_models/wheel_noise_fit_data.hpp"
 
 #include <cmath>
 #include <limits>
@@ -13,7 +13,7 @@
 
 namespace umbmark {
 
-std::vector<NoiseFitRun> NoiseRunsFromEndpoints(const EndpointData& data, const std::vector<PathSegment>& path,
+std::vector<WheelNoiseFitRun> NoiseRunsFromEndpoints(const EndpointData& data, const std::vector<PathSegment>& path,
                                                 double wheelbase_m, const std::string& group_prefix,
                                                 const NoiseFitInputOptions& options) {
   const std::vector<WheelSegment> wheels = ToWheelSegments(path, wheelbase_m);
@@ -21,9 +21,9 @@ std::vector<NoiseFitRun> NoiseRunsFromEndpoints(const EndpointData& data, const 
   SecondOrderBasis q2;
   if (options.second_order) q2 = SecondOrderHeadingBasis(wheels, wheelbase_m);
   const PoseCovariance M = MeasurementCovariance(options.sigma_xy_m, options.sigma_theta_rad, pc.mean);
-  std::vector<NoiseFitRun> out;
+  std::vector<WheelNoiseFitRun> out;
   for (const EndpointRun& r : data.runs) {
-    NoiseFitRun f;
+    WheelNoiseFitRun f;
     f.group = group_prefix + r.direction;
     f.run = r.run;
     f.has_theta = r.etheta_rad.has_value();
@@ -36,10 +36,10 @@ std::vector<NoiseFitRun> NoiseRunsFromEndpoints(const EndpointData& data, const 
   return out;
 }
 
-std::vector<NoiseFitRun> NoiseRunsFromTrajectories(const TrajectoryData& data, const RobotParams& robot,
+std::vector<WheelNoiseFitRun> NoiseRunsFromTrajectories(const TrajectoryData& data, const RobotParams& robot,
                                                    const std::string& group_prefix,
                                                    const NoiseFitInputOptions& options, int* skipped) {
-  std::vector<NoiseFitRun> out;
+  std::vector<WheelNoiseFitRun> out;
   int skip = 0;
   for (const TrajectoryRun& run : data.runs) {
     const std::size_t n = run.size();
@@ -56,7 +56,7 @@ std::vector<NoiseFitRun> NoiseRunsFromTrajectories(const TrajectoryData& data, c
     const TrajectoryCovarianceSummary kelly = TrajectoryCovariance(travel, robot.wheelbase_m);
     const Pose2& odo = kelly.poses.back();
     const Pose2 gt = RelativeTo(run.GroundTruth(0), run.GroundTruth(n - 1));  // contract: GT in its first frame
-    NoiseFitRun f;
+    WheelNoiseFitRun f;
     f.group = group_prefix + run.direction;
     f.run = run.run;
     f.error = Eigen::Vector3d(gt.x - odo.x, gt.y - odo.y, WrapAngle(gt.theta - odo.theta));

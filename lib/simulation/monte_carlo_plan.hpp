@@ -32,7 +32,7 @@
 #include "core/robot.hpp"
 #include "error_models/path_spec.hpp"
 #include "error_models/wheel_noise.hpp"
-#include "kinematics/pose2.hpp"
+#include "core/pose2.hpp"
 
 namespace umbmark::sim {
 

@@ -1,8 +1,8 @@
-// Normal and Student t quantiles (see refine_stats.hpp). The t CDF uses the
+// Normal and Student t quantiles (see distributions.hpp). The t CDF uses the
 // regularised incomplete beta function, evaluated by its continued fraction
 // (modified Lentz); quantiles are found by bisection on the CDF, which is
 // monotone, so they are as accurate as the CDF (about 1e-13).
-#include "calibration/refine_stats.hpp"
+#include "stats/distributions.hpp"
 
 #include <cmath>
 
