@@ -412,3 +412,26 @@ TEST_CASE("simulate: encoder ticks are whole counts of true rotation; controller
     CHECK(static_cast<double>(max_left) == target);
   }
 }
+
+TEST_CASE("castor_kick: no kick between motions back to back (no standstill), one at the run's start", "[effects]") {
+  // The contract: "at every start from standstill". Without pauses only the
+  // run's first motion starts from standstill; a leg right after a spot
+  // turn, or a reversal without a pause, does not.
+  const double kappa = 0.01;
+  CampaignSimOptions o = Quiet();
+  o.effects.castor_kappa = kappa;
+  o.pause_s = 0.0;
+  const SimulatedCampaign c = SimulateCampaign(Campaign(false), o);
+  for (const auto& run : Traj(c, 1).runs) {
+    // One kick of +kappa forward, none at the reversal: the backward leg
+    // retraces the forward one at heading kappa and ends at the start.
+    const Pose2 end = Last(run);
+    CHECK_THAT(end.x, WithinAbs(0.0, 1e-9));
+    CHECK_THAT(end.y, WithinAbs(0.0, 1e-9));
+    CHECK_THAT(end.theta, WithinAbs(kappa, 1e-12));
+  }
+  for (const auto& run : Traj(c, 0).runs) {
+    const double sign = run.direction == "cw" ? -1.0 : 1.0;
+    CHECK_THAT(Last(run).theta, WithinAbs(sign * 2.0 * kPi + kappa, 1e-9));
+  }
+}

@@ -99,8 +99,9 @@ inline double HeadingFactor(const TrueFactors& f, signed char cls) {
 }
 
 /// The pose after fraction `u` in [0, 1] of interval i's time from `q`
-/// (u = 1: the whole interval): a junction's two parts in turn (B's castor
-/// kick between them), else the interval's one step within its active window.
+/// (u = 1: the whole interval): a junction's two parts in turn, else the
+/// interval's one step within its active window (after the castor kick of a
+/// start from standstill).
 Pose2 AdvanceInterval(const DiagRun& r, std::size_t i, const TrueFactors& f, double drift, double kappa, Pose2 q,
                       double u) {
   const double dl = r.left[i + 1] - r.left[i], dr = r.right[i + 1] - r.right[i];
@@ -112,7 +113,6 @@ Pose2 AdvanceInterval(const DiagRun& r, std::size_t i, const TrueFactors& f, dou
     TrueTravel(f, drift, ua * j.left_m, ua * j.right_m, l, rr);
     q = Advance(q, l, rr, f.wheelbase, HeadingFactor(f, j.class_a));
     if (u <= fa) return q;
-    if (j.kick != 0) q.theta += kappa * j.kick;
     const double ub = fa < 1.0 ? std::min(1.0, (u - fa) / (1.0 - fa)) : 1.0;
     TrueTravel(f, drift, ub * (dl - j.left_m), ub * (dr - j.right_m), l, rr);
     return Advance(q, l, rr, f.wheelbase, HeadingFactor(f, j.class_b));

@@ -108,10 +108,15 @@ void AnnotateIntervals(DiagRun& r) {
   r.kick.assign(intervals, 0);
   r.window_start.assign(intervals, 0.0f);
   r.window_end.assign(intervals, 1.0f);
-  for (const auto& m : r.motions) {
+  for (std::size_t k = 0; k < r.motions.size(); ++k) {
+    const sim::MotionSegment& m = r.motions[k];
     for (std::size_t i = m.first_interval; i <= m.last_interval; ++i)
       r.interval_class[i] = static_cast<signed char>(m.cls);
-    if (m.cls != sim::MotionClass::kTurn) r.kick[m.first_interval] = static_cast<signed char>(m.sign);
+    // castor_kick: only a start from standstill (the run's first motion, or
+    // one after at least one still interval); spot turns excluded.
+    const bool from_standstill = k == 0 || r.motions[k - 1].last_interval + 1 < m.first_interval;
+    if (from_standstill && m.cls != sim::MotionClass::kTurn)
+      r.kick[m.first_interval] = static_cast<signed char>(m.sign);
     if (m.last_interval > m.first_interval) {
       const double t0 = IntervalTravel(r, m.first_interval), t1 = IntervalTravel(r, m.first_interval + 1);
       if (t1 > 0.0) r.window_start[m.first_interval] = static_cast<float>(1.0 - std::min(1.0, t0 / t1));
@@ -171,8 +176,6 @@ void FindJunctions(DiagRun& r) {
     j.time_fraction = ta / (ta + tb);
     j.class_a = static_cast<signed char>(A.cls);
     j.class_b = static_cast<signed char>(B.cls);
-    j.kick = r.kick[B.first_interval];
-    r.kick[B.first_interval] = 0;
     r.window_start[j.interval] = 0.0f;
     r.window_end[j.interval] = 1.0f;
     r.junction_of[j.interval] = static_cast<int>(r.junctions.size());

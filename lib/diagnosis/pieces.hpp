@@ -85,14 +85,13 @@ struct DiagRun {
   /// motion A ends and B begins is two steps, A's direction then B's. For
   /// such an interval i, junctions holds {i, ...}: the nominal travel of
   /// A's part, the fraction of the interval's time it takes (at each
-  /// motion's speed), the two classes and B's castor kick sign (applied
-  /// between the parts; kick[i] is then 0).
+  /// motion's speed) and the two classes. B starts back to back, not from
+  /// standstill: no castor kick.
   struct Junction {
     std::size_t interval = 0;
     double left_m = 0.0, right_m = 0.0;  ///< A's part
     double time_fraction = 0.5;
     signed char class_a = 0, class_b = 0;
-    signed char kick = 0;
   };
   std::vector<Junction> junctions;
   /// Index into `junctions` per interval (-1: a plain interval).

@@ -71,7 +71,9 @@ struct PlannedMotion {
   /// Commanded nominal wheel travel [m] (what the odometry measures).
   double left_m = 0.0, right_m = 0.0;
   double duration_s = 0.0;
-  /// Starts from standstill (a castor kick applies unless cls is kTurn).
+  /// Starts from standstill: the first motion of the run, or a motion right
+  /// after a pause of non-zero duration (a motion that follows another one
+  /// back to back never does). A castor kick applies unless cls is kTurn.
   bool from_standstill = true;
 };
 

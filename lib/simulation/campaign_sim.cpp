@@ -35,6 +35,20 @@ PlannedMotion Move(MotionClass cls, double left_m, double right_m, double durati
   return m;
 }
 
+/// Marks the moves that start from standstill (the contract's castor_kick):
+/// the run's first move and every move right after a pause that lasts.
+void MarkStandstillStarts(RunPlan& plan) {
+  bool still = true;  // a run starts at rest
+  for (PlannedMotion& m : plan.motions) {
+    if (m.pause) {
+      if (m.duration_s > 0.0) still = true;
+      continue;
+    }
+    m.from_standstill = still;
+    still = false;
+  }
+}
+
 RunPlan SquarePlan(bool clockwise, double side_m, double wheelbase_m, const CampaignSimOptions& o) {
   RunPlan plan;
   plan.sample_rate_hz = o.sample_rate_hz;
@@ -47,6 +61,7 @@ RunPlan SquarePlan(bool clockwise, double side_m, double wheelbase_m, const Camp
     plan.motions.push_back(Move(MotionClass::kTurn, -wheel, wheel, std::abs(phi) / o.turn_rate_rad_s));
     plan.motions.push_back(Pause(o.pause_s));
   }
+  MarkStandstillStarts(plan);
   return plan;
 }
 
@@ -58,6 +73,7 @@ RunPlan BackAndForthPlan(double distance_m, const CampaignSimOptions& o) {
   plan.motions.push_back(Pause(o.pause_s));
   plan.motions.push_back(Move(MotionClass::kStraight, -distance_m, -distance_m, distance_m / o.speed_m_s));
   plan.motions.push_back(Pause(o.pause_s));
+  MarkStandstillStarts(plan);
   return plan;
 }
 
@@ -73,6 +89,7 @@ RunPlan FigureEightPlan(double radius_m, double wheelbase_m, const CampaignSimOp
   plan.motions.push_back(Pause(o.pause_s));
   plan.motions.push_back(Move(cls, outer, inner, duration));
   plan.motions.push_back(Pause(o.pause_s));
+  MarkStandstillStarts(plan);
   return plan;
 }
 
@@ -99,7 +116,11 @@ RunPlan ReplayPlan(const TrajectoryRun& run, const RobotParams& robot) {
     }
     const MotionSegment& m = motions[next_motion];
     PlannedMotion step = Move(m.cls, travel.left_m[i + 1] - travel.left_m[i], travel.right_m[i + 1] - travel.right_m[i], dt);
-    step.from_standstill = i == m.first_interval;
+    // From standstill: the run's first motion, or one after at least one
+    // still interval (a motion that follows another back to back does not
+    // start from standstill, whatever its class).
+    step.from_standstill =
+        i == m.first_interval && (next_motion == 0 || motions[next_motion - 1].last_interval + 1 < m.first_interval);
     if (step.from_standstill && m.cls != MotionClass::kTurn) {
       // The kick's direction is the motion's, not this first step's.
       const double sgn = m.left_m + m.right_m >= 0.0 ? 1.0 : -1.0;
