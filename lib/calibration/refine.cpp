@@ -64,6 +64,32 @@ std::optional<TrajectoryCovariance> TrajectoryCovarianceFromString(std::string_v
   return std::nullopt;
 }
 
+const char* PoseSamplingToString(PoseSampling s) {
+  return s == PoseSampling::kPerRun ? "per_run" : "every_sample";
+}
+
+std::optional<PoseSampling> PoseSamplingFromString(std::string_view s) {
+  if (s == "per_run") return PoseSampling::kPerRun;
+  if (s == "every_sample") return PoseSampling::kEverySample;
+  return std::nullopt;
+}
+
+const char* StartPoseToString(StartPose s) {
+  switch (s) {
+    case StartPose::kFirstSample: return "first_sample";
+    case StartPose::kStandstillMean: return "standstill_mean";
+    case StartPose::kFitted: return "fitted";
+  }
+  return "?";
+}
+
+std::optional<StartPose> StartPoseFromString(std::string_view s) {
+  if (s == "first_sample") return StartPose::kFirstSample;
+  if (s == "standstill_mean") return StartPose::kStandstillMean;
+  if (s == "fitted") return StartPose::kFitted;
+  return std::nullopt;
+}
+
 const char* RefineInputKindToString(RefineInputKind k) {
   return k == RefineInputKind::kReturnErrors ? "return_errors" : "trajectories";
 }
@@ -111,6 +137,9 @@ std::string RefineOptions::Check() const {
   if (samples_per_run < 1) return fmt::format("samples_per_run = {} must be >= 1", samples_per_run);
   if (!std::isfinite(heading_length_m)) {
     return fmt::format("heading_length_m = {} must be finite (<= 0 selects the wheelbase)", heading_length_m);
+  }
+  if (!std::isfinite(heading_weight) || heading_weight < 0.0) {
+    return fmt::format("heading_weight = {} must be a finite number >= 0", heading_weight);
   }
   if (loss != RobustLoss::kNone) {
     if (auto e = positive("loss_scale_m", loss_scale_m); !e.empty()) return e;

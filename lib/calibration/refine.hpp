@@ -82,6 +82,36 @@ enum class TrajectoryCovariance {
 const char* TrajectoryCovarianceToString(TrajectoryCovariance c);
 std::optional<TrajectoryCovariance> TrajectoryCovarianceFromString(std::string_view s);
 
+/// Which poses of a trajectory run enter the fit.
+enum class PoseSampling {
+  /// RefineOptions::samples_per_run poses, evenly in travelled distance:
+  /// every run weighs the same, however long or finely logged.
+  kPerRun,
+  /// Every sample with ground truth (runs weigh by their sample count).
+  kEverySample
+};
+const char* PoseSamplingToString(PoseSampling s);
+std::optional<PoseSampling> PoseSamplingFromString(std::string_view s);
+
+/// The frame a trajectory run's odometry starts in (ground truth is
+/// re-expressed in it).
+enum class StartPose {
+  /// The run's first ground-truth sample (the contract's evaluation frame):
+  /// one noisy sample defines the whole run's frame.
+  kFirstSample,
+  /// The mean ground-truth pose over the initial standstill (the samples
+  /// before either wheel moves): the frame's noise averages down by the
+  /// number of standstill samples. Same as kFirstSample without standstill.
+  kStandstillMean,
+  /// Fitted per run: at every evaluation the rigid transform that best
+  /// aligns the odometry positions with the ground truth (2-D Procrustes,
+  /// closed form, differentiated through) is applied, i.e. the start pose
+  /// is a nuisance profiled out of the objective.
+  kFitted
+};
+const char* StartPoseToString(StartPose s);
+std::optional<StartPose> StartPoseFromString(std::string_view s);
+
 /// Starting point, relative to the reference robot. Pass the classic UMBmark
 /// solution (UmbmarkSummary::selected.E_b, .E_d) for return errors.
 struct RefineStart {
@@ -149,12 +179,19 @@ struct RefineOptions {
   /// Sampled poses per run, evenly spaced in travelled distance
   /// (|d_L| + |d_R|)/2 so spot turns are sampled too and standstill is not;
   /// every run weighs the same. The last ground-truth sample is always one.
-  /// Default 100.
+  /// Default 100 (used with PoseSampling::kPerRun).
   int samples_per_run = 100;
+  /// See PoseSampling. Default kPerRun.
+  PoseSampling sampling = PoseSampling::kPerRun;
+  /// See StartPose. Default kFirstSample.
+  StartPose start_pose = StartPose::kFirstSample;
   /// Metres per radian for the heading residual; <= 0 means the reference
   /// wheelbase (a heading error of 1 rad counts like a position error of
   /// one wheelbase: the displacement of a wheel contact point). Default 0.
   double heading_length_m = 0.0;
+  /// Multiplies the heading residual (h = heading_weight * heading length);
+  /// 0 = position-only residual. Default 1.
+  double heading_weight = 1.0;
   /// Robust loss per sampled pose and its scale [m]. Default Huber, 0.02 m:
   /// about twice the path residual of a calibrated small robot, so ordinary
   /// poses stay quadratic and a bump or a tracking glitch counts linearly.

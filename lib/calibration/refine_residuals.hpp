@@ -100,7 +100,7 @@ class TrajectoryRunResidual {
   /// reference robot (true travel = c * these).
   TrajectoryRunResidual(std::vector<double> d_left_m, std::vector<double> d_right_m, double reference_wheelbase_m,
                         std::vector<Sample> samples, double heading_length_m, RobustLoss loss, double loss_scale_m,
-                        Integrator integrator)
+                        Integrator integrator, bool fit_start = false)
       : d_left_m_(std::move(d_left_m)),
         d_right_m_(std::move(d_right_m)),
         reference_wheelbase_m_(reference_wheelbase_m),
@@ -108,7 +108,8 @@ class TrajectoryRunResidual {
         heading_length_m_(heading_length_m),
         loss_(loss),
         loss_scale_m_(loss_scale_m),
-        integrator_(integrator) {}
+        integrator_(integrator),
+        fit_start_(fit_start) {}
 
   int num_residuals() const { return static_cast<int>(3 * samples_.size()); }
 
@@ -117,15 +118,19 @@ class TrajectoryRunResidual {
     T c_L, c_R;
     WheelFactors(theta, &c_L, &c_R);
     const T wheelbase = theta[kIndexEb] * T(reference_wheelbase_m_);
+    std::vector<Pose2T<T>> odo(samples_.size());
     Pose2T<T> pose{T(0.0), T(0.0), T(0.0)};
     std::size_t at = 0;  // pose is the odometry at sample `at`
     for (std::size_t k = 0; k < samples_.size(); ++k) {
-      const Sample& s = samples_[k];
-      for (; at < s.index; ++at) {
+      for (; at < samples_[k].index; ++at) {
         pose = DiffDriveStep(pose, c_L * d_left_m_[at], c_R * d_right_m_[at], wheelbase, integrator_);
       }
-      T r[3] = {pose.x - T(s.ground_truth.x), pose.y - T(s.ground_truth.y),
-                T(heading_length_m_) * (pose.theta - T(s.ground_truth.theta))};
+      odo[k] = pose;
+    }
+    if (fit_start_) AlignStart(&odo);
+    for (std::size_t k = 0; k < samples_.size(); ++k) {
+      const Pose2& gt = samples_[k].ground_truth;
+      T r[3] = {odo[k].x - T(gt.x), odo[k].y - T(gt.y), T(heading_length_m_) * (odo[k].theta - T(gt.theta))};
       const T f = RobustFactor(r[0] * r[0] + r[1] * r[1] + r[2] * r[2], loss_, loss_scale_m_);
       for (int i = 0; i < 3; ++i) residuals[3 * k + static_cast<std::size_t>(i)] = f * r[i];
     }
@@ -135,14 +140,57 @@ class TrajectoryRunResidual {
   static ceres::CostFunction* Create(std::vector<double> d_left_m, std::vector<double> d_right_m,
                                      double reference_wheelbase_m, std::vector<Sample> samples,
                                      double heading_length_m, RobustLoss loss, double loss_scale_m,
-                                     Integrator integrator) {
+                                     Integrator integrator, bool fit_start = false) {
     auto* functor = new TrajectoryRunResidual(std::move(d_left_m), std::move(d_right_m), reference_wheelbase_m,
-                                              std::move(samples), heading_length_m, loss, loss_scale_m, integrator);
+                                              std::move(samples), heading_length_m, loss, loss_scale_m, integrator,
+                                              fit_start);
     return new ceres::AutoDiffCostFunction<TrajectoryRunResidual, ceres::DYNAMIC, kNumRefineParameters>(
         functor, functor->num_residuals());
   }
 
  private:
+  /// Start pose profiled out (StartPose::kFitted): applies to the odometry
+  /// poses the rigid transform (phi, t) minimising sum |R(phi) o_k + t - g_k|^2
+  /// over the sampled positions (2-D Procrustes: phi = atan2(sum o' x g',
+  /// sum o' . g') on the centred points, t = mean g - R mean o).
+  template <typename T>
+  void AlignStart(std::vector<Pose2T<T>>* odo) const {
+    using std::atan2;
+    using std::cos;
+    using std::sin;
+    const std::size_t n = samples_.size();
+    if (n < 2) return;
+    T mox(0.0), moy(0.0);
+    double mgx = 0.0, mgy = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+      mox += (*odo)[k].x;
+      moy += (*odo)[k].y;
+      mgx += samples_[k].ground_truth.x;
+      mgy += samples_[k].ground_truth.y;
+    }
+    const T inv_n(1.0 / static_cast<double>(n));
+    mox *= inv_n;
+    moy *= inv_n;
+    mgx /= static_cast<double>(n);
+    mgy /= static_cast<double>(n);
+    T cross(0.0), dot(0.0);
+    for (std::size_t k = 0; k < n; ++k) {
+      const T ox = (*odo)[k].x - mox, oy = (*odo)[k].y - moy;
+      const double gx = samples_[k].ground_truth.x - mgx, gy = samples_[k].ground_truth.y - mgy;
+      cross += ox * T(gy) - oy * T(gx);
+      dot += ox * T(gx) + oy * T(gy);
+    }
+    const T phi = atan2(cross, dot);
+    const T c = cos(phi), s = sin(phi);
+    const T tx = T(mgx) - (c * mox - s * moy), ty = T(mgy) - (s * mox + c * moy);
+    for (auto& p : *odo) {
+      const T x = c * p.x - s * p.y + tx, y = s * p.x + c * p.y + ty;
+      p.x = x;
+      p.y = y;
+      p.theta += phi;
+    }
+  }
+
   const std::vector<double> d_left_m_, d_right_m_;
   const double reference_wheelbase_m_;
   const std::vector<Sample> samples_;
@@ -150,6 +198,7 @@ class TrajectoryRunResidual {
   const RobustLoss loss_;
   const double loss_scale_m_;
   const Integrator integrator_;
+  const bool fit_start_;
 };
 
 }  // namespace umbmark

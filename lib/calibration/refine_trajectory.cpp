@@ -52,15 +52,41 @@ PreparedRun PrepareRun(const TrajectoryRun& run, const std::string& path, const 
                              std::abs(travel.right_m[i] - travel.right_m[i - 1]));
   }
   std::vector<std::size_t> picks;
-  const int n = options.samples_per_run;
-  std::size_t i = 1;
-  for (int j = 1; j <= n && s[last] > 0.0; ++j) {
-    const double target = s[last] * j / n;
-    while (i < last && (s[i] < target || !track.has_ground_truth[i])) ++i;
-    if (picks.empty() || picks.back() < i) picks.push_back(i);
+  if (options.sampling == PoseSampling::kEverySample) {
+    for (std::size_t k = 1; k <= last; ++k) {
+      if (track.has_ground_truth[k]) picks.push_back(k);
+    }
+  } else {
+    const int n = options.samples_per_run;
+    std::size_t i = 1;
+    for (int j = 1; j <= n && s[last] > 0.0; ++j) {
+      const double target = s[last] * j / n;
+      while (i < last && (s[i] < target || !track.has_ground_truth[i])) ++i;
+      if (picks.empty() || picks.back() < i) picks.push_back(i);
+    }
+    if (picks.empty() || picks.back() != last) picks.push_back(last);
   }
-  if (picks.empty() || picks.back() != last) picks.push_back(last);
-  for (std::size_t k : picks) out.samples.push_back({k, track.ground_truth[k]});
+  // Frame of the run: the first ground-truth sample, or the mean pose over
+  // the initial standstill (samples before either wheel moves; the wheels
+  // do not move there, so the odometry still starts at sample 0).
+  Pose2 start{0.0, 0.0, 0.0};
+  if (options.start_pose == StartPose::kStandstillMean) {
+    double sx = 0.0, sy = 0.0, st = 0.0;
+    int count = 0;
+    for (std::size_t k = 0; k <= last && s[k] == 0.0; ++k) {
+      if (!track.has_ground_truth[k]) continue;
+      sx += track.ground_truth[k].x;
+      sy += track.ground_truth[k].y;
+      st += track.ground_truth[k].theta;  // continuous, near 0
+      ++count;
+    }
+    start = {sx / count, sy / count, st / count};  // count >= 1: sample 0 has ground truth
+  }
+  for (std::size_t k : picks) {
+    Pose2 g = RelativeTo(start, track.ground_truth[k]);
+    g.theta = track.ground_truth[k].theta - start.theta;  // keep the heading continuous
+    out.samples.push_back({k, g});
+  }
   out.d_left_m.resize(last);
   out.d_right_m.resize(last);
   for (std::size_t k = 0; k < last; ++k) {
@@ -107,7 +133,9 @@ RefineSummary RefineFromTrajectories(const std::vector<TrajectoryRunSet>& sets, 
                      "no trajectory run with ground truth beyond its first sample to refine");
   }
   summary.runs = static_cast<int>(prepared.size());
-  const double heading_length = options.heading_length_m > 0.0 ? options.heading_length_m : reference.wheelbase_m;
+  const double heading_length =
+      options.heading_weight * (options.heading_length_m > 0.0 ? options.heading_length_m : reference.wheelbase_m);
+  const bool fit_start = options.start_pose == StartPose::kFitted;
 
   // ---- step 2: build, solve and assess (E_s free unless fixed) ----
   auto attempt = [&](bool scale_free) {
@@ -119,13 +147,13 @@ RefineSummary RefineFromTrajectories(const std::vector<TrajectoryRunSet>& sets, 
     for (const PreparedRun& p : prepared) {
       ceres::CostFunction* cost =
           TrajectoryRunResidual::Create(p.d_left_m, p.d_right_m, reference.wheelbase_m, p.samples, heading_length,
-                                        options.loss, options.loss_scale_m, options.integrator);
+                                        options.loss, options.loss_scale_m, options.integrator, fit_start);
       fit.problem->AddResidualBlock(cost, nullptr, fit.theta);
       fit.blocks.push_back(cost);
       if (options.loss != RobustLoss::kNone) {
         fit.plain_blocks.emplace_back(TrajectoryRunResidual::Create(p.d_left_m, p.d_right_m, reference.wheelbase_m,
                                                                     p.samples, heading_length, RobustLoss::kNone,
-                                                                    options.loss_scale_m, options.integrator));
+                                                                    options.loss_scale_m, options.integrator, fit_start));
       }
     }
     fit.loss = options.loss;
