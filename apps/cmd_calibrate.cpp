@@ -42,6 +42,9 @@ struct CalibrateOptions {
   std::string loss = "huber";
   double loss_scale_m = 0.02;
   int samples_per_run = 100;
+  std::string sampling = "per_run";
+  std::string start_pose = "fitted";
+  double heading_weight = 4.0;
 };
 
 // Turns one command-line input into calibration inputs (a manifest may hold
@@ -224,6 +227,9 @@ int RunCalibrate(const CalibrateOptions& o) {
     ro.loss = *RobustLossFromString(o.loss);
     ro.loss_scale_m = o.loss_scale_m;
     ro.samples_per_run = o.samples_per_run;
+    ro.sampling = *PoseSamplingFromString(o.sampling);
+    ro.start_pose = *StartPoseFromString(o.start_pose);
+    ro.heading_weight = o.heading_weight;
     if (auto err = ro.Check(); !err.empty()) throw InvalidOptions(err);
     jo.refine = ro;
   }
@@ -352,6 +358,19 @@ Command SetupCalibrate(CLI::App& parent) {
   app->add_option("--loss-scale", opts->loss_scale_m, "Robust loss scale [m]")->check(CLI::PositiveNumber)->capture_default_str();
   app->add_option("--samples-per-run", opts->samples_per_run, "Poses sampled per trajectory run (evenly in travel)")
       ->check(CLI::Range(2, 100000))
+      ->capture_default_str();
+  app->add_option("--sampling", opts->sampling,
+                  "With --refine on trajectories: poses per run (--samples-per-run) or every sample with ground truth")
+      ->check(CLI::IsMember({"per_run", "every_sample"}))
+      ->capture_default_str();
+  app->add_option("--start-pose", opts->start_pose,
+                  "With --refine on trajectories: each run's frame at its first ground-truth sample, the mean over "
+                  "its initial standstill, or fitted (profiled out; docs/calibration-comparison.md)")
+      ->check(CLI::IsMember({"first_sample", "standstill_mean", "fitted"}))
+      ->capture_default_str();
+  app->add_option("--heading-weight", opts->heading_weight,
+                  "With --refine on trajectories: heading residual weight, in wheelbases per radian (0 = position only)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   return {app, [opts] { return RunCalibrate(*opts); }};
 }

@@ -87,17 +87,6 @@ struct Candidate {
   RefineOptions options;
 };
 
-/// Plain least squares: position-only residual at every sample with ground
-/// truth, no robust loss, wheelbase and both diameters free.
-RefineOptions PlainLeastSquares() {
-  RefineOptions o;
-  o.heading_weight = 0.0;
-  o.loss = RobustLoss::kNone;
-  o.sampling = PoseSampling::kEverySample;
-  o.scale = ScaleMode::kFree;
-  return o;
-}
-
 int Choices(const HeldOut& held, const std::vector<fs::path>& squares) {
   std::vector<io::OptiOdomDataset> cal;
   for (const auto& sq : squares) cal.push_back(io::ImportOptiOdom(sq.string()));
@@ -110,7 +99,7 @@ int Choices(const HeldOut& held, const std::vector<fs::path>& squares) {
     }
     return e;
   };
-  const auto plain = pairs(PlainLeastSquares());
+  const auto plain = pairs(PlainLeastSquaresOptions());
   std::vector<std::vector<double>> classic;
   for (const auto& ds : cal) {
     const auto in = InputFromTrajectories(ds.runs, ds.robot, ds.experiment.side_m, Integrator::kArc, ds.id);
@@ -170,7 +159,7 @@ int Choices(const HeldOut& held, const std::vector<fs::path>& squares) {
              base.heading_weight, RobustLossToString(base.loss), base.loss_scale_m, PoseSamplingToString(base.sampling),
              base.samples_per_run, StartPoseToString(base.start_pose));
   table("Heading term weight (times the wheelbase, metres per radian)",
-        vary([](RefineOptions& o, double v) { o.heading_weight = v; }, {0.0, 0.1, 0.25, 0.5, 1.0, 2.0}, "heading weight {}"));
+        vary([](RefineOptions& o, double v) { o.heading_weight = v; }, {0.0, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0}, "heading weight {}"));
   {
     auto c = vary([](RefineOptions& o, double v) { o.loss_scale_m = v; }, {0.002, 0.005, 0.01, 0.02, 0.05},
                   "Huber, scale {} m");
@@ -271,6 +260,13 @@ int main(int argc, char** argv) {
       const auto r = RunCalibrateJob(in, o);
       mean_final["refined (trajectories)"].push_back(
           row(ds.id, "refined (trajectories)", r.refined->refined).mean_final_position_error_m);
+    }
+    {
+      CalibrateJobOptions o;
+      o.refine = PlainLeastSquaresOptions();
+      const auto r = RunCalibrateJob(in, o);
+      mean_final["plain least squares (trajectories)"].push_back(
+          row(ds.id, "plain least squares (trajectories)", r.refined->refined).mean_final_position_error_m);
     }
     {
       // Refined from the return errors alone (what an endpoint CSV gives).

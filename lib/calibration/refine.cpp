@@ -147,6 +147,16 @@ std::string RefineOptions::Check() const {
   return {};
 }
 
+RefineOptions PlainLeastSquaresOptions() {
+  RefineOptions o;
+  o.heading_weight = 0.0;
+  o.loss = RobustLoss::kNone;
+  o.sampling = PoseSampling::kEverySample;
+  o.start_pose = StartPose::kFirstSample;
+  o.scale = ScaleMode::kFree;
+  return o;
+}
+
 RobotParams ApplyRefinedFactors(const RobotParams& reference, double E_b, double E_d, double E_s) {
   const double theta[kNumRefineParameters] = {E_b, E_d, E_s};
   double c_L = 0.0, c_R = 0.0;

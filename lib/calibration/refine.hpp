@@ -184,14 +184,14 @@ struct RefineOptions {
   /// See PoseSampling. Default kPerRun.
   PoseSampling sampling = PoseSampling::kPerRun;
   /// See StartPose. Default kFirstSample.
-  StartPose start_pose = StartPose::kFirstSample;
+  StartPose start_pose = StartPose::kFitted;
   /// Metres per radian for the heading residual; <= 0 means the reference
   /// wheelbase (a heading error of 1 rad counts like a position error of
   /// one wheelbase: the displacement of a wheel contact point). Default 0.
   double heading_length_m = 0.0;
   /// Multiplies the heading residual (h = heading_weight * heading length);
   /// 0 = position-only residual. Default 1.
-  double heading_weight = 1.0;
+  double heading_weight = 4.0;
   /// Robust loss per sampled pose and its scale [m]. Default Huber, 0.02 m:
   /// about twice the path residual of a calibrated small robot, so ordinary
   /// poses stay quadratic and a bump or a tracking glitch counts linearly.
@@ -305,6 +305,12 @@ struct RefineSummary {
   int runs = 0;
   int residuals = 0;
   int sampled_poses = 0;  ///< trajectories only
+  /// Trajectories only: the residual's settings (RefineOptions), as used.
+  struct TrajectorySettings {
+    std::string sampling, start_pose, loss;
+    double heading_length_m = 0.0;  ///< metres per radian after heading_weight
+    double loss_scale_m = 0.0;
+  } trajectory_settings;
 
   RefineSolverReport solver;
   RefineIdentifiability identifiability;
@@ -334,6 +340,13 @@ RefineSummary RefineFromReturnErrors(const std::vector<SquareRunSet>& sets, cons
 /// at its first sample; samples without ground truth are skipped).
 RefineSummary RefineFromTrajectories(const std::vector<TrajectoryRunSet>& sets, const RobotParams& reference,
                                      const RefineOptions& options);
+
+/// Plain least squares on trajectories, the comparison row of
+/// docs/calibration-comparison.md: position-only residual at every sample
+/// with ground truth, no robust loss, each run's frame at its first sample,
+/// wheelbase and both diameters free. The refined defaults are chosen to
+/// beat it on held-out recordings.
+RefineOptions PlainLeastSquaresOptions();
 
 /// Corrected robot for theta relative to `reference`.
 RobotParams ApplyRefinedFactors(const RobotParams& reference, double E_b, double E_d, double E_s);

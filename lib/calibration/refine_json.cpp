@@ -83,7 +83,15 @@ nlohmann::json RefinedToJson(const RefineSummary& s) {
   if (s.input == RefineInputKind::kReturnErrors) j["weighting"] = groups;
   j["runs"] = s.runs;
   j["residuals"] = s.residuals;
-  if (s.input == RefineInputKind::kTrajectories) j["sampled_poses"] = s.sampled_poses;
+  if (s.input == RefineInputKind::kTrajectories) {
+    j["sampled_poses"] = s.sampled_poses;
+    const auto& t = s.trajectory_settings;
+    j["trajectory_settings"] = {{"sampling", t.sampling},
+                                {"start_pose", t.start_pose},
+                                {"heading_length_m_per_rad", t.heading_length_m},
+                                {"loss", t.loss},
+                                {"loss_scale_m", t.loss_scale_m}};
+  }
   j["notes"] = s.notes;
   return j;
 }
@@ -97,6 +105,11 @@ std::string RefineReport(const RefineSummary& s) {
   };
   out += fmt::format("refined calibration ({}, {} runs, {} residuals):\n", RefineInputKindToString(s.input), s.runs,
                      s.residuals);
+  if (s.input == RefineInputKind::kTrajectories) {
+    const auto& t = s.trajectory_settings;
+    out += fmt::format("  poses {}, run frames {}, heading {:.3g} m/rad, loss {} ({} m)\n", t.sampling, t.start_pose,
+                       t.heading_length_m, t.loss, t.loss_scale_m);
+  }
   line("wheelbase_m", s.intervals.wheelbase_m, 6);
   line("wheel_diameter_right_m", s.intervals.wheel_diameter_right_m, 6);
   line("wheel_diameter_left_m", s.intervals.wheel_diameter_left_m, 6);

@@ -136,6 +136,8 @@ RefineSummary RefineFromTrajectories(const std::vector<TrajectoryRunSet>& sets, 
   const double heading_length =
       options.heading_weight * (options.heading_length_m > 0.0 ? options.heading_length_m : reference.wheelbase_m);
   const bool fit_start = options.start_pose == StartPose::kFitted;
+  summary.trajectory_settings = {PoseSamplingToString(options.sampling), StartPoseToString(options.start_pose),
+                                 RobustLossToString(options.loss), heading_length, options.loss_scale_m};
 
   // ---- step 2: build, solve and assess (E_s free unless fixed) ----
   auto attempt = [&](bool scale_free) {
