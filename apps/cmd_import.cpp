@@ -1,6 +1,8 @@
 // `umbmark import optiodom DIR --out OUTDIR`: converts one OptiOdom dataset
 // folder into the contract's campaign manifest (OUTDIR/campaign.toml) and
 // trajectory CSV (OUTDIR/runs.csv).
+// `umbmark import rosbag2 BAG... --out OUTDIR ...` does the same for ROS 2
+// recordings (contract section "ROS 2 recordings"); `--list` shows topics.
 #include <filesystem>
 #include <memory>
 
@@ -13,6 +15,7 @@
 #include "io/atomic_write.hpp"
 #include "io/campaign_writer.hpp"
 #include "io/optiodom.hpp"
+#include "io/rosbag2/rosbag2_import.hpp"
 
 namespace umbmark::cli {
 
@@ -69,6 +72,140 @@ int RunImportOptiOdom(const ImportOptions& o) {
   return 0;
 }
 
+struct Rosbag2Options {
+  std::vector<std::string> bags;
+  std::string out;
+  bool list = false;
+  std::string experiment;
+  std::optional<double> side_m, distance_m;
+  std::string integrator = "arc";
+  std::string time = "header";
+  io::rosbag2::Rosbag2ImportOptions import;
+  RobotFlags robot;
+  JsonFlag json;
+};
+
+void EnsureOutDir(const std::string& out) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (ec || !fs::is_directory(out)) throw InputError(out, "cannot create output directory: " + ec.message());
+}
+
+int RunRosbag2List(const Rosbag2Options& o) {
+  nlohmann::json bags = nlohmann::json::array();
+  std::vector<std::string> warnings;
+  for (const auto& path : o.bags) {
+    const auto listing = io::rosbag2::ListRosbag2(path, warnings);
+    nlohmann::json topics = nlohmann::json::array();
+    if (o.json.PrintText()) {
+      fmt::print("{} ({} storage file{}: {})\n", path, listing.files.size(), listing.files.size() == 1 ? "" : "s",
+                 fmt::join(listing.files, ", "));
+      fmt::print("  {:<28} {:<44} {:>9} {:>9}  use as\n", "topic", "type", "messages", "rate Hz");
+    }
+    for (const auto& l : listing.topics) {
+      std::string use;
+      if (l.wheels) use = l.topic.type == "sensor_msgs/msg/JointState" ? "--wheels" : "--odometry";
+      if (l.ground_truth) use += use.empty() ? "--ground-truth" : ", --ground-truth";
+      if (!l.joints.empty()) use += fmt::format(" (joints: {})", fmt::join(l.joints, ", "));
+      if (!l.frames.empty()) use += fmt::format(" (child frames: {})", fmt::join(l.frames, ", "));
+      if (o.json.PrintText())
+        fmt::print("  {:<28} {:<44} {:>9} {:>9.1f}  {}\n", l.topic.name, l.topic.type, l.topic.count, l.topic.RateHz(), use);
+      topics.push_back({{"name", l.topic.name},
+                        {"type", l.topic.type},
+                        {"messages", l.topic.count},
+                        {"rate_hz", JsonNumber(l.topic.RateHz())},
+                        {"wheels", l.wheels},
+                        {"ground_truth", l.ground_truth},
+                        {"joints", l.joints},
+                        {"child_frames", l.frames}});
+    }
+    bags.push_back({{"path", path}, {"files", listing.files}, {"topics", topics}});
+  }
+  if (o.json.PrintText()) {
+    for (const auto& w : warnings) fmt::print(stderr, "warning: {}\n", w);
+    fmt::print("Next: umbmark import rosbag2 BAG --out DIR --experiment square --side S --robot R.toml "
+               "--wheels TOPIC --ground-truth TOPIC\n");
+  }
+  o.json.Emit({{"bags", bags}, {"warnings", warnings}});
+  return 0;
+}
+
+int RunRosbag2(Rosbag2Options o) {
+  namespace fs = std::filesystem;
+  if (o.list) return RunRosbag2List(o);
+  if (o.out.empty()) throw InvalidOptions("--out OUTDIR is required (or --list to see the topics)");
+  if (o.experiment.empty()) throw InvalidOptions("--experiment square|back_and_forth|free is required");
+  auto& opt = o.import;
+  opt.kind = o.experiment == "square" ? ExperimentKind::kSquare
+             : o.experiment == "back_and_forth" ? ExperimentKind::kBackAndForth
+                                                : ExperimentKind::kFree;
+  opt.side_m = o.side_m.value_or(0.0);
+  opt.distance_m = o.distance_m.value_or(0.0);
+  opt.integrator = *IntegratorFromString(o.integrator);
+  opt.time = o.time == "log" ? io::rosbag2::StampSource::kLog : io::rosbag2::StampSource::kHeader;
+  const RobotParams robot = o.robot.Resolve();
+  const auto result = io::rosbag2::ImportRosbag2(o.bags, robot, opt);
+
+  EnsureOutDir(o.out);
+  std::vector<std::string> comment = {
+      fmt::format("ROS 2 recording(s) {}, imported by umbmark import rosbag2", fmt::join(o.bags, ", ")),
+      fmt::format("wheels: {} {}; ground truth: {}; time: {}", opt.wheels_topic.empty() ? "--odometry" : "--wheels",
+                  opt.wheels_topic.empty() ? opt.odometry_topic : opt.wheels_topic,
+                  opt.ground_truth_topic.empty() ? "none" : opt.ground_truth_topic, o.time)};
+  Manifest m;
+  m.robot = robot;
+  m.experiments.push_back(result.experiment);
+  const std::string runs_path = (fs::path(o.out) / "runs.csv").string();
+  const std::string manifest_path = (fs::path(o.out) / "campaign.toml").string();
+  io::WriteFileAtomically(runs_path, io::FormatTrajectoryCsv(result.runs, comment));
+  io::WriteFileAtomically(manifest_path, io::FormatManifest(m, {comment[0]}));
+
+  nlohmann::json recordings = nlohmann::json::array();
+  for (const auto& r : result.recordings)
+    recordings.push_back({{"path", r.path},
+                          {"wheel_messages", r.wheel_messages},
+                          {"ground_truth_messages", r.ground_truth_messages},
+                          {"runs", r.runs},
+                          {"left_joint", r.left_joint},
+                          {"right_joint", r.right_joint},
+                          {"duration_s", JsonNumber(r.duration_s)}});
+  nlohmann::json runs = nlohmann::json::array();
+  for (const auto& r : result.runs.runs) {
+    std::size_t with_gt = 0;
+    for (std::size_t i = 0; i < r.size(); ++i) with_gt += r.HasGroundTruth(i) ? 1 : 0;
+    runs.push_back({{"run", r.run},
+                    {"direction", r.direction},
+                    {"samples", r.size()},
+                    {"ground_truth_samples", with_gt},
+                    {"t_start_s", JsonNumber(r.t_s.front())},
+                    {"t_end_s", JsonNumber(r.t_s.back())},
+                    {"dist_left_m", JsonNumber(r.dist_left_m.back())},
+                    {"dist_right_m", JsonNumber(r.dist_right_m.back())}});
+  }
+  if (o.json.PrintText()) {
+    for (const auto& r : result.recordings) {
+      fmt::print("{}: {} wheel messages, {} ground-truth poses, {:.1f} s, {} run(s){}\n", r.path, r.wheel_messages,
+                 r.ground_truth_messages, r.duration_s, r.runs,
+                 r.left_joint.empty() ? "" : fmt::format(" (joints {} / {})", r.left_joint, r.right_joint));
+    }
+    for (const auto& r : result.runs.runs)
+      fmt::print("  run {:>3}  {:<14} {:>6} samples  t {:8.2f} .. {:8.2f} s  travel L {:7.3f} m  R {:7.3f} m\n", r.run,
+                 r.direction, r.size(), r.t_s.front(), r.t_s.back(), r.dist_left_m.back(), r.dist_right_m.back());
+    for (const auto& w : result.warnings) fmt::print("warning: {}\n", w);
+    fmt::print("  wrote {}\n  wrote {}\nNext: umbmark calibrate {} (squares) or umbmark fit-noise {}\n", manifest_path,
+               runs_path, manifest_path, manifest_path);
+  }
+  o.json.Emit({{"manifest", manifest_path},
+               {"runs_csv", runs_path},
+               {"robot", JsonParams(robot)},
+               {"experiment", o.experiment},
+               {"recordings", recordings},
+               {"runs", runs},
+               {"warnings", result.warnings}});
+  return 0;
+}
+
 }  // namespace
 
 Command SetupImport(CLI::App& parent) {
@@ -84,7 +221,46 @@ Command SetupImport(CLI::App& parent) {
                  "Dataset category (square|circular|ivanjko|free); default: the parent folder's name")
       ->check(CLI::IsMember({"square", "circular", "ivanjko", "free"}));
   opts->json.Bind(*od);
-  return {imp, [opts] { return RunImportOptiOdom(*opts); }};
+
+  auto ro = std::make_shared<Rosbag2Options>();
+  auto* rb = imp->add_subcommand("rosbag2", "Convert ROS 2 recordings (rosbag2: MCAP or SQLite3) to OUTDIR/campaign.toml + "
+                                            "runs.csv, or --list their topics");
+  rb->add_option("BAG", ro->bags, "rosbag2 folder (metadata.yaml + .mcap/.db3 files) or a single .mcap/.db3 file; "
+                                  "several are read in order, runs numbered across them")
+      ->required();
+  rb->add_flag("--list", ro->list, "Print every topic with type, message count and rate, and what it can serve as; write nothing");
+  rb->add_option("--out", ro->out, "Output directory");
+  rb->add_option("--experiment", ro->experiment, "Experiment kind")->check(CLI::IsMember({"square", "back_and_forth", "free"}));
+  rb->add_option("--side", ro->side_m, "Square side [m] (square)");
+  rb->add_option("--distance", ro->distance_m, "Leg length [m] (back_and_forth)");
+  auto* wheels = rb->add_option("--wheels", ro->import.wheels_topic, "sensor_msgs/msg/JointState topic with the wheel positions [rad]");
+  auto* odom = rb->add_option("--odometry", ro->import.odometry_topic,
+                              "nav_msgs/msg/Odometry topic as the robot computed it (inverted with the wheelbase)");
+  wheels->excludes(odom);
+  rb->add_option("--left-joint", ro->import.left_joint, "Left wheel joint (default: the only joint named *left*)")->needs(wheels);
+  rb->add_option("--right-joint", ro->import.right_joint, "Right wheel joint (default: the only joint named *right*)")->needs(wheels);
+  rb->add_option("--ground-truth", ro->import.ground_truth_topic,
+                 "Ground-truth pose topic: PoseStamped, PoseWithCovarianceStamped, Odometry or TFMessage");
+  rb->add_option("--ground-truth-frame", ro->import.ground_truth_frame, "TFMessage: the child_frame_id to follow");
+  rb->add_option("--time", ro->time, "Time stamps: header (header.stamp) or log (receive time)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"header", "log"}));
+  rb->add_option("--integrator", ro->integrator, "Integrator the robot's /odom used (for --odometry)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"arc", "midpoint"}));
+  rb->add_option("--pause", ro->import.pause_s, "Split runs where both wheels stand still this long [s]; 0 = one run per recording")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  rb->add_option("--max-gt-gap", ro->import.max_gt_gap_s,
+                 "Interpolate ground truth only between poses at most this far from the sample [s]")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  ro->robot.Bind(*rb);
+  ro->json.Bind(*rb);
+  return {imp, [opts, ro, rb] {
+            if (rb->parsed()) return RunRosbag2(*ro);
+            return RunImportOptiOdom(*opts);
+          }};
 }
 
 }  // namespace umbmark::cli

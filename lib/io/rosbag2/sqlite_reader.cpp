@@ -1,0 +1,129 @@
+// rosbag2 SQLite3 storage reader (see sqlite_reader.hpp).
+#include "io/rosbag2/sqlite_reader.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+
+#include <fmt/format.h>
+#include <sqlite3.h>
+
+#include "core/errors.hpp"
+
+namespace umbmark::io::rosbag2 {
+
+namespace {
+
+// Finalizes a statement on every path out.
+struct Statement {
+  sqlite3_stmt* stmt = nullptr;
+  ~Statement() { sqlite3_finalize(stmt); }
+};
+
+std::string Text(sqlite3_stmt* s, int col) {
+  const unsigned char* t = sqlite3_column_text(s, col);
+  return t ? reinterpret_cast<const char*>(t) : "";
+}
+
+}  // namespace
+
+void SqliteBagFile::Fail(const std::string& what) const { throw InputError(path_, what); }
+
+SqliteBagFile::SqliteBagFile(std::string path) : path_(std::move(path)) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path_, ec)) Fail("not a regular file");
+  if (sqlite3_open_v2(path_.c_str(), &db_, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX, nullptr) != SQLITE_OK)
+    Fail(fmt::format("cannot open as SQLite3: {}", db_ ? sqlite3_errmsg(db_) : "out of memory"));
+  sqlite3_busy_timeout(db_, 0);
+  auto prepare = [&](Statement& st, const char* sql) {
+    const int rc = sqlite3_prepare_v2(db_, sql, -1, &st.stmt, nullptr);
+    if (rc == SQLITE_NOTADB) Fail("not an SQLite3 database (a rosbag2 .db3 file is one)");
+    if (rc == SQLITE_BUSY || rc == SQLITE_LOCKED) Fail("the database is locked by another process (is the recorder still running?)");
+    if (rc != SQLITE_OK) Fail(fmt::format("SQLite error: {}", sqlite3_errmsg(db_)));
+  };
+  auto step_error = [&](int rc) {
+    if (rc == SQLITE_BUSY || rc == SQLITE_LOCKED) Fail("the database is locked by another process (is the recorder still running?)");
+    if (rc == SQLITE_NOTADB) Fail("not an SQLite3 database (a rosbag2 .db3 file is one)");
+    if (rc == SQLITE_CORRUPT) Fail(fmt::format("corrupt SQLite3 database: {}", sqlite3_errmsg(db_)));
+    Fail(fmt::format("SQLite error: {}", sqlite3_errmsg(db_)));
+  };
+
+  // Which tables are there: a rosbag2 database has topics and messages.
+  std::vector<std::string> tables;
+  {
+    Statement st;
+    prepare(st, "SELECT name FROM sqlite_master WHERE type = 'table' ORDER BY name");
+    int rc;
+    while ((rc = sqlite3_step(st.stmt)) == SQLITE_ROW) tables.push_back(Text(st.stmt, 0));
+    if (rc != SQLITE_DONE) step_error(rc);
+  }
+  const bool has_topics = std::find(tables.begin(), tables.end(), "topics") != tables.end();
+  const bool has_messages = std::find(tables.begin(), tables.end(), "messages") != tables.end();
+  if (!has_topics || !has_messages) {
+    Fail(fmt::format("not a rosbag2 database: it needs the tables 'topics' and 'messages', it has {}",
+                     tables.empty() ? std::string("none") : fmt::format("{}", fmt::join(tables, ", "))));
+  }
+  {
+    Statement st;
+    prepare(st, "SELECT id, name, type, serialization_format FROM topics ORDER BY id");
+    int rc;
+    while ((rc = sqlite3_step(st.stmt)) == SQLITE_ROW) {
+      SqliteTopic t;
+      t.id = sqlite3_column_int64(st.stmt, 0);
+      t.name = Text(st.stmt, 1);
+      t.type = Text(st.stmt, 2);
+      t.serialization_format = Text(st.stmt, 3);
+      topics_.push_back(std::move(t));
+    }
+    if (rc != SQLITE_DONE) step_error(rc);
+  }
+  std::map<std::int64_t, std::size_t> index;
+  for (std::size_t i = 0; i < topics_.size(); ++i) index[topics_[i].id] = i;
+  {
+    Statement st;
+    prepare(st, "SELECT topic_id, COUNT(*), MIN(timestamp), MAX(timestamp) FROM messages GROUP BY topic_id");
+    int rc;
+    while ((rc = sqlite3_step(st.stmt)) == SQLITE_ROW) {
+      const std::int64_t id = sqlite3_column_int64(st.stmt, 0);
+      auto it = index.find(id);
+      if (it == index.end()) Fail(fmt::format("messages refer to topic id {}, which is not in the topics table", id));
+      auto& t = topics_[it->second];
+      t.count = static_cast<std::uint64_t>(sqlite3_column_int64(st.stmt, 1));
+      t.first_ns = sqlite3_column_int64(st.stmt, 2);
+      t.last_ns = sqlite3_column_int64(st.stmt, 3);
+    }
+    if (rc != SQLITE_DONE) step_error(rc);
+  }
+}
+
+SqliteBagFile::~SqliteBagFile() { sqlite3_close(db_); }
+
+void SqliteBagFile::Stream(const std::vector<bool>& wanted,
+                           const std::function<void(std::size_t, std::int64_t, const std::uint8_t*, std::size_t)>& fn) {
+  std::string ids;
+  std::map<std::int64_t, std::size_t> index;
+  for (std::size_t i = 0; i < topics_.size(); ++i) {
+    if (i >= wanted.size() || !wanted[i]) continue;
+    index[topics_[i].id] = i;
+    if (!ids.empty()) ids += ',';
+    ids += std::to_string(topics_[i].id);
+  }
+  if (ids.empty()) return;
+  const std::string sql =
+      "SELECT topic_id, timestamp, data FROM messages WHERE topic_id IN (" + ids + ") ORDER BY timestamp, id";
+  Statement st;
+  if (sqlite3_prepare_v2(db_, sql.c_str(), -1, &st.stmt, nullptr) != SQLITE_OK)
+    Fail(fmt::format("SQLite error: {}", sqlite3_errmsg(db_)));
+  int rc;
+  while ((rc = sqlite3_step(st.stmt)) == SQLITE_ROW) {
+    const std::size_t topic = index.at(sqlite3_column_int64(st.stmt, 0));
+    const std::int64_t ts = sqlite3_column_int64(st.stmt, 1);
+    const void* blob = sqlite3_column_blob(st.stmt, 2);
+    const int n = sqlite3_column_bytes(st.stmt, 2);
+    fn(topic, ts, static_cast<const std::uint8_t*>(blob), static_cast<std::size_t>(n));
+  }
+  if (rc == SQLITE_BUSY || rc == SQLITE_LOCKED) Fail("the database is locked by another process (is the recorder still running?)");
+  if (rc != SQLITE_DONE) Fail(fmt::format("SQLite error while reading messages: {}", sqlite3_errmsg(db_)));
+}
+
+}  // namespace umbmark::io::rosbag2
