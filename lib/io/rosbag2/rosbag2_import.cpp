@@ -96,8 +96,9 @@ std::string Where(const BagMessage& m, const TopicInfo& t, std::size_t index) {
 void CheckIncreasing(std::int64_t prev, std::int64_t t, std::size_t count, const BagMessage& m, const TopicInfo& topic,
                      std::size_t index, StampSource time) {
   if (count > 0 && t <= prev) {
-    throw InputError(*m.file, fmt::format("{}: {} stamp {:.9f} s does not increase (previous {:.9f} s){}", Where(m, topic, index),
-                                          time == StampSource::kHeader ? "header" : "receive", static_cast<double>(t) * 1e-9, static_cast<double>(prev) * 1e-9,
+    auto sec = [](std::int64_t ns) { return fmt::format("{}.{:09d}", ns / 1000000000, std::abs(ns % 1000000000)); };
+    throw InputError(*m.file, fmt::format("{}: {} stamp {} s does not increase (previous {} s){}", Where(m, topic, index),
+                                          time == StampSource::kHeader ? "header" : "receive", sec(t), sec(prev),
                                           time == StampSource::kHeader ? "; try --time log" : ""));
   }
 }

@@ -2,7 +2,9 @@
 #include "io/rosbag2/sqlite_reader.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 
 #include <fmt/format.h>
@@ -32,7 +34,26 @@ void SqliteBagFile::Fail(const std::string& what) const { throw InputError(path_
 SqliteBagFile::SqliteBagFile(std::string path) : path_(std::move(path)) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path_, ec)) Fail("not a regular file");
-  if (sqlite3_open_v2(path_.c_str(), &db_, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX, nullptr) != SQLITE_OK)
+  // A database in WAL mode (file header byte 18 = 2) makes even a read-only
+  // connection create -shm/-wal files beside it. With no -wal file there is
+  // nothing beyond the main file, so it is opened immutable: nothing is
+  // written next to the input. Otherwise (rollback journal, or a live WAL)
+  // the normal read-only open with locking applies.
+  bool immutable = false;
+  {
+    std::ifstream f(path_, std::ios::binary);
+    char head[100] = {};
+    if (f.read(head, sizeof(head)) && std::memcmp(head, "SQLite format 3", 16) == 0 && head[18] == 2 &&
+        !std::filesystem::exists(path_ + "-wal", ec))
+      immutable = true;
+  }
+  std::string uri = "file:";
+  for (char c : std::filesystem::absolute(path_, ec).string()) {
+    if (c == '?' || c == '#' || c == '%') uri += fmt::format("%{:02x}", static_cast<unsigned char>(c));
+    else uri += c;
+  }
+  uri += immutable ? "?mode=ro&immutable=1" : "?mode=ro";
+  if (sqlite3_open_v2(uri.c_str(), &db_, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX | SQLITE_OPEN_URI, nullptr) != SQLITE_OK)
     Fail(fmt::format("cannot open as SQLite3: {}", db_ ? sqlite3_errmsg(db_) : "out of memory"));
   sqlite3_busy_timeout(db_, 0);
   auto prepare = [&](Statement& st, const char* sql) {
