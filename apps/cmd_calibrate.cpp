@@ -234,6 +234,14 @@ int RunCalibrate(const CalibrateOptions& o) {
     jo.refine = ro;
   }
 
+  // Output safety: no output may be an input or another output.
+  io::OutputSet& outs = CommandOutputs();
+  RegisterInputs(o.inputs, &o.robot);
+  outs.AddOutput("--json", o.json.path);
+  outs.AddOutput("--ros2", o.ros2);
+  outs.AddOutput("--plot", o.plot);
+  outs.Check();
+
   // Collect every calibration unit first; with one input, errors propagate
   // (exit 1). With several, a failing input is reported and skipped, and the
   // exit status is 1 at the end.
@@ -280,9 +288,8 @@ int RunCalibrate(const CalibrateOptions& o) {
         continue;
       }
       const std::string tag = std::filesystem::path(in.path).stem().string() + "-" + std::to_string(rows.size() + 1);
-      if (!o.ros2.empty()) io::WriteFileAtomically(batch ? TaggedPath(o.ros2, tag) : o.ros2, Ros2Snippet(r));
-      if (!o.plot.empty())
-        io::WriteFileAtomically(batch ? TaggedPath(o.plot, tag) : o.plot, CalibrationPlotSvg(in, r, jo.integrator));
+      if (!o.ros2.empty()) outs.Write(batch ? TaggedPath(o.ros2, tag) : o.ros2, Ros2Snippet(r));
+      if (!o.plot.empty()) outs.Write(batch ? TaggedPath(o.plot, tag) : o.plot, CalibrationPlotSvg(in, r, jo.integrator));
       if (o.json.PrintText()) {
         PrintResult(r);
         fmt::print("\n");

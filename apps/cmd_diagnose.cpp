@@ -34,11 +34,16 @@ int RunDiagnose(DiagnoseCliOptions o) {
     if (!k) throw InvalidOptions(fmt::format("--effects: unknown effect '{}'", name));
     o.diag.effects.push_back(*k);
   }
+  io::OutputSet& outs = CommandOutputs();
+  RegisterInputs({o.manifest});
+  outs.AddOutput("--json", o.json.path);
+  outs.AddOutput("--plot", o.plot);
+  outs.Check();
   const diag::CampaignData campaign = diag::LoadCampaign(o.manifest, o.diag.pieces);
   const diag::DiagnoseSummary s = diag::Diagnose(campaign, o.diag);
   if (o.json.PrintText()) fmt::print("{}", diag::DiagnoseReport(s));
   if (!o.plot.empty()) {
-    io::WriteFileAtomically(o.plot, diag::DiagnosePlotSvg(s));
+    outs.Write(o.plot, diag::DiagnosePlotSvg(s));
     if (o.json.PrintText()) fmt::print("wrote {}\n", o.plot);
   }
   nlohmann::json j = diag::DiagnoseToJson(s);
@@ -73,7 +78,7 @@ Command SetupDiagnose(CLI::App& parent) {
                "Judge the gap by the gap score alone (default: combined with the candidates' likelihood-ratio tests)");
   app->add_flag("!--no-standstill-averaging", d.pieces.average_standstills,
                 "Measure motions from/to single ground-truth samples (default: the adjacent standstills' mean pose)");
-  app->add_option("--seed", d.seed, "Seed of the null simulations (default 1)");
+  app->add_option("--seed", d.seed, "Seed of the null simulations (default 1)")->check(SeedValidator());
   app->add_option("--threads", d.threads, "Threads (default 2)")->check(CLI::Range(1, 256));
   app->add_option("--where", d.where_top, "Discrepancies listed under 'where' (default 12)")->check(CLI::NonNegativeNumber);
   app->add_option("--effects", opts->effects, "Effects to try (default: the contract's nine)")->delimiter(',');

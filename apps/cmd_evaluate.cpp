@@ -168,6 +168,12 @@ std::string PlotSvg(const std::vector<Source>& sources, const std::optional<Robo
 
 int RunEvaluate(const EvaluateOptions& o) {
   const Integrator integ = *IntegratorFromString(o.integrator);
+  io::OutputSet& outs = CommandOutputs();
+  RegisterInputs(o.inputs, &o.robot);
+  outs.AddInput(o.params_file);
+  outs.AddOutput("--json", o.json.path);
+  outs.AddOutput("--plot", o.plot);
+  outs.Check();
   const std::vector<Source> sources = LoadSources(o);
   std::optional<RobotParams> params;
   if (!o.params_file.empty()) params = ReadParams(o.params_file, sources.front().recorded);
@@ -201,7 +207,7 @@ int RunEvaluate(const EvaluateOptions& o) {
                      {"runs", JsonEvaluationRuns(base)},
                      {"summary", JsonEvaluationSummary(base)}};
   }
-  if (!o.plot.empty()) io::WriteFileAtomically(o.plot, PlotSvg(sources, params, integ));
+  if (!o.plot.empty()) outs.Write(o.plot, PlotSvg(sources, params, integ));
   o.json.Emit(j);
   return 0;
 }

@@ -189,6 +189,11 @@ std::string PlotSvg(const WheelNoiseFitSummary& s) {
 }
 
 int RunFitNoise(const FitNoiseOptions& o) {
+  io::OutputSet& outs = CommandOutputs();
+  RegisterInputs(o.inputs, &o.robot);
+  outs.AddOutput("--json", o.json.path);
+  outs.AddOutput("--plot", o.plot);
+  outs.Check();
   Loaded data = Load(o);
   if (data.runs.empty()) throw InputError(o.inputs.front(), "no run with ground truth at its start and end");
   WheelNoiseFitOptions fo;
@@ -254,7 +259,7 @@ int RunFitNoise(const FitNoiseOptions& o) {
     }
     if (flagged) fmt::print("  |z| > 3: the wheel noise model cannot explain that element (see docs/noise-model.md)\n");
   }
-  if (!o.plot.empty()) io::WriteFileAtomically(o.plot, PlotSvg(s));
+  if (!o.plot.empty()) CommandOutputs().Write(o.plot, PlotSvg(s));
   o.json.Emit(j);
   return 0;
 }

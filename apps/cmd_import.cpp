@@ -32,6 +32,19 @@ int RunImportOptiOdom(const ImportOptions& o) {
   namespace fs = std::filesystem;
   std::optional<std::string> category;
   if (!o.category.empty()) category = o.category;
+  // The output folder must not hold the dataset; the two files it gets must
+  // not be other outputs.
+  io::OutputSet& outs = CommandOutputs();
+  outs.AddInput(o.dir);
+  if (fs::exists(o.dir)) {
+    for (const auto& entry : fs::directory_iterator(o.dir)) outs.AddInput(entry.path().string());
+  }
+  const std::string runs_path = (fs::path(o.out) / "runs.csv").string();
+  const std::string manifest_path = (fs::path(o.out) / "campaign.toml").string();
+  outs.AddOutput("--out", runs_path);
+  outs.AddOutput("--out", manifest_path);
+  outs.AddOutput("--json", o.json.path);
+  outs.Check();
   const io::OptiOdomDataset ds = io::ImportOptiOdom(o.dir, category);
 
   std::error_code ec;
@@ -42,10 +55,8 @@ int RunImportOptiOdom(const ImportOptions& o) {
   Manifest m;
   m.robot = ds.robot;
   m.experiments.push_back(ds.experiment);
-  const std::string runs_path = (fs::path(o.out) / "runs.csv").string();
-  const std::string manifest_path = (fs::path(o.out) / "campaign.toml").string();
-  io::WriteFileAtomically(runs_path, io::FormatTrajectoryCsv(ds.runs, {source}));
-  io::WriteFileAtomically(manifest_path, io::FormatManifest(m, {source}));
+  outs.Write(runs_path, io::FormatTrajectoryCsv(ds.runs, {source}));
+  outs.Write(manifest_path, io::FormatManifest(m, {source}));
 
   std::size_t samples = 0;
   nlohmann::json runs = nlohmann::json::array();

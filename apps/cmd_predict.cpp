@@ -72,6 +72,9 @@ void PrintCovariance(const char* title, const Pose2& mean, const PoseCovariance&
 }
 
 int RunPredict(const PredictOptions& o) {
+  RegisterInputs({}, &o.robot);
+  CommandOutputs().AddOutput("--json", o.json.path);
+  CommandOutputs().Check();
   const RobotParams robot = o.robot.Resolve();
   const WheelNoise noise{o.k_L, o.k_R};
   const std::vector<PathSegment> spec = ParsePathSpec(o.path);
@@ -165,6 +168,7 @@ Command SetupPredict(CLI::App& parent) {
       ->check(CLI::Range(1, 1 << 30))
       ->capture_default_str();
   app->add_option("--seed", opts->seed, "Monte Carlo: seed (run i uses streams derived from (seed, i))")
+      ->check(SeedValidator())
       ->capture_default_str();
   app->add_option("--threads", opts->threads, "Monte Carlo: worker threads (0 = all cores)")
       ->check(CLI::NonNegativeNumber)

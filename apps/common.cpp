@@ -8,7 +8,9 @@
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
+#include "core/utf8.hpp"
 #include "io/atomic_write.hpp"
+#include "io/manifest.hpp"
 #include "io/robot_toml.hpp"
 
 namespace umbmark::cli {
@@ -58,12 +60,67 @@ void JsonFlag::Bind(CLI::App& app) {
 
 void JsonFlag::Emit(const nlohmann::json& j) const {
   if (path.empty()) return;
-  const std::string text = j.dump(2) + "\n";
-  if (ToStdout()) {
-    std::fwrite(text.data(), 1, text.size(), stdout);
-    std::fflush(stdout);
-  } else {
-    io::WriteFileAtomically(path, text);
+  nlohmann::json out = j;
+  if (out.is_object() && !out.contains("warnings")) out["warnings"] = nlohmann::json::array();
+  CommandOutputs().Write(path, DumpJson(out) + "\n");
+}
+
+CLI::Validator SeedValidator() {
+  return CLI::Validator(
+      [](std::string& v) -> std::string {
+        const bool digits = !v.empty() && v.size() <= 20 && v.find_first_not_of("0123456789") == std::string::npos;
+        if (!digits || (v.size() == 20 && v > "18446744073709551615")) {
+          return fmt::format("the seed must be a whole number from 0 to 18446744073709551615 (got '{}')", v);
+        }
+        return {};
+      },
+      "SEED");
+}
+
+io::OutputSet& CommandOutputs() {
+  static io::OutputSet set;
+  return set;
+}
+
+void RegisterInputs(const std::vector<std::string>& inputs, const RobotFlags* robot) {
+  io::OutputSet& outs = CommandOutputs();
+  for (const auto& path : inputs) {
+    outs.AddInput(path);
+    if (!io::IsManifestPath(path)) continue;
+    try {
+      outs.AddManifestInputs(path, io::ReadManifest(path));
+    } catch (const InputError&) {
+      // reported by the command when it reads the manifest
+    }
+  }
+  if (robot) outs.AddInput(robot->robot_file);
+}
+
+namespace {
+nlohmann::json EscapedStrings(const nlohmann::json& j) {
+  if (j.is_string()) {
+    const auto& s = j.get_ref<const std::string&>();
+    return IsValidUtf8(s) ? j : nlohmann::json(EscapeInvalidUtf8(s));
+  }
+  if (j.is_array()) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const auto& v : j) out.push_back(EscapedStrings(v));
+    return out;
+  }
+  if (j.is_object()) {
+    nlohmann::json out = nlohmann::json::object();
+    for (auto it = j.begin(); it != j.end(); ++it) out[EscapeInvalidUtf8(it.key())] = EscapedStrings(it.value());
+    return out;
+  }
+  return j;
+}
+}  // namespace
+
+std::string DumpJson(const nlohmann::json& j, int indent) {
+  try {
+    return j.dump(indent);
+  } catch (const nlohmann::json::type_error&) {
+    return EscapedStrings(j).dump(indent);  // invalid UTF-8 somewhere: escape, then dump
   }
 }
 

@@ -13,6 +13,7 @@
 #include "core/robot.hpp"
 #include "core/runs.hpp"
 #include "evaluation/trajectory_eval.hpp"
+#include "io/output_set.hpp"
 
 namespace umbmark::cli {
 
@@ -38,11 +39,34 @@ struct JsonFlag {
   bool ToStdout() const { return path == "-"; }
   /// True when the human-readable text should be printed (not `--json -`).
   bool PrintText() const { return !ToStdout(); }
-  /// Writes `j` (pretty, 2-space indent) to stdout or atomically to the file.
+  /// Writes `j` (pretty, 2-space indent) to stdout or atomically to the file
+  /// through CommandOutputs(). Adds an empty top-level `warnings` list when
+  /// `j` is an object without one (the contract: every command's JSON has
+  /// it); invalid UTF-8 in strings is escaped (see DumpJson).
   void Emit(const nlohmann::json& j) const;
 };
 
-/// Rounds-trips doubles; NaN/Inf become null so the JSON stays valid.
+/// Validator for --seed: a whole number in [0, 2^64), quoted back as given
+/// (CLI11 would turn "-1" silently into 2^64-1).
+CLI::Validator SeedValidator();
+
+/// The process's output set: every command registers its inputs and outputs
+/// here, calls Check() before writing anything, and writes through Write()
+/// (see io/output_set.hpp). One command runs per process.
+io::OutputSet& CommandOutputs();
+
+/// Registers the command's input files with CommandOutputs(): each path, and
+/// for a manifest (.toml) every experiment file it names (a manifest that
+/// cannot be read is left to the command's own reader to report), plus the
+/// robot file of `robot` when given.
+void RegisterInputs(const std::vector<std::string>& inputs, const RobotFlags* robot = nullptr);
+
+/// `j` as text (pretty when indent >= 0), every string and key with invalid
+/// UTF-8 bytes escaped as \xNN, so a run id read from a file never breaks
+/// the JSON writer.
+std::string DumpJson(const nlohmann::json& j, int indent = 2);
+
+/// Round-trips doubles; NaN/Inf become null so the JSON stays valid.
 nlohmann::json JsonNumber(double v);
 nlohmann::json JsonParams(const RobotParams& p);
 

@@ -1,5 +1,7 @@
 // Atomic file output (temporary file in the target's directory, fsync,
-// rename) and whole-file input, on POSIX file descriptors.
+// rename), staging directories renamed into place as a whole, clean-up of
+// temporary files on SIGINT/SIGTERM/SIGHUP, the rename fault-injection hook,
+// and whole-file input, on POSIX file descriptors.
 #include "io/atomic_write.hpp"
 
 #include <fcntl.h>
@@ -8,6 +10,10 @@
 
 #include <atomic>
 #include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <system_error>
 
@@ -17,6 +23,8 @@
 
 namespace umbmark::io {
 namespace {
+
+namespace fs = std::filesystem;
 
 std::string ErrnoText(int err) { return std::error_code(err, std::generic_category()).message(); }
 
@@ -41,24 +49,113 @@ class FdGuard {
   int fd_;
 };
 
+// ---- Temporary paths in flight, for the signal handler ---------------------
+// Fixed storage (no allocation, async-signal-safe to read): a handler unlinks
+// the files, then removes the directories.
+constexpr int kMaxPending = 64;
+constexpr std::size_t kMaxPath = 4096;
+struct PendingSlot {
+  std::atomic<int> state{0};  // 0 free, 1 file, 2 directory
+  char path[kMaxPath];
+};
+PendingSlot g_pending[kMaxPending];
+
+int RegisterPending(const std::string& path, int kind) {
+  if (path.size() >= kMaxPath) return -1;
+  for (int i = 0; i < kMaxPending; ++i) {
+    int expected = 0;
+    if (g_pending[i].state.compare_exchange_strong(expected, -1)) {
+      std::memcpy(g_pending[i].path, path.c_str(), path.size() + 1);
+      g_pending[i].state.store(kind);
+      return i;
+    }
+  }
+  return -1;
+}
+
+void Unregister(int slot) {
+  if (slot >= 0) g_pending[slot].state.store(0);
+}
+
+/// Unregisters a slot when the scope ends (success or error).
+struct PendingGuard {
+  int slot;
+  ~PendingGuard() { Unregister(slot); }
+};
+
+extern "C" void CleanupOnSignal(int sig) {
+  for (auto& s : g_pending)
+    if (s.state.load() == 1) ::unlink(s.path);
+  for (int i = kMaxPending - 1; i >= 0; --i)  // sub-folders were registered after their parent
+    if (g_pending[i].state.load() == 2) ::rmdir(g_pending[i].path);
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
+
+/// Test hook: raise a signal just before the N-th rename into place.
+void BeforeRename() {
+  static const long kill_at = [] {
+    const char* v = std::getenv("UMBMARK_TEST_KILL_AT_RENAME");
+    return v ? std::strtol(v, nullptr, 10) : 0L;
+  }();
+  static long renames = 0;
+  if (kill_at <= 0 || ++renames != kill_at) return;
+  const char* s = std::getenv("UMBMARK_TEST_KILL_SIGNAL");
+  const std::string name = s ? s : "TERM";
+  ::raise(name == "KILL" ? SIGKILL : name == "INT" ? SIGINT : SIGTERM);
+}
+
+/// True when `p` lies in a staging directory registered for clean-up: files
+/// renamed into it are registered too, so a signal removes them.
+bool InPendingDirectory(const fs::path& p) {
+  const std::string parent = p.parent_path().string();
+  for (auto& s : g_pending)
+    if (s.state.load() == 2 && parent == s.path) return true;
+  return false;
+}
+
+bool UnderSpecialTree(const std::string& p) {
+  return p == "/dev" || p.rfind("/dev/", 0) == 0 || p == "/proc" || p.rfind("/proc/", 0) == 0;
+}
+
 }  // namespace
 
-void WriteFileAtomically(const std::string& path, std::string_view content) {
-  namespace fs = std::filesystem;
+std::string ResolveOutputTarget(const std::string& path) {
   if (path.empty()) throw InputError(path, "empty output file name");
-  struct stat st {};
-  if (::stat(path.c_str(), &st) == 0) {
-    if (!S_ISREG(st.st_mode)) {
-      throw InputError(path, S_ISDIR(st.st_mode)
-                                 ? "refusing to write: it is a directory"
-                                 : "refusing to write: it exists and is not a regular file (device, FIFO or socket)");
+  if (!fs::path(path).has_filename()) throw InputError(path, "refusing to write: the path names a directory");
+  // Follow symbolic links by hand (a dangling link's target may not exist yet).
+  fs::path p(path);
+  for (int hops = 0;; ++hops) {
+    if (UnderSpecialTree(fs::absolute(p).lexically_normal().string())) {
+      struct stat st {};
+      if (::lstat(p.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+        throw InputError(path, "refusing to write: it is a device or a process's file descriptor, not a regular file "
+                               "(use '-' for standard output)");
+      }
     }
-  } else if (errno != ENOENT) {
-    throw InputError(path, fmt::format("cannot write: {}", ErrnoText(errno)));
+    struct stat st {};
+    if (::lstat(p.c_str(), &st) != 0) {
+      if (errno != ENOENT) throw InputError(path, fmt::format("cannot write: {}", ErrnoText(errno)));
+      return p.string();
+    }
+    if (S_ISREG(st.st_mode)) return p.string();
+    if (S_ISDIR(st.st_mode)) throw InputError(path, "refusing to write: it is a directory");
+    if (!S_ISLNK(st.st_mode)) {
+      throw InputError(path, "refusing to write: it exists and is not a regular file (device, FIFO or socket)");
+    }
+    if (hops >= 40) throw InputError(path, "refusing to write: too many levels of symbolic links");
+    std::error_code ec;
+    const fs::path link = fs::read_symlink(p, ec);
+    if (ec) throw InputError(path, fmt::format("cannot read the symbolic link: {}", ec.message()));
+    p = link.is_absolute() ? link : p.parent_path() / link;
   }
+}
 
-  const fs::path target(path);
-  if (!target.has_filename()) throw InputError(path, "refusing to write: the path names a directory");
+void WriteFileAtomically(const std::string& path, std::string_view content) {
+  const fs::path target(ResolveOutputTarget(path));
+  struct stat old {};
+  const bool had_old = ::stat(target.c_str(), &old) == 0;
+
   static std::atomic<unsigned> counter{0};
   std::string tmp;
   int fd = -1;
@@ -71,6 +168,7 @@ void WriteFileAtomically(const std::string& path, std::string_view content) {
     }
   }
   if (fd < 0) throw InputError(path, fmt::format("cannot create a temporary file next to it"));
+  PendingGuard pending{RegisterPending(tmp, 1)};
 
   FdGuard guard(fd);
   const auto fail = [&](const char* what, int err) {
@@ -78,6 +176,7 @@ void WriteFileAtomically(const std::string& path, std::string_view content) {
     ::unlink(tmp.c_str());
     throw InputError(path, fmt::format("{}: {}", what, ErrnoText(err)));
   };
+  if (had_old && ::fchmod(fd, old.st_mode & 07777) != 0) fail("cannot set the permissions", errno);
   const char* p = content.data();
   std::size_t left = content.size();
   while (left > 0) {
@@ -95,7 +194,11 @@ void WriteFileAtomically(const std::string& path, std::string_view content) {
     ::unlink(tmp.c_str());
     throw InputError(path, fmt::format("cannot close: {}", ErrnoText(err)));
   }
-  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+  // A file renamed into a staging directory stays registered until the
+  // directory is committed, so an interrupted run leaves nothing behind.
+  if (InPendingDirectory(target)) RegisterPending(target.string(), 1);
+  BeforeRename();
+  if (::rename(tmp.c_str(), target.c_str()) != 0) {
     const int err = errno;
     ::unlink(tmp.c_str());
     throw InputError(path, fmt::format("cannot rename the temporary file into place: {}", ErrnoText(err)));
@@ -106,6 +209,82 @@ void WriteFileAtomically(const std::string& path, std::string_view content) {
   if (dir_fd >= 0) {
     ::fsync(dir_fd);
     ::close(dir_fd);
+  }
+}
+
+std::string MakeStagingDirectory(const std::string& dir) {
+  fs::path d = fs::path(dir).lexically_normal();
+  if (!d.has_filename()) d = d.parent_path();
+  if (d.empty() || d == "." || d == "..") {
+    d = fs::absolute(d).lexically_normal();
+    if (!d.has_filename()) d = d.parent_path();
+  }
+  const fs::path parent = d.parent_path().empty() ? fs::path(".") : d.parent_path();
+  std::string templ = (parent / fmt::format(".{}.tmp.{}.XXXXXX", d.filename().string(), ::getpid())).string();
+  if (::mkdtemp(templ.data()) == nullptr) {
+    throw InputError(dir, fmt::format("cannot create a temporary folder in '{}': {}", parent.string(), ErrnoText(errno)));
+  }
+  RegisterPending(templ, 2);
+  return templ;
+}
+
+void CreateStagedFolder(const std::string& path) {
+  std::error_code ec;
+  const fs::path p(path);
+  if (fs::is_directory(p, ec)) return;
+  if (!p.parent_path().empty()) CreateStagedFolder(p.parent_path().string());
+  if (!fs::create_directory(p, ec) && ec) throw InputError(path, "cannot create folder: " + ec.message());
+  if (InPendingDirectory(p)) RegisterPending(p.string(), 2);
+}
+
+void DiscardStagingDirectory(const std::string& staging) noexcept {
+  std::error_code ec;
+  fs::remove_all(staging, ec);
+  for (int i = 0; i < kMaxPending; ++i) {
+    const int st = g_pending[i].state.load();
+    if (st <= 0) continue;
+    const std::string p = g_pending[i].path;
+    if (p == staging || p.rfind(staging + "/", 0) == 0) Unregister(i);
+  }
+}
+
+void CommitStagingDirectory(const std::string& staging, const std::string& dir, bool replace) {
+  struct stat st {};
+  const bool exists = ::lstat(dir.c_str(), &st) == 0;
+  if (exists && !S_ISDIR(st.st_mode)) {
+    DiscardStagingDirectory(staging);
+    throw InputError(dir, S_ISLNK(st.st_mode) ? "refusing to replace a symbolic link with a folder"
+                                              : "refusing to replace: it exists and is not a folder");
+  }
+  BeforeRename();
+  if (::rename(staging.c_str(), dir.c_str()) == 0) {
+    DiscardStagingDirectory(staging);  // only unregisters: the folder moved
+    return;
+  }
+  const int err = errno;
+  if ((err != ENOTEMPTY && err != EEXIST) || !replace) {
+    DiscardStagingDirectory(staging);
+    if (err == ENOTEMPTY || err == EEXIST) {
+      throw InputError(dir, "refusing to write into a folder that is not empty (use --force to replace it)");
+    }
+    throw InputError(dir, fmt::format("cannot rename the finished folder into place: {}", ErrnoText(err)));
+  }
+  // Replace a non-empty folder: swap both in one step, then delete the old.
+  if (::renameat2(AT_FDCWD, staging.c_str(), AT_FDCWD, dir.c_str(), RENAME_EXCHANGE) != 0) {
+    const int e2 = errno;
+    DiscardStagingDirectory(staging);
+    throw InputError(dir, fmt::format("cannot replace the folder: {}", ErrnoText(e2)));
+  }
+  DiscardStagingDirectory(staging);  // now holds the old contents
+}
+
+void InstallTemporaryFileCleanup() {
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction sa {};
+    sa.sa_handler = CleanupOnSignal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESETHAND;
+    ::sigaction(sig, &sa, nullptr);
   }
 }
 

@@ -94,11 +94,9 @@ std::string FormatEndpointCsv(const EndpointData& data, const std::vector<std::s
 }
 
 std::string WriteCampaign(const Manifest& manifest, const std::vector<ExperimentData>& data, const std::string& dir,
-                          const std::vector<std::string>& comment) {
+                          const std::vector<std::string>& comment, const std::vector<ExtraFile>& extra_files,
+                          bool replace) {
   namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir)) throw InputError(dir, "cannot create output directory: " + ec.message());
   if (data.size() != manifest.experiments.size())
     throw InputError(manifest.path, fmt::format("{} experiments but {} data sets to write", manifest.experiments.size(), data.size()));
   std::set<std::string> names = {"campaign.toml"};
@@ -113,18 +111,36 @@ std::string WriteCampaign(const Manifest& manifest, const std::vector<Experiment
       throw InputError(manifest.path,
                        fmt::format("experiment {}: file '{}' is used twice (or is campaign.toml)", e + 1, file));
   }
-  for (std::size_t e = 0; e < manifest.experiments.size(); ++e) {
-    const fs::path target = fs::path(dir) / manifest.experiments[e].file;
-    fs::create_directories(target.parent_path(), ec);
-    const auto& d = data[e];
-    if (const auto* t = std::get_if<TrajectoryData>(&d))
-      WriteFileAtomically(target.string(), FormatTrajectoryCsv(*t, comment));
-    else
-      WriteFileAtomically(target.string(), FormatEndpointCsv(std::get<EndpointData>(d), comment));
+  for (const auto& x : extra_files) {
+    if (!names.insert(fs::path(x.name).lexically_normal().string()).second)
+      throw InputError(dir, fmt::format("'{}' would be written twice", x.name));
   }
-  const std::string manifest_path = (fs::path(dir) / "campaign.toml").string();
-  WriteFileAtomically(manifest_path, FormatManifest(manifest, comment));
-  return manifest_path;
+  std::error_code ec;
+  const fs::path parent = fs::absolute(dir).lexically_normal().parent_path();
+  fs::create_directories(parent, ec);
+  if (ec || !fs::is_directory(parent)) throw InputError(dir, "cannot create the parent folder: " + ec.message());
+  // The whole campaign goes into a staging folder next to `dir`, renamed
+  // into place in one step: a reader (or an interrupted run) sees the
+  // complete old campaign or the complete new one, never a mix.
+  const std::string staging = MakeStagingDirectory(dir);
+  try {
+    for (std::size_t e = 0; e < manifest.experiments.size(); ++e) {
+      const fs::path target = fs::path(staging) / fs::path(manifest.experiments[e].file).lexically_normal();
+      if (target.parent_path() != fs::path(staging)) CreateStagedFolder(target.parent_path().string());
+      const auto& d = data[e];
+      if (const auto* t = std::get_if<TrajectoryData>(&d))
+        WriteFileAtomically(target.string(), FormatTrajectoryCsv(*t, comment));
+      else
+        WriteFileAtomically(target.string(), FormatEndpointCsv(std::get<EndpointData>(d), comment));
+    }
+    for (const auto& x : extra_files) WriteFileAtomically((fs::path(staging) / x.name).string(), x.content);
+    WriteFileAtomically((fs::path(staging) / "campaign.toml").string(), FormatManifest(manifest, comment));
+  } catch (...) {
+    DiscardStagingDirectory(staging);
+    throw;
+  }
+  CommitStagingDirectory(staging, dir, replace);
+  return (fs::path(dir) / "campaign.toml").string();
 }
 
 }  // namespace umbmark::io

@@ -22,12 +22,23 @@ std::string FormatManifest(const Manifest& manifest, const std::vector<std::stri
 /// Endpoint CSV text (run,direction,ex_m,ey_m,etheta_rad).
 std::string FormatEndpointCsv(const EndpointData& data, const std::vector<std::string>& comment = {});
 
-/// Writes a campaign into `dir` (created if missing): `campaign.toml` and one
-/// file per experiment (data[e] for manifest.experiments[e], named by its
-/// `file`), all atomically. Returns the manifest path. Throws InputError
-/// when a file cannot be written, two experiments name the same file, or
-/// data and experiments differ in number.
+/// A further file written into the campaign folder (e.g. truth.json).
+struct ExtraFile {
+  std::string name;  ///< relative to the folder
+  std::string content;
+};
+
+/// Writes a campaign as the folder `dir`: `campaign.toml`, one file per
+/// experiment (data[e] for manifest.experiments[e], named by its `file`) and
+/// `extra_files`, all into a staging folder next to `dir` that is renamed
+/// into place as a whole (an interrupted run leaves the complete old folder
+/// or the complete new one). `dir` must be new or empty; with `replace` a
+/// non-empty `dir` is replaced with everything in it. Returns the manifest
+/// path. Throws InputError when a file cannot be written, two experiments
+/// name the same file, data and experiments differ in number, or `dir` is
+/// not empty.
 std::string WriteCampaign(const Manifest& manifest, const std::vector<ExperimentData>& data, const std::string& dir,
-                          const std::vector<std::string>& comment = {});
+                          const std::vector<std::string>& comment = {}, const std::vector<ExtraFile>& extra_files = {},
+                          bool replace = false);
 
 }  // namespace umbmark::io

@@ -157,6 +157,7 @@ std::string CampaignSimOptions::Check() const {
   if (auto e = positive("turn_rate_rad_s", turn_rate_rad_s); !e.empty()) return e;
   if (auto e = positive("free_radius_m", free_radius_m); !e.empty()) return e;
   if (!(pause_s >= 0.0) || !std::isfinite(pause_s)) return fmt::format("pause_s = {} must be >= 0", pause_s);
+  if (!(max_samples > 0.0)) return fmt::format("max_samples = {} must be > 0", max_samples);
   if (ground_truth) {
     if (!(ground_truth->sigma_xy_m >= 0.0) || !std::isfinite(ground_truth->sigma_xy_m))
       return fmt::format("ground_truth.sigma_xy_m = {} must be >= 0", ground_truth->sigma_xy_m);
@@ -166,11 +167,47 @@ std::string CampaignSimOptions::Check() const {
   return {};
 }
 
+double EstimateCampaignSamples(const Manifest& manifest, const CampaignSimOptions& o,
+                               const std::vector<std::optional<TrajectoryData>>& free_templates) {
+  const double b = manifest.robot.wheelbase_m, rate = o.sample_rate_hz;
+  double total = 0.0;
+  for (std::size_t e = 0; e < manifest.experiments.size(); ++e) {
+    const Experiment& ex = manifest.experiments[e];
+    switch (ex.kind) {
+      case ExperimentKind::kSquare:
+        total += 2.0 * o.square_runs_per_direction *
+                 ((4.0 * ex.side_m / o.speed_m_s + 2.0 * kPi / o.turn_rate_rad_s + 9.0 * o.pause_s) * rate + 1.0);
+        break;
+      case ExperimentKind::kBackAndForth:
+        total += o.back_and_forth_runs * ((2.0 * ex.distance_m / o.speed_m_s + 3.0 * o.pause_s) * rate + 1.0);
+        break;
+      case ExperimentKind::kFree:
+        if (e < free_templates.size() && free_templates[e]) {
+          for (const auto& r : free_templates[e]->runs) total += static_cast<double>(r.size());
+        } else {
+          const double outer = 2.0 * kPi * (o.free_radius_m + 0.5 * b);
+          total += o.free_runs * ((2.0 * outer / o.speed_m_s + 3.0 * o.pause_s) * rate + 1.0);
+        }
+        break;
+    }
+  }
+  return total;
+}
+
 SimulatedCampaign SimulateCampaign(const Manifest& manifest, const CampaignSimOptions& options,
                                    const std::vector<std::optional<TrajectoryData>>& free_templates) {
   if (auto e = options.Check(); !e.empty()) throw InvalidOptions("simulate: " + e);
   const RobotParams& robot = manifest.robot;
   if (auto e = robot.Check(); !e.empty()) throw InvalidOptions("simulate: robot: " + e);
+  // Resource bound first: a tiny speed or a huge run count must be refused
+  // before any run is planned or any memory taken.
+  const double samples = EstimateCampaignSamples(manifest, options, free_templates);
+  if (!(samples <= options.max_samples)) {
+    throw InvalidOptions(fmt::format(
+        "simulate: the campaign would hold about {:.3g} samples (about {:.3g} GB), more than the limit of {:.3g}; "
+        "lower the run counts or the sample rate, or raise the speed",
+        samples, samples * 150e-9, options.max_samples));
+  }
   const bool ticks = robot.ticks_per_rev.has_value();
 
   // Run plans per experiment, then the campaign's run count (drift check).

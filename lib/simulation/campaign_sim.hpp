@@ -84,6 +84,10 @@ struct CampaignSimOptions {
   /// Write square experiments as endpoint CSV (return errors e = ground
   /// truth - odometry, eq. 3.1) instead of trajectories. Default false.
   bool endpoint_squares = false;
+  /// Upper bound on the samples of the whole campaign (checked up front,
+  /// before any memory is taken; each sample costs about 150 bytes in memory
+  /// and in the CSV). Default 20 million (about 3 GB).
+  double max_samples = 2e7;
 
   std::string Check() const;
 };
@@ -108,6 +112,11 @@ struct SimulatedCampaign {
 /// ticks_per_rev).
 SimulatedCampaign SimulateCampaign(const Manifest& manifest, const CampaignSimOptions& options,
                                    const std::vector<std::optional<TrajectoryData>>& free_templates = {});
+
+/// The number of samples SimulateCampaign would produce (sum over runs of
+/// duration x sample rate, or the template's samples). Cheap: no run is planned.
+double EstimateCampaignSamples(const Manifest& manifest, const CampaignSimOptions& options,
+                               const std::vector<std::optional<TrajectoryData>>& free_templates = {});
 
 /// The truth behind a campaign (seed, true robot, effects with their
 /// parameters, ground-truth noise, run counts) as JSON.
