@@ -1,6 +1,8 @@
 // SVG for `calibrate --plot` (see calibrate_plot.hpp).
 #include "calibrate_plot.hpp"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "io/svg_plot.hpp"
@@ -42,17 +44,17 @@ std::string Panel(double left, const std::string& title, const std::vector<Retur
 }  // namespace
 
 std::string CalibrationPlotSvg(const CalibrateInput& input, const CalibrateJobResult& result,
-                               Integrator integrator) {
+                               Integrator integrator, const RobotParams& after_params, const std::string& after_method) {
   const auto& s = result.umbmark;
   std::vector<std::string> parts;
   parts.push_back(Panel(60, fmt::format("Before: {} (L = {} m)", input.label, input.side_m), input.errors, s.runs,
                         s.cw, s.ccw, s.E_max_syst_m));
   double width = 520;
   if (result.evaluation && input.trajectories) {
-    const auto after =
-        ReturnErrorsFromTrajectories(*input.trajectories, s.corrected, input.recorded, integrator);
-    parts.push_back(Panel(560, "After correction (same runs)", after, s.runs, result.evaluation->cw,
-                          result.evaluation->ccw, result.evaluation->E_max_syst_m));
+    const auto after = ReturnErrorsFromTrajectories(*input.trajectories, after_params, input.recorded, integrator);
+    const ClusterStats cw = ClusterOfUsed(after, s.runs, "cw"), ccw = ClusterOfUsed(after, s.runs, "ccw");
+    parts.push_back(Panel(560, fmt::format("After correction: {} (same runs)", after_method), after, s.runs, cw, ccw,
+                          std::max(cw.r_cg_m, ccw.r_cg_m)));
     width = 1020;
   }
   return io::SvgDocument(width, 500, parts);

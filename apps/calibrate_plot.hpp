@@ -8,7 +8,9 @@
 
 namespace umbmark::cli {
 
+/// `after` / `after_method`: the calibration the "after" panel shows (the
+/// one --use selects).
 std::string CalibrationPlotSvg(const CalibrateInput& input, const CalibrateJobResult& result,
-                               Integrator integrator);
+                               Integrator integrator, const RobotParams& after, const std::string& after_method);
 
 }  // namespace umbmark::cli

@@ -12,6 +12,7 @@
 
 #include "calibrate_plot.hpp"
 #include "calibration/calibrate_job.hpp"
+#include "calibration/heldout.hpp"
 #include "commands.hpp"
 #include "common.hpp"
 #include "core/angles.hpp"
@@ -45,7 +46,29 @@ struct CalibrateOptions {
   std::string sampling = "per_run";
   std::string start_pose = "fitted";
   double heading_weight = 4.0;
+  std::string use = "recommended";
 };
+
+// The parameters --ros2 and --plot use: --use classic | refined |
+// recommended (the lowest leave-one-run-out error; classic when none).
+struct Chosen {
+  std::string method;  ///< umbmark_<estimator> | refined | plain_least_squares | recorded
+  RobotParams parameters;
+  std::string why;
+};
+
+Chosen ChooseParameters(const CalibrateJobResult& r, const HeldoutComparison& h, const std::string& use) {
+  const std::string classic = fmt::format("umbmark_{}", UmbmarkEstimatorToString(r.umbmark.estimator));
+  if (use == "classic") return {classic, r.umbmark.corrected, "--use classic"};
+  if (use == "refined") {
+    if (!r.refined) throw InvalidOptions("--use refined needs --refine");
+    return {"refined", r.refined->refined, "--use refined"};
+  }
+  if (const MethodHeldout* m = h.recommended.empty() ? nullptr : h.Find(h.recommended)) {
+    return {m->method, m->parameters, "recommended: lowest leave-one-run-out prediction error"};
+  }
+  return {classic, r.umbmark.corrected, "no recommendation could be formed (too few runs): the classic result"};
+}
 
 // Turns one command-line input into calibration inputs (a manifest may hold
 // several square experiments; each is calibrated on its own).
@@ -82,7 +105,19 @@ nlohmann::json JsonEstimate(const UmbmarkEstimate& e) {
   return {{"alpha_rad", e.alpha_rad}, {"beta_rad", e.beta_rad}, {"R_m", JsonNumber(e.R_m)}, {"E_b", e.E_b}, {"E_d", e.E_d}};
 }
 
-nlohmann::json JsonResult(const CalibrateInput& in, const CalibrateJobResult& r, const CalibrateOptions& o) {
+nlohmann::json JsonHeldout(const HeldoutComparison& h) {
+  nlohmann::json methods = nlohmann::json::object();
+  for (const auto& m : h.methods) {
+    methods[m.method] = {{"mean_m", JsonNumber(m.mean_m)}, {"sem_m", JsonNumber(m.sem_m)},
+                         {"rms_m", JsonNumber(m.rms_m)},   {"folds", m.folds},
+                         {"failed_folds", m.failed_folds}, {"parameters", JsonParams(m.parameters)}};
+  }
+  return methods;
+}
+
+nlohmann::json JsonResult(const CalibrateInput& in, const CalibrateJobResult& r, const CalibrateOptions& o,
+                          const HeldoutComparison& h, const ModelCheck& check, const Chosen& chosen,
+                          const std::vector<std::string>& warnings) {
   const UmbmarkSummary& s = r.umbmark;
   nlohmann::json j;
   j["input"] = r.label;
@@ -125,6 +160,24 @@ nlohmann::json JsonResult(const CalibrateInput& in, const CalibrateJobResult& r,
                                     {"runs", JsonEvaluationRuns(*r.refined_evaluation)}};
     }
   }
+  j["heldout_error"] = JsonHeldout(h);
+  j["heldout"] = {{"scheme", h.scheme},
+                  {"measure", h.measure},
+                  {"left_out", h.left_out},
+                  {"runner_up", h.runner_up.empty() ? nlohmann::json(nullptr) : nlohmann::json(h.runner_up)},
+                  {"runner_up_difference_m", h.runner_up.empty() ? nlohmann::json(nullptr)
+                                                                   : JsonNumber(h.runner_up_difference_m)},
+                  {"runner_up_difference_sem_m", h.runner_up.empty() ? nlohmann::json(nullptr)
+                                                                       : JsonNumber(h.runner_up_difference_sem_m)},
+                  {"notes", h.notes}};
+  j["recommended"] = h.recommended.empty() ? nlohmann::json(nullptr) : nlohmann::json(h.recommended);
+  if (r.refined && h.Find("refined")) j["refined"]["heldout_error"] = JsonHeldout(h)["refined"];
+  j["model_check"] = check.available ? nlohmann::json{{"reduced_chi2", check.reduced_chi2},
+                                                      {"dof", check.dof},
+                                                      {"p_value", check.p_value}}
+                                     : nlohmann::json(nullptr);
+  j["outputs_use"] = {{"method", chosen.method}, {"parameters", JsonParams(chosen.parameters)}, {"why", chosen.why}};
+  j["warnings"] = warnings;
   if (r.evaluation) {
     const auto& a = *r.evaluation;
     j["evaluation"] = {{"before", JsonEvaluationSummary(a.before)},
@@ -145,6 +198,37 @@ void PrintEvaluation(const char* title, const EvaluationSummary& e) {
              title, e.max_max_position_error_m * 1e3, e.mean_max_position_error_m * 1e3,
              e.max_final_position_error_m * 1e3, e.mean_final_position_error_m * 1e3,
              Rad2Deg(e.max_max_heading_error_rad), Rad2Deg(e.max_final_heading_error_rad));
+}
+
+void PrintHeldout(const HeldoutComparison& h, const Chosen& chosen, const std::vector<std::string>& warnings,
+                  const CalibrateOptions& o) {
+  fmt::print("Which calibration to trust: leave-one-run-out prediction error ({} folds, {})\n",
+             h.methods.empty() ? 0 : h.methods.front().folds,
+             h.measure == "max_position_error_m" ? "largest position error along the left-out run"
+                                                   : "left-out return error vs the model's prediction");
+  for (const auto& m : h.methods) {
+    fmt::print("  {:<20} {:7.2f} mm +- {:5.2f} (SE){}{}\n", m.method, m.mean_m * 1e3, m.sem_m * 1e3,
+               m.failed_folds ? fmt::format(", failed on {} folds", m.failed_folds) : "",
+               m.method == h.recommended ? "   <- lowest" : "");
+  }
+  for (const auto& n : h.notes) fmt::print("  note: {}\n", n);
+  if (!h.recommended.empty()) {
+    const MethodHeldout* m = h.Find(h.recommended);
+    fmt::print("  Put {} on the robot: wheelbase {:.6f} m, left diameter {:.6f} m, right diameter {:.6f} m\n",
+               h.recommended, m->parameters.wheelbase_m, m->parameters.wheel_diameter_left_m,
+               m->parameters.wheel_diameter_right_m);
+    if (!h.runner_up.empty()) {
+      fmt::print("  ({:.2f} mm +- {:.2f} better than the runner-up {}{})\n", h.runner_up_difference_m * 1e3,
+                 h.runner_up_difference_sem_m * 1e3, h.runner_up,
+                 h.runner_up_difference_m < 2.0 * h.runner_up_difference_sem_m
+                     ? "; the difference is within 2 SE, either is as good"
+                     : "");
+    }
+  }
+  if (!o.ros2.empty() || !o.plot.empty()) {
+    fmt::print("  --ros2/--plot use {} ({})\n", chosen.method, chosen.why);
+  }
+  for (const auto& w : warnings) fmt::print("  WARNING: {}\n", w);
 }
 
 void PrintResult(const CalibrateJobResult& r) {
@@ -188,15 +272,15 @@ void PrintResult(const CalibrateJobResult& r) {
   }
 }
 
-std::string Ros2Snippet(const CalibrateJobResult& r) {
+std::string Ros2Snippet(const CalibrateJobResult& r, const Chosen& chosen) {
   const UmbmarkSummary& s = r.umbmark;
-  // Refined multipliers when --refine ran: wheelbase and each radius
+  // Multipliers of the chosen calibration: wheelbase and each radius
   // relative to the recorded ones.
-  const double sep = r.refined ? r.refined->refined.wheelbase_m / s.recorded.wheelbase_m : s.selected.E_b;
-  const double left = r.refined ? r.refined->refined.wheel_diameter_left_m / s.recorded.wheel_diameter_left_m : s.c_L;
-  const double right = r.refined ? r.refined->refined.wheel_diameter_right_m / s.recorded.wheel_diameter_right_m : s.c_R;
+  const double sep = chosen.parameters.wheelbase_m / s.recorded.wheelbase_m;
+  const double left = chosen.parameters.wheel_diameter_left_m / s.recorded.wheel_diameter_left_m;
+  const double right = chosen.parameters.wheel_diameter_right_m / s.recorded.wheel_diameter_right_m;
   return fmt::format(
-      "# ros2_control diff_drive_controller parameters from umbmark calibrate{} ({})\n"
+      "# ros2_control diff_drive_controller parameters from umbmark calibrate: {} ({})\n"
       "# Multipliers are relative to the parameters the runs were recorded with:\n"
       "#   wheel_separation = {} m, left/right wheel diameter = {} / {} m.\n"
       "diff_drive_controller:\n"
@@ -204,11 +288,12 @@ std::string Ros2Snippet(const CalibrateJobResult& r) {
       "    wheel_separation_multiplier: {}\n"
       "    left_wheel_radius_multiplier: {}\n"
       "    right_wheel_radius_multiplier: {}\n",
-      r.refined ? " --refine" : "", r.label, s.recorded.wheelbase_m, s.recorded.wheel_diameter_left_m,
+      chosen.method, r.label, s.recorded.wheelbase_m, s.recorded.wheel_diameter_left_m,
       s.recorded.wheel_diameter_right_m, sep, left, right);
 }
 
 int RunCalibrate(const CalibrateOptions& o) {
+  if (o.use == "refined" && !o.refine) throw InvalidOptions("--use refined needs --refine");
   CalibrateJobOptions jo;
   jo.umbmark.estimator = *UmbmarkEstimatorFromString(o.estimator);
   jo.umbmark.ed_with_corrected_wheelbase = o.ed_wheelbase == "corrected";
@@ -287,14 +372,25 @@ int RunCalibrate(const CalibrateOptions& o) {
         status = std::max(status, 1);
         continue;
       }
+      const HeldoutComparison heldout = CompareMethodsHeldout(in, jo, r);
+      const Chosen chosen = ChooseParameters(r, heldout, o.use);
+      const ModelCheck check = CheckCentresAgainstModel(in, r.umbmark.runs, r.refined ? r.refined->refined : r.umbmark.corrected,
+                                                        jo.refine ? jo.refine->final_turn : true);
+      const std::vector<std::string> warnings = TrustWarnings(r, heldout, check);
       const std::string tag = std::filesystem::path(in.path).stem().string() + "-" + std::to_string(rows.size() + 1);
-      if (!o.ros2.empty()) outs.Write(batch ? TaggedPath(o.ros2, tag) : o.ros2, Ros2Snippet(r));
-      if (!o.plot.empty()) outs.Write(batch ? TaggedPath(o.plot, tag) : o.plot, CalibrationPlotSvg(in, r, jo.integrator));
+      if (!o.ros2.empty()) outs.Write(batch ? TaggedPath(o.ros2, tag) : o.ros2, Ros2Snippet(r, chosen));
+      if (!o.plot.empty()) {
+        outs.Write(batch ? TaggedPath(o.plot, tag) : o.plot,
+                   CalibrationPlotSvg(in, r, jo.integrator, chosen.parameters, chosen.method));
+      }
       if (o.json.PrintText()) {
         PrintResult(r);
+        PrintHeldout(heldout, chosen, warnings, o);
         fmt::print("\n");
+      } else {
+        for (const auto& w : warnings) fmt::print(stderr, "{}: warning: {}\n", in.label, w);
       }
-      results.push_back(JsonResult(in, r, o));
+      results.push_back(JsonResult(in, r, o, heldout, check, chosen, warnings));
       rows.push_back({in.label, std::move(r), ""});
     }
   }
@@ -349,8 +445,15 @@ Command SetupCalibrate(CLI::App& parent) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   opts->json.Bind(*app);
-  app->add_option("--ros2", opts->ros2, "Write a ros2_control diff_drive_controller parameter snippet (YAML)");
-  app->add_option("--plot", opts->plot, "Write an SVG of the return errors, centres of gravity and E_max,syst");
+  app->add_option("--ros2", opts->ros2,
+                  "Write a ros2_control diff_drive_controller parameter snippet (YAML) of the --use calibration");
+  app->add_option("--plot", opts->plot,
+                  "Write an SVG of the return errors, centres of gravity and E_max,syst (after: the --use calibration)");
+  app->add_option("--use", opts->use,
+                  "Calibration --ros2 and --plot use: the recommended one (lowest leave-one-run-out error), classic "
+                  "UMBmark, or refined (needs --refine)")
+      ->check(CLI::IsMember({"recommended", "classic", "refined"}))
+      ->capture_default_str();
   app->add_flag("--refine", opts->refine,
                 "Add the exact Ceres fit (every run, full path geometry for trajectories) with covariance and 95% intervals");
   app->add_option("--fix", opts->fix, "With --refine: hold these parameters at their recorded values (scale)")

@@ -43,15 +43,34 @@ CalibrateInput InputFromEndpoints(const EndpointData& data, const RobotParams& r
   return in;
 }
 
-namespace {
-ClusterStats ClusterAfter(const std::vector<ReturnError>& errors, const std::vector<RunFlag>& flags,
-                          const std::string& direction) {
+ClusterStats ClusterOfUsed(const std::vector<ReturnError>& errors, const std::vector<RunFlag>& flags,
+                           const std::string& direction) {
   std::vector<std::pair<double, double>> used;
   for (std::size_t i = 0; i < errors.size(); ++i)
     if (errors[i].direction == direction && flags[i].used()) used.emplace_back(errors[i].ex_m, errors[i].ey_m);
   return ClusterOf(used);
 }
-}  // namespace
+
+RefineSummary RefineInput(const CalibrateInput& input, const std::vector<bool>& keep, RefineOptions ro,
+                          const UmbmarkEstimate& start, Integrator integrator) {
+  ro.integrator = integrator;
+  ro.start.E_b = start.E_b;
+  ro.start.E_d = start.E_d;
+  if (input.trajectories) {
+    TrajectoryData kept;
+    kept.path = input.trajectories->path;
+    for (std::size_t i = 0; i < input.trajectories->runs.size(); ++i)
+      if (keep[i]) kept.runs.push_back(input.trajectories->runs[i]);
+    return RefineFromTrajectories({{input.recorded, &kept}}, input.recorded, ro);
+  }
+  SquareRunSet set;
+  set.side_m = input.side_m;
+  set.recorded = input.recorded;
+  set.source = input.path;
+  for (std::size_t i = 0; i < input.errors.size(); ++i)
+    if (keep[i]) set.errors.push_back(input.errors[i]);
+  return RefineFromReturnErrors({set}, input.recorded, ro);
+}
 
 CalibrateJobResult RunCalibrateJob(const CalibrateInput& input, const CalibrateJobOptions& options) {
   CalibrateJobResult r;
@@ -66,36 +85,24 @@ CalibrateJobResult RunCalibrateJob(const CalibrateInput& input, const CalibrateJ
     a.before = Summarise(EvaluateRuns(data, input.label, input.recorded, input.recorded, options.integrator));
     a.after = Summarise(EvaluateRuns(data, input.label, r.umbmark.corrected, input.recorded, options.integrator));
     const auto after_errors = ReturnErrorsFromTrajectories(data, r.umbmark.corrected, input.recorded, options.integrator);
-    a.cw = ClusterAfter(after_errors, r.umbmark.runs, "cw");
-    a.ccw = ClusterAfter(after_errors, r.umbmark.runs, "ccw");
+    a.cw = ClusterOfUsed(after_errors, r.umbmark.runs, "cw");
+    a.ccw = ClusterOfUsed(after_errors, r.umbmark.runs, "ccw");
     a.E_max_syst_m = std::max(a.cw.r_cg_m, a.ccw.r_cg_m);
     a.sem_m = std::max(a.cw.sem_m, a.ccw.sem_m);
     a.second_pass_worthwhile = a.E_max_syst_m > 3.0 * a.sem_m;
     r.evaluation = std::move(a);
   }
   if (options.refine) {
-    RefineOptions ro = *options.refine;
-    ro.integrator = options.integrator;
-    ro.start.E_b = r.umbmark.selected.E_b;
-    ro.start.E_d = r.umbmark.selected.E_d;
-    // Only the runs UMBmark used (excluded and rejected runs stay out).
-    auto used = [&](std::size_t i) { return r.umbmark.runs[i].used(); };
+    std::vector<bool> keep;
+    for (const auto& f : r.umbmark.runs) keep.push_back(f.used());
+    r.refined = RefineInput(input, keep, *options.refine, r.umbmark.selected, options.integrator);
     if (input.trajectories) {
       TrajectoryData kept;
       kept.path = input.trajectories->path;
-      for (std::size_t i = 0; i < input.trajectories->runs.size(); ++i)
-        if (used(i)) kept.runs.push_back(input.trajectories->runs[i]);
-      r.refined = RefineFromTrajectories({{input.recorded, &kept}}, input.recorded, ro);
+      for (std::size_t i = 0; i < keep.size(); ++i)
+        if (keep[i]) kept.runs.push_back(input.trajectories->runs[i]);
       r.refined_evaluation =
           Summarise(EvaluateRuns(kept, input.label, r.refined->refined, input.recorded, options.integrator));
-    } else {
-      SquareRunSet set;
-      set.side_m = input.side_m;
-      set.recorded = input.recorded;
-      set.source = input.path;
-      for (std::size_t i = 0; i < input.errors.size(); ++i)
-        if (used(i)) set.errors.push_back(input.errors[i]);
-      r.refined = RefineFromReturnErrors({set}, input.recorded, ro);
     }
   }
   return r;

@@ -63,6 +63,18 @@ CalibrateInput InputFromTrajectories(const TrajectoryData& data, const RobotPara
 CalibrateInput InputFromEndpoints(const EndpointData& data, const RobotParams& recorded, double side_m,
                                   const std::string& label);
 
+/// Centre of gravity of the return errors of `direction` (cw | ccw) whose
+/// run UMBmark used (flags in the same order as errors).
+ClusterStats ClusterOfUsed(const std::vector<ReturnError>& errors, const std::vector<RunFlag>& flags,
+                           const std::string& direction);
+
+/// The refined fit on the runs of `input` where keep[i] (same order as
+/// input.errors), started from `start` (the classic estimate), odometry with
+/// `integrator`: trajectories when the input has them, else return errors.
+/// Throws RefineError (exit 3) when the fit fails its quality gates.
+RefineSummary RefineInput(const CalibrateInput& input, const std::vector<bool>& keep, RefineOptions options,
+                          const UmbmarkEstimate& start, Integrator integrator);
+
 /// Runs UMBmark (and the after-correction evaluation when trajectories are
 /// present, and the refined fit when asked). Throws RefineError (exit 3)
 /// when the refined fit fails its quality gates.

@@ -1,0 +1,204 @@
+// Leave-one-run-out comparison of calibration methods and the trust
+// warnings (calibration/heldout.hpp), on synthetic return errors from the
+// exact commanded-square model with Gaussian scatter, and the calibrate
+// command's `recommended` / `--use` / `--ros2` behaviour on a real file.
+#include "calibration/heldout.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "model/commanded_square.hpp"
+#include "support/run_cli.hpp"
+
+using namespace umbmark;
+using Catch::Matchers::WithinAbs;
+
+namespace {
+
+/// n runs per direction of a robot with true E_b, c_L, c_R (relative to the
+/// recorded 0.4 m / 0.1 m robot) on 4 m squares, scatter sigma per axis, and
+/// an unmodelled constant offset added to every return error.
+CalibrateInput Squares(int n, double E_b, double c_L, double c_R, double sigma_m, std::uint64_t seed,
+                       double offset_x_m = 0.0) {
+  CalibrateInput in;
+  in.label = in.path = "synthetic.csv";
+  in.recorded.wheelbase_m = 0.4;
+  in.recorded.wheel_diameter_left_m = in.recorded.wheel_diameter_right_m = 0.1;
+  in.side_m = 4.0;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> N(0.0, sigma_m);
+  for (SquareDirection d : {SquareDirection::kCw, SquareDirection::kCcw}) {
+    const Pose2 e = SquareReturnError(d, in.side_m, in.recorded.wheelbase_m, E_b, c_L, c_R);
+    for (int i = 0; i < n; ++i) {
+      ReturnError r;
+      r.direction = SquareDirectionToString(d);
+      r.run = fmt::format("{}{}", r.direction, i + 1);
+      r.ex_m = e.x + N(rng) + offset_x_m;
+      r.ey_m = e.y + N(rng);
+      in.errors.push_back(r);
+    }
+  }
+  return in;
+}
+
+HeldoutComparison Compare(const CalibrateInput& in, bool refine, CalibrateJobResult* full = nullptr) {
+  CalibrateJobOptions o;
+  if (refine) o.refine = RefineOptions{};
+  CalibrateJobResult r = RunCalibrateJob(in, o);
+  HeldoutComparison h = CompareMethodsHeldout(in, o, r);
+  if (full) *full = std::move(r);
+  return h;
+}
+
+}  // namespace
+
+TEST_CASE("held-out error of the recorded parameters is the mean return error", "[heldout]") {
+  // The recorded robot predicts a zero return error, so its leave-one-run-out
+  // error is the mean |(ex, ey)| of the runs: a closed form independent of
+  // the fold machinery.
+  const CalibrateInput in = Squares(5, 0.995, 0.999, 1.001, 0.003, 11);
+  const HeldoutComparison h = Compare(in, true);
+  double mean = 0.0;
+  for (const auto& e : in.errors) mean += std::hypot(e.ex_m, e.ey_m);
+  mean /= static_cast<double>(in.errors.size());
+  const MethodHeldout* rec = h.Find("recorded");
+  REQUIRE(rec != nullptr);
+  CHECK(rec->folds == 10);
+  CHECK_THAT(rec->mean_m, WithinAbs(mean, 1e-12));
+  CHECK(h.measure == "return_error_prediction_m");
+  for (const char* m : {"umbmark_x", "umbmark_y", "umbmark_mean", "refined"}) {
+    REQUIRE(h.Find(m) != nullptr);
+    CHECK(h.Find(m)->failed_folds == 0);
+    CHECK(h.Find(m)->mean_m < rec->mean_m);  // a 0.5 % wheelbase error stands far out of 3 mm scatter
+  }
+  CHECK(h.Find("plain_least_squares") == nullptr);  // trajectories only
+  CHECK(h.recommended != "recorded");
+  CHECK(!h.recommended.empty());
+}
+
+TEST_CASE("held-out comparison prefers the exact model when classic UMBmark is biased", "[heldout]") {
+  // E_b = 0.97 on 4 m squares: classic UMBmark's linearisation is off by
+  // ~1e-3 in E_b (docs/refine.md), several millimetres of return error,
+  // while the scatter is 0.5 mm. The exact refined model must win on
+  // held-out runs in every one of 5 independent campaigns.
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    const HeldoutComparison h = Compare(Squares(5, 0.97, 1.006, 0.994, 0.0005, seed), true);
+    INFO("seed " << seed << ": refined " << h.Find("refined")->mean_m << " m, umbmark_mean "
+                 << h.Find("umbmark_mean")->mean_m << " m");
+    CHECK(h.recommended == "refined");
+    CHECK(h.Find("refined")->mean_m < 0.5 * h.Find("umbmark_mean")->mean_m);
+  }
+}
+
+TEST_CASE("trust warnings: few runs, a model that does not fit, nothing beats the recorded robot", "[heldout]") {
+  {
+    CalibrateJobResult r;
+    const CalibrateInput in = Squares(3, 0.995, 0.999, 1.001, 0.002, 3);
+    const HeldoutComparison h = Compare(in, false, &r);
+    const auto w = TrustWarnings(r, h, ModelCheck{});
+    REQUIRE(!w.empty());
+    CHECK(w.front().find("3 cw and 3 ccw runs") != std::string::npos);
+  }
+  {
+    // Model-consistent scatter, 8 runs per direction: the centres-of-gravity
+    // check passes (p > 0.01 in at least 45 of 50 campaigns: its size is 1 %).
+    int rejected = 0;
+    for (std::uint64_t seed = 1; seed <= 50; ++seed) {
+      CalibrateJobResult r;
+      const CalibrateInput in = Squares(8, 0.99, 1.002, 0.998, 0.002, 100 + seed);
+      const HeldoutComparison h = Compare(in, true, &r);
+      const ModelCheck c = CheckCentresAgainstModel(in, r.umbmark.runs, r.refined->refined);
+      REQUIRE(c.available);
+      CHECK(c.dof == 2);
+      rejected += c.p_value < 0.01 ? 1 : 0;
+    }
+    CHECK(rejected <= 5);
+  }
+  {
+    // An unmodelled offset of 3 mm along x in both directions (no E_b, E_d
+    // produces it) with 1 mm scatter: the check must flag it.
+    CalibrateJobResult r;
+    const CalibrateInput in = Squares(8, 0.99, 1.002, 0.998, 0.001, 7, 0.003);
+    const HeldoutComparison h = Compare(in, true, &r);
+    const ModelCheck c = CheckCentresAgainstModel(in, r.umbmark.runs, r.refined->refined);
+    REQUIRE(c.available);
+    CHECK(c.p_value < 1e-4);
+    const auto w = TrustWarnings(r, h, c);
+    bool flagged = false;
+    for (const auto& s : w) flagged = flagged || s.find("reduced chi-square") != std::string::npos;
+    CHECK(flagged);
+  }
+  {
+    // A perfect robot: no calibration predicts left-out runs better than
+    // the recorded parameters (they fit noise); the warning says so in most
+    // campaigns.
+    int warned = 0;
+    for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+      CalibrateJobResult r;
+      const CalibrateInput in = Squares(5, 1.0, 1.0, 1.0, 0.003, 200 + seed);
+      const HeldoutComparison h = Compare(in, false, &r);
+      for (const auto& s : TrustWarnings(r, h, ModelCheck{})) {
+        warned += s.find("recorded parameters") != std::string::npos ? 1 : 0;
+      }
+    }
+    CHECK(warned >= 7);
+  }
+}
+
+TEST_CASE("calibrate recommends a method and --ros2 follows --use", "[heldout][cli]") {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / fmt::format("umbmark_heldout_cli_{}", ::getpid());
+  fs::create_directories(dir);
+  const std::string data = std::string(UMBMARK_SOURCE_DIR) + "/data/examples/";
+  const std::string base = fmt::format("calibrate {}endpoints.csv --robot {}robot.toml --side 0.75 --refine", data, data);
+  const auto rec = testing::RunCli(base + " --json - --ros2 " + (dir / "rec.yaml").string());
+  REQUIRE(rec.status == 0);
+  const auto j = nlohmann::json::parse(rec.out);
+  REQUIRE(j["recommended"].is_string());
+  const std::string best = j["recommended"];
+  for (const char* m : {"recorded", "umbmark_x", "umbmark_y", "umbmark_mean", "refined"}) {
+    REQUIRE(j["heldout_error"].contains(m));
+    CHECK(j["heldout_error"][m]["folds"] == 6);
+    const bool lowest =
+        j["heldout_error"][best]["mean_m"].get<double>() <= j["heldout_error"][m]["mean_m"].get<double>();
+    CHECK((lowest || std::string(m) == "recorded"));
+  }
+  CHECK(j["outputs_use"]["method"] == best);
+  CHECK(j["refined"]["heldout_error"]["folds"] == 6);
+  // 3 runs per direction: the intervals warning is in the JSON.
+  REQUIRE(j["warnings"].is_array());
+  CHECK(j["warnings"][0].get<std::string>().find("3 cw and 3 ccw") != std::string::npos);
+  auto multiplier = [](const fs::path& yaml) {
+    std::ifstream f(yaml);
+    std::string line;
+    while (std::getline(f, line)) {
+      if (auto at = line.find("wheel_separation_multiplier: "); at != std::string::npos) return std::stod(line.substr(at + 29));
+    }
+    return 0.0;
+  };
+  const double b_rec = j["heldout_error"][best]["parameters"]["wheelbase_m"];
+  CHECK_THAT(multiplier(dir / "rec.yaml"), WithinAbs(b_rec / 0.2, 1e-12));
+  // --use refined / classic pick those, and the text says which.
+  const auto ref = testing::RunCli(base + " --use refined --ros2 " + (dir / "ref.yaml").string());
+  REQUIRE(ref.status == 0);
+  CHECK(ref.out.find("--ros2/--plot use refined (--use refined)") != std::string::npos);
+  CHECK_THAT(multiplier(dir / "ref.yaml"), WithinAbs(j["refined"]["parameters"]["wheelbase_m"].get<double>() / 0.2, 1e-12));
+  const auto cls = testing::RunCli(base + " --use classic --ros2 " + (dir / "cls.yaml").string());
+  REQUIRE(cls.status == 0);
+  CHECK(cls.out.find("--ros2/--plot use umbmark_mean (--use classic)") != std::string::npos);
+  CHECK_THAT(multiplier(dir / "cls.yaml"), WithinAbs(j["parameters"]["wheelbase_m"].get<double>() / 0.2, 1e-12));
+  // --use refined without --refine is a usage error.
+  const auto bad = testing::RunCli(fmt::format("calibrate {}endpoints.csv --robot {}robot.toml --side 0.75 --use refined --ros2 {}",
+                                               data, data, (dir / "bad.yaml").string()));
+  CHECK(bad.status == 2);  // usage error
+  CHECK(bad.err.find("--use refined needs --refine") != std::string::npos);
+  fs::remove_all(dir);
+}
