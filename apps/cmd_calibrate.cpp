@@ -55,19 +55,38 @@ struct Chosen {
   std::string method;  ///< umbmark_<estimator> | refined | plain_least_squares | recorded
   RobotParams parameters;
   std::string why;
+  /// ros2 multipliers (wheel separation, left, right radius) relative to the
+  /// recorded robot: the method's own factors where it has them (exact), else
+  /// ratios of the parameters.
+  double separation = 1.0, left = 1.0, right = 1.0;
 };
 
+Chosen WithRatios(Chosen c, const RobotParams& recorded) {
+  c.separation = c.parameters.wheelbase_m / recorded.wheelbase_m;
+  c.left = c.parameters.wheel_diameter_left_m / recorded.wheel_diameter_left_m;
+  c.right = c.parameters.wheel_diameter_right_m / recorded.wheel_diameter_right_m;
+  return c;
+}
+
 Chosen ChooseParameters(const CalibrateJobResult& r, const HeldoutComparison& h, const std::string& use) {
-  const std::string classic = fmt::format("umbmark_{}", UmbmarkEstimatorToString(r.umbmark.estimator));
-  if (use == "classic") return {classic, r.umbmark.corrected, "--use classic"};
-  if (use == "refined") {
+  const UmbmarkSummary& s = r.umbmark;
+  const std::string classic_name = fmt::format("umbmark_{}", UmbmarkEstimatorToString(s.estimator));
+  auto classic = [&](const std::string& why) {
+    return Chosen{classic_name, s.corrected, why, s.selected.E_b, s.c_L, s.c_R};
+  };
+  auto refined = [&](const std::string& why) {
     if (!r.refined) throw InvalidOptions("--use refined needs --refine");
-    return {"refined", r.refined->refined, "--use refined"};
-  }
+    return Chosen{"refined", r.refined->refined, why, r.refined->E_b, r.refined->c_L, r.refined->c_R};
+  };
+  if (use == "classic") return classic("--use classic");
+  if (use == "refined") return refined("--use refined");
+  const std::string why = "recommended: lowest leave-one-run-out prediction error";
+  if (h.recommended == classic_name) return classic(why);
+  if (h.recommended == "refined") return refined(why);
   if (const MethodHeldout* m = h.recommended.empty() ? nullptr : h.Find(h.recommended)) {
-    return {m->method, m->parameters, "recommended: lowest leave-one-run-out prediction error"};
+    return WithRatios({m->method, m->parameters, why}, s.recorded);
   }
-  return {classic, r.umbmark.corrected, "no recommendation could be formed (too few runs): the classic result"};
+  return classic("no recommendation could be formed (too few runs): the classic result");
 }
 
 // Turns one command-line input into calibration inputs (a manifest may hold
@@ -276,9 +295,7 @@ std::string Ros2Snippet(const CalibrateJobResult& r, const Chosen& chosen) {
   const UmbmarkSummary& s = r.umbmark;
   // Multipliers of the chosen calibration: wheelbase and each radius
   // relative to the recorded ones.
-  const double sep = chosen.parameters.wheelbase_m / s.recorded.wheelbase_m;
-  const double left = chosen.parameters.wheel_diameter_left_m / s.recorded.wheel_diameter_left_m;
-  const double right = chosen.parameters.wheel_diameter_right_m / s.recorded.wheel_diameter_right_m;
+  const double sep = chosen.separation, left = chosen.left, right = chosen.right;
   return fmt::format(
       "# ros2_control diff_drive_controller parameters from umbmark calibrate: {} ({})\n"
       "# Multipliers are relative to the parameters the runs were recorded with:\n"

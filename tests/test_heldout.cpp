@@ -190,11 +190,11 @@ TEST_CASE("calibrate recommends a method and --ros2 follows --use", "[heldout][c
   const auto ref = testing::RunCli(base + " --use refined --ros2 " + (dir / "ref.yaml").string());
   REQUIRE(ref.status == 0);
   CHECK(ref.out.find("--ros2/--plot use refined (--use refined)") != std::string::npos);
-  CHECK_THAT(multiplier(dir / "ref.yaml"), WithinAbs(j["refined"]["parameters"]["wheelbase_m"].get<double>() / 0.2, 1e-12));
+  CHECK_THAT(multiplier(dir / "ref.yaml"), WithinAbs(j["refined"]["E_b"].get<double>(), 1e-12));
   const auto cls = testing::RunCli(base + " --use classic --ros2 " + (dir / "cls.yaml").string());
   REQUIRE(cls.status == 0);
   CHECK(cls.out.find("--ros2/--plot use umbmark_mean (--use classic)") != std::string::npos);
-  CHECK_THAT(multiplier(dir / "cls.yaml"), WithinAbs(j["parameters"]["wheelbase_m"].get<double>() / 0.2, 1e-12));
+  CHECK_THAT(multiplier(dir / "cls.yaml"), WithinAbs(j["E_b"].get<double>(), 1e-12));
   // --use refined without --refine is a usage error.
   const auto bad = testing::RunCli(fmt::format("calibrate {}endpoints.csv --robot {}robot.toml --side 0.75 --use refined --ros2 {}",
                                                data, data, (dir / "bad.yaml").string()));
