@@ -78,6 +78,13 @@ Command SetupDiagnose(CLI::App& parent) {
                "Judge the gap by the gap score alone (default: combined with the candidates' likelihood-ratio tests)");
   app->add_flag("!--no-standstill-averaging", d.pieces.average_standstills,
                 "Measure motions from/to single ground-truth samples (default: the adjacent standstills' mean pose)");
+  app->add_option("--negligible", d.negligible,
+                  "Practical significance: effects that move the predicted pose over a run by less than this "
+                  "fraction of the noise of one piece (<= 1 m or a spot turn) are negligible, never the verdict "
+                  "(default 0.25)")
+      ->check(CLI::NonNegativeNumber);
+  app->add_option("--max-effects", d.max_explanation_effects, "Most effects in the stepwise explanation (default 4)")
+      ->check(CLI::Range(1, 12));
   app->add_option("--seed", d.seed, "Seed of the null simulations (default 1)")->check(SeedValidator());
   app->add_option("--threads", d.threads, "Threads (default 2)")->check(CLI::Range(1, 256));
   app->add_option("--where", d.where_top, "Discrepancies listed under 'where' (default 12)")->check(CLI::NonNegativeNumber);

@@ -375,6 +375,8 @@ TEST_CASE("diagnose: turn_scrub needs arcs: found with figure-eights", "[diagnos
   s.sim.effects.scrub_k = 0.05;
   const DiagnoseSummary d = Diagnose(Build(s), Fast());
   const Candidate* c = Find(d, sim::EffectKind::kTurnScrub);
+  INFO(d.verdict_reason);
+  INFO(DiagnoseToJson(d).at("explanation").dump());
   REQUIRE(c);
   CHECK(c->identifiable);
   CHECK(d.verdict == "turn_scrub");
@@ -480,4 +482,53 @@ TEST_CASE("umbmark diagnose: contract JSON, report, plot", "[diagnose][cli]") {
   // Usage and input errors.
   CHECK(testing::RunCli("diagnose " + Q(manifest) + " --effects warp").status == 2);
   CHECK(testing::RunCli("diagnose " + Q(dir / "missing.toml")).status == 2);
+}
+
+TEST_CASE("diagnose: two effects at once (castor kick + time offset) are both named, stepwise", "[diagnose][explanation]") {
+  Small s = MakeSmall(61);
+  s.sim.effects.castor_kappa = 0.008;
+  s.sim.effects.time_tau = 0.04;
+  const DiagnoseSummary d = Diagnose(Build(s), Fast());
+  INFO(d.verdict_reason);
+  REQUIRE(d.explanation.size() >= 2);
+  CHECK(std::find(d.verdict_effects.begin(), d.verdict_effects.end(), "castor_kick") != d.verdict_effects.end());
+  CHECK(std::find(d.verdict_effects.begin(), d.verdict_effects.end(), "time_offset") != d.verdict_effects.end());
+  REQUIRE_FALSE(d.verdict_effects.empty());
+  CHECK(d.verdict == d.verdict_effects.front());
+  // Fitted jointly: both parameters recovered at the last step's fit.
+  for (const auto& e : d.explanation) {
+    if (e.effect == sim::EffectKind::kCastorKick) CHECK_THAT(e.params.at("kappa"), WithinAbs(0.008, 0.0008));
+    if (e.effect == sim::EffectKind::kTimeOffset) CHECK_THAT(e.params.at("tau"), WithinAbs(0.04, 0.004));
+  }
+  // Cumulative shrink grows step by step and closes the gap.
+  CHECK(d.explanation.back().cumulative_heldout_shrink > d.explanation.front().cumulative_heldout_shrink);
+  CHECK(d.explanation.back().cumulative_heldout_shrink > 0.9);
+  CHECK_THAT(d.unexplained_fraction, WithinAbs(1.0 - d.explanation.back().cumulative_heldout_shrink, 1e-12));
+  const nlohmann::json j = DiagnoseToJson(d);
+  CHECK(j.at("explanation").size() == d.explanation.size());
+  CHECK(j.at("verdict").at("effects").size() == d.verdict_effects.size());
+  CHECK(j.at("verdict").contains("unexplained_fraction"));
+}
+
+TEST_CASE("diagnose: a significant but sub-millimetre marker offset is negligible, never the verdict",
+          "[diagnose][negligible]") {
+  // Noise-free ground truth makes a 0.3 mm offset highly significant; next
+  // to a run-to-run scatter of millimetres it does not matter.
+  Small s = MakeSmall(62);
+  s.sim.ground_truth = GroundTruthNoise{1e-5, 1e-4};
+  s.sim.effects.gt_dx = 3e-4;
+  DiagnoseSummary d = Diagnose(Build(s), Fast());
+  INFO(d.verdict_reason);
+  CHECK(d.verdict == "none");
+  CHECK(d.verdict_effects.empty());
+  if (d.significant) {
+    REQUIRE_FALSE(d.explanation.empty());
+    CHECK(d.explanation.front().negligible);
+    CHECK(d.explanation.front().size_mm < 0.5);
+  }
+  // With the threshold at 0 the same offset is named.
+  DiagnoseOptions o = Fast();
+  o.negligible = 0.0;
+  d = Diagnose(Build(s), o);
+  if (d.significant) CHECK(d.verdict == "gt_offset");
 }

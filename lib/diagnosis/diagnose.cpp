@@ -2,15 +2,18 @@
 // each in its own file, timed.
 #include "diagnosis/diagnose.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "core/errors.hpp"
 #include "diagnosis/baseline.hpp"
 #include "diagnosis/candidates.hpp"
 #include "diagnosis/cross_validation.hpp"
+#include "diagnosis/explanation.hpp"
 #include "diagnosis/null_distribution.hpp"
 #include "diagnosis/return_check.hpp"
 #include "diagnosis/verdict.hpp"
@@ -28,6 +31,9 @@ std::string DiagnoseOptions::Check() const {
   if (!(complexity_penalty_nats >= 0.0))
     return fmt::format("complexity_penalty_nats = {} must be >= 0", complexity_penalty_nats);
   if (threads < 1) return fmt::format("threads = {} must be >= 1", threads);
+  if (!(negligible >= 0.0)) return fmt::format("negligible = {} must be >= 0", negligible);
+  if (max_explanation_effects < 1)
+    return fmt::format("max_explanation_effects = {} must be >= 1", max_explanation_effects);
   if (where_top < 0) return fmt::format("where_top = {} must be >= 0", where_top);
   if (auto e = pieces.Check(); !e.empty()) return "pieces: " + e;
   if (!(gap.threshold_se >= 0.0)) return fmt::format("gap.threshold_se = {} must be >= 0", gap.threshold_se);
@@ -58,6 +64,7 @@ class StageTimer {
 };
 
 BaselineSummary Summarise(const CampaignData& c, const BaselineStart& start, const BaselineFit& b, ReturnCheck rc) {
+  // (rc by value: its vectors move into the summary)
   BaselineSummary bs;
   bs.E_d = b.p[kParamEd];
   bs.E_b = b.p[kParamEb];
@@ -80,6 +87,54 @@ BaselineSummary Summarise(const CampaignData& c, const BaselineStart& start, con
   return bs;
 }
 
+/// The verdict's effects from the explanation: its non-negligible effects.
+/// A single-effect verdict whose effect is negligible becomes `none`; an
+/// `unexplained` gap that the explanation closes (no significant gap left,
+/// held-out shrink >= min_heldout_shrink) is named by its effects.
+void NameEffects(const Explanation& ex, const DiagnoseOptions& options, DiagnoseSummary& out) {
+  std::vector<std::string> named, negligible;
+  for (const ExplanationStep& s : ex.steps)
+    (s.negligible ? negligible : named).push_back(sim::EffectToString(s.effect));
+  const double heldout = ex.steps.empty() ? 0.0 : ex.steps.back().cumulative_heldout_shrink;
+  out.unexplained_fraction = std::clamp(1.0 - heldout, 0.0, 1.0);
+  const std::string negligible_text =
+      negligible.empty() ? std::string()
+                         : fmt::format("; negligible in practice (size below {:.2g} x the noise of one piece): {}",
+                                       options.negligible, fmt::join(negligible, ", "));
+  if (out.verdict == "unexplained") {
+    if (!ex.steps.empty() && !ex.gap_left && heldout >= options.min_heldout_shrink) {
+      if (named.empty()) {
+        out.verdict = "none";
+        out.verdict_reason = "the significant gap is closed by effects too small to matter" + negligible_text;
+      } else {
+        out.verdict = named.front();
+        out.verdict_reason = fmt::format(
+            "{} together close {:.0f}% of the gap on held-out runs and leave no significant gap (added one at a "
+            "time, fitted jointly){}",
+            fmt::join(named, " + "), 100.0 * heldout, negligible_text);
+      }
+    } else {
+      out.verdict_reason += negligible_text;
+    }
+  } else if (!ex.steps.empty()) {
+    if (named.empty()) {
+      out.verdict_reason = fmt::format("the gap is significant, but {} is too small to matter (relative size {:.2g} < "
+                                       "{:.2g}): {}",
+                                       out.verdict, ex.steps.front().relative_size, options.negligible,
+                                       out.verdict_reason);
+      out.verdict = "none";
+    } else {
+      if (named.front() != out.verdict) out.verdict = named.front();
+      if (named.size() > 1)
+        out.verdict_reason += fmt::format("; with {} the explanation closes {:.0f}% on held-out runs",
+                                          fmt::join(named.begin() + 1, named.end(), " + "), 100.0 * heldout);
+      out.verdict_reason += negligible_text;
+    }
+  }
+  out.verdict_effects = out.verdict == "none" ? std::vector<std::string>{} : named;
+  if (out.verdict == "none") out.unexplained_fraction = 0.0;
+}
+
 }  // namespace
 
 DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) {
@@ -99,7 +154,8 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
   timer.Lap("refined calibration (start)");
   const BaselineFit base = FitBaseline(c, model, start, BaselineFitOptions{});
   out.notes.insert(out.notes.end(), base.notes.begin(), base.notes.end());
-  out.baseline = Summarise(c, start, base, CheckReturns(c, model, base));
+  const ReturnCheck returns = CheckReturns(c, model, base);
+  out.baseline = Summarise(c, start, base, returns);
   timer.Lap("baseline fit and predictions");
 
   // 2. Where, and the gap's null distribution.
@@ -121,7 +177,8 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
   co.complexity_penalty_nats = options.complexity_penalty_nats;
   co.threads = options.threads;
   co.gap = options.gap;
-  const CandidateFits fits = FitCandidates(c, model, base, MakeFolds(c), out.gap_score, out.null_median, co);
+  const Folds folds = MakeFolds(c);
+  const CandidateFits fits = FitCandidates(c, model, base, folds, out.gap_score, out.null_median, co);
   timer.Lap("candidate effects and cross-validation");
 
   // 4-5. Significance and verdict.
@@ -137,6 +194,25 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
   out.verdict_reason = std::move(v.reason);
   out.indistinguishable = std::move(v.indistinguishable);
   timer.Lap("verdict");
+
+  // 6. Stepwise explanation and practical significance.
+  out.negligible_threshold = options.negligible;
+  if (out.significant) {
+    ExplanationOptions eo;
+    eo.max_effects = options.max_explanation_effects;
+    eo.complexity_penalty_nats = options.complexity_penalty_nats;
+    eo.negligible = options.negligible;
+    eo.threads = options.threads;
+    eo.gap = options.gap;
+    std::vector<sim::EffectKind> first;
+    if (const auto k = sim::EffectFromString(out.verdict)) first.push_back(*k);
+    const Explanation ex = Explain(c, model, base, folds, out.candidates, first, out.gap_score,
+                                   out.null_median, out.null_quantile_alpha, eo);
+    out.explanation = ex.steps;
+    out.explanation_stop = ex.stop_reason;
+    NameEffects(ex, options, out);
+    timer.Lap("stepwise explanation");
+  }
   out.timings = timer.Finish();
   return out;
 }

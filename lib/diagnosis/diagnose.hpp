@@ -56,6 +56,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "diagnosis/candidates.hpp"
+#include "diagnosis/explanation.hpp"
 #include "diagnosis/gap_stats.hpp"
 #include "diagnosis/model.hpp"
 #include "diagnosis/piece_noise.hpp"
@@ -91,6 +92,13 @@ struct DiagnoseOptions {
   /// Combine G's p-value with the candidates' likelihood-ratio tests
   /// (step 4 above). Default true; false: the gap is judged by G alone.
   bool likelihood_tests = true;
+  /// Practical significance: an effect whose size (explanation.hpp: how far
+  /// it moves the predicted pose over a run, relative to the scatter of one
+  /// piece's motion under the baseline) is below this is negligible and
+  /// never named in the verdict. Default 0.25.
+  double negligible = 0.25;
+  /// Most effects in the stepwise explanation (>= 1). Default 4.
+  int max_explanation_effects = 4;
   /// Effects to try (empty: the contract's nine).
   std::vector<sim::EffectKind> effects;
   PieceOptions pieces;
@@ -137,6 +145,16 @@ struct DiagnoseSummary {
   std::vector<Candidate> candidates;  ///< best first
   std::string verdict;                ///< effect name | none | unexplained
   std::string verdict_reason;
+  /// Stepwise explanation (explanation.hpp), in the order added; empty
+  /// without a significant gap.
+  std::vector<ExplanationStep> explanation;
+  std::string explanation_stop;
+  /// Every effect the verdict names (the explanation's non-negligible
+  /// effects; for `unexplained` those that close part of the gap).
+  std::vector<std::string> verdict_effects;
+  /// 1 - the explanation's cumulative held-out shrink (0 for `none`).
+  double unexplained_fraction = 0.0;
+  double negligible_threshold = 0.25;
   std::vector<std::string> indistinguishable;
   std::vector<std::pair<std::string, double>> timings;  ///< stage, seconds
   std::vector<std::string> experiment_labels;

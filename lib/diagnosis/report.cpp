@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "core/angles.hpp"
@@ -32,10 +33,44 @@ nlohmann::json ByKind(const std::array<double, kNumStatKinds>& a) {
   return j;
 }
 
+/// "name = value unit" in the unit an engineer reads: mm, mrad, ms, per
+/// metre, per run; dimensionless factors as they are.
+std::string FormatParam(const std::string& name, double v) {
+  if (name == "dx" || name == "dy" || name == "sigma" || name == "sigma_xy") return fmt::format("{} = {:.3g} mm", name, 1e3 * v);
+  if (name == "kappa" || name == "sigma_theta") return fmt::format("{} = {:.3g} mrad", name, 1e3 * v);
+  if (name == "tau" || name == "tau_sd") return fmt::format("{} = {:.3g} ms", name, 1e3 * v);
+  if (name == "rate") return fmt::format("{} = {:.3g} per metre", name, v);
+  if (name == "r") return fmt::format("{} = {:.3g} per run", name, v);
+  return fmt::format("{} = {:.4g}", name, v);
+}
+
+/// p-values below what double precision and the model's approximations
+/// can vouch for print as "< 1e-12".
+std::string FormatP(double p) { return p < 1e-12 ? std::string("< 1e-12") : fmt::format("{:.3g}", p); }
+
 const Candidate* Winner(const DiagnoseSummary& s) {
   for (const auto& c : s.candidates)
     if (s.verdict == sim::EffectToString(c.effect)) return &c;
   return s.candidates.empty() || !s.candidates.front().identifiable ? nullptr : &s.candidates.front();
+}
+
+nlohmann::json ExplanationJson(const DiagnoseSummary& s) {
+  nlohmann::json steps = nlohmann::json::array();
+  for (const auto& e : s.explanation) {
+    nlohmann::json params = nlohmann::json::object();
+    for (const auto& [k, v] : e.params) params[k] = Num(v);
+    steps.push_back({{"effect", sim::EffectToString(e.effect)},
+                     {"params", params},
+                     {"cumulative_shrink", Num(e.cumulative_shrink)},
+                     {"cumulative_heldout_shrink", Num(e.cumulative_heldout_shrink)},
+                     {"heldout_gain_nats", Num(e.heldout_gain_nats)},
+                     {"gap_after", Num(e.gap_after)},
+                     {"size_mm", Num(e.size_mm)},
+                     {"size_mrad", Num(e.size_mrad)},
+                     {"relative_size", Num(e.relative_size)},
+                     {"negligible", e.negligible}});
+  }
+  return steps;
 }
 
 }  // namespace
@@ -110,7 +145,13 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
             {"by_statistic", ByKind(s.gap_by_kind)},
             {"seed", s.seed}}},
           {"candidates", cands},
-          {"verdict", {{"effect", s.verdict}, {"reason", s.verdict_reason}}},
+          {"explanation", ExplanationJson(s)},
+          {"verdict",
+           {{"effect", s.verdict},
+            {"effects", s.verdict_effects},
+            {"unexplained_fraction", Num(s.unexplained_fraction)},
+            {"reason", s.verdict_reason},
+            {"negligible_threshold", Num(s.negligible_threshold)}}},
           {"indistinguishable", s.indistinguishable},
           {"baseline",
            {{"E_d", Num(b.E_d)},
@@ -198,16 +239,35 @@ std::string DiagnoseReport(const DiagnoseSummary& s) {
     std::string params;
     for (const auto& [k, v] : c.params) {
       const auto se = c.param_se.find(k);
-      params += se != c.param_se.end() ? fmt::format("{} = {:.4g} +- {:.2g}  ", k, v, se->second)
-                                       : fmt::format("{} = {:.4g}  ", k, v);
+      params += se != c.param_se.end() ? fmt::format("{} (se {:.2g})  ", FormatParam(k, v), se->second)
+                                       : FormatParam(k, v) + "  ";
     }
     if (!c.note.empty()) params += "(" + c.note + ")";
     line(fmt::format("    {:<20} {:>8.3f} {:>9.3f} {:>9.1f} n {:>10}  {}", sim::EffectToString(c.effect), c.shrink,
-                     c.heldout_shrink, c.evidence, c.tested ? fmt::format("{:.3g}", c.lr_p_value) : std::string("-"),
+                     c.heldout_shrink, c.evidence, c.tested ? FormatP(c.lr_p_value) : std::string("-"),
                      params));
   }
   line("");
-  line("4. Verdict: " + s.verdict);
+  if (!s.explanation.empty()) {
+    line("");
+    line(fmt::format("   Stepwise explanation (effects added one at a time, fitted jointly; stops: {}):",
+                     s.explanation_stop));
+    line("    step effect                 cumulative shrink  held-out   size (mm / mrad, x scatter)  parameters");
+    int k = 0;
+    for (const auto& e : s.explanation) {
+      std::string params;
+      for (const auto& [n, v] : e.params) params += FormatParam(n, v) + "  ";
+      line(fmt::format("    {:>4} {:<22} {:>17.0f}% {:>8.0f}%   {:>7.2f} / {:>6.2f}, x {:<5.2f}{}  {}", ++k,
+                       sim::EffectToString(e.effect), 100.0 * e.cumulative_shrink, 100.0 * e.cumulative_heldout_shrink,
+                       e.size_mm, e.size_mrad, e.relative_size, e.negligible ? " (negligible)" : "", params));
+    }
+    line(fmt::format("    unexplained on held-out runs: {:.0f}%; negligible = size below {:.2g} x the noise of one "
+                     "piece (<= 1 m of travel or a spot turn)",
+                     100.0 * s.unexplained_fraction, s.negligible_threshold));
+  }
+  line("");
+  line("4. Verdict: " + s.verdict +
+       (s.verdict_effects.size() > 1 ? fmt::format(" (effects: {})", fmt::join(s.verdict_effects, ", ")) : ""));
   line("  " + s.verdict_reason);
   for (const auto& i : s.indistinguishable) line("  cannot tell apart: " + i);
   for (const auto& n : s.notes) line("  note: " + n);

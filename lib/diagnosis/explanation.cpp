@@ -1,0 +1,231 @@
+// Stepwise explanation of the gap and practical significance (see
+// explanation.hpp).
+#include "diagnosis/explanation.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/angles.hpp"
+#include "diagnosis/mean_fit.hpp"
+#include "diagnosis/parallel.hpp"
+
+namespace umbmark::diag {
+
+namespace {
+
+bool Contains(const std::vector<sim::EffectKind>& set, sim::EffectKind k) {
+  return std::find(set.begin(), set.end(), k) != set.end();
+}
+
+/// A set of effects fitted jointly, in sample and held out.
+struct SetFit {
+  ParamVector p{};
+  NoiseParams noise;
+  double gap_after = 0.0, heldout_gap = 0.0, cv_loglik = 0.0;
+};
+
+SetFit FitSet(const CampaignData& c, const MeanModel& model, const BaselineFit& b, const Folds& folds,
+              const std::vector<sim::EffectKind>& set, const GapOptions& gap) {
+  std::vector<int> params = BaselineParams();
+  for (sim::EffectKind e : set)
+    for (int k : EffectParams(e)) params.push_back(k);
+  const bool corr = Contains(set, sim::EffectKind::kCorrelatedNoise);
+  const bool bumps = Contains(set, sim::EffectKind::kBumpOutliers);
+  const bool scrub = Contains(set, sim::EffectKind::kTurnScrub);
+  const MeanFit mf = FitMean(model, b.p, params, b.W, MeanFitOptions{12});
+  // turn_scrub changes the spot turns' noise bases too (candidates.cpp).
+  const std::vector<PieceBases> bases = scrub ? ComputeBases(c, model, mf.p) : b.bases;
+  PieceNoiseFitOptions nf = b.noise_fit;
+  nf.correlated = corr;
+  SetFit out;
+  out.p = mf.p;
+  // Bumps and rho together: the bump mixture (its fit has no rho).
+  out.noise = bumps ? FitBumps(mf.eps, bases, c.pieces, {}, b.noise)
+                    : FitPieceNoise(mf.eps, bases, c.pieces, {}, b.noise, nf);
+  const std::vector<Eigen::Matrix3d> W = Whiteners(bases, c.pieces, out.noise);
+  out.gap_after = ComputeGap(c, PieceScores(mf.eps, bases, c.pieces, out.noise), gap).score;
+  PieceNoiseFitOptions fold_fit = nf;
+  fold_fit.line_search = false;
+  fold_fit.max_iterations = 6;
+  const NoiseParams& ne = out.noise;
+  const CrossValidation cv =
+      CrossValidate(c, bases, folds, mf.eps, mf.D, W, [&](const std::vector<double>& e, const std::vector<char>& use) {
+        return bumps ? FitBumps(e, bases, c.pieces, use, ne) : FitPieceNoise(e, bases, c.pieces, use, ne, fold_fit);
+      });
+  out.cv_loglik = cv.loglik;
+  out.heldout_gap = ComputeGap(c, cv.scores, gap).score;
+  return out;
+}
+
+int Parameters(sim::EffectKind e) {
+  if (e == sim::EffectKind::kCorrelatedNoise) return 1;
+  if (e == sim::EffectKind::kBumpOutliers) return 2;
+  return static_cast<int>(EffectParams(e).size());
+}
+
+std::map<std::string, double> ParamsOf(sim::EffectKind e, const SetFit& f) {
+  std::map<std::string, double> out;
+  if (e == sim::EffectKind::kCorrelatedNoise) {
+    out["rho"] = f.noise.rho();
+  } else if (e == sim::EffectKind::kBumpOutliers) {
+    out["rate"] = f.noise.bump_rate;
+    out["sigma"] = std::sqrt(f.noise.bump_s2);
+  } else {
+    for (int k : EffectParams(e)) out[ParamName(k)] = f.p[k];
+  }
+  return out;
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+/// The baseline's scatter of one piece's relative motion: RMS over the
+/// pieces (those with heading) of the predicted position and heading sd.
+struct PieceScatter {
+  double position_m = 0.0, heading_rad = 0.0;
+};
+
+PieceScatter Scatter(const CampaignData& c, const BaselineFit& b) {
+  double sp = 0.0, sh = 0.0;
+  int n = 0;
+  for (std::size_t j = 0; j < c.pieces.size(); ++j) {
+    if (c.pieces[j].components != 3) continue;
+    const Eigen::Matrix3d C = PieceCovariance(b.bases[j], b.noise);
+    sp += C(0, 0) + C(1, 1);
+    sh += C(2, 2);
+    ++n;
+  }
+  if (n == 0) return {};
+  return {std::sqrt(sp / n), std::sqrt(sh / n)};
+}
+
+/// Practical size of effect e within the joint fit f (see explanation.hpp).
+void Size(const CampaignData& c, const MeanModel& model, const PieceScatter& noise, const SetFit& f,
+          sim::EffectKind e, ExplanationStep& s) {
+  const double kL2 = f.noise.kL2, kR2 = f.noise.kR2, kbar2 = 0.5 * (kL2 + kR2);
+  if (e == sim::EffectKind::kCorrelatedNoise) {
+    const double ratio = kbar2 > 0.0 ? f.noise.c_LR / kbar2 : 0.0;
+    s.relative_size = std::abs(std::sqrt(std::max(0.0, 1.0 + ratio)) - 1.0);
+    return;
+  }
+  if (e == sim::EffectKind::kBumpOutliers) {
+    s.relative_size = kbar2 > 0.0 ? std::sqrt(1.0 + f.noise.bump_rate * f.noise.bump_s2 / kbar2) - 1.0 : 1.0;
+    return;
+  }
+  ParamVector without = f.p;
+  for (int k : EffectParams(e)) without[k] = 0.0;
+  // Per experiment: an effect may show in one kind of run only (turn_scrub
+  // in the squares' spot turns), so the typical run is that of the
+  // experiment where it shows most.
+  std::vector<std::vector<double>> pos(c.experiments.size()), head(c.experiments.size());
+  for (std::size_t ri = 0; ri < c.runs.size(); ++ri) {
+    const DiagRun& r = c.runs[ri];
+    const std::vector<Pose2> a = model.PredictRun(static_cast<int>(ri), f.p);
+    const std::vector<Pose2> b = model.PredictRun(static_cast<int>(ri), without);
+    double sp = 0.0, sh = 0.0;
+    int n = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      if (!r.has_gt[i]) continue;
+      sp += (a[i].x - b[i].x) * (a[i].x - b[i].x) + (a[i].y - b[i].y) * (a[i].y - b[i].y);
+      const double dth = WrapAngle(a[i].theta - b[i].theta);
+      sh += dth * dth;
+      ++n;
+    }
+    if (n == 0) continue;
+    pos[static_cast<std::size_t>(r.experiment)].push_back(std::sqrt(sp / n));
+    head[static_cast<std::size_t>(r.experiment)].push_back(std::sqrt(sh / n));
+  }
+  const double np = noise.position_m, nh = noise.heading_rad;
+  double dp = 0.0, dh = 0.0;
+  for (std::size_t x = 0; x < pos.size(); ++x) {
+    dp = std::max(dp, Median(pos[x]));
+    dh = std::max(dh, Median(head[x]));
+  }
+  s.size_mm = 1e3 * dp;
+  s.size_mrad = 1e3 * dh;
+  s.relative_size = std::max(np > 0.0 ? dp / np : 0.0, nh > 0.0 ? dh / nh : 0.0);
+}
+
+}  // namespace
+
+Explanation Explain(const CampaignData& c, const MeanModel& model, const BaselineFit& b, const Folds& folds,
+                    const std::vector<Candidate>& candidates,
+                    const std::vector<sim::EffectKind>& first, double gap_score, double null_median,
+                    double null_quantile, const ExplanationOptions& options) {
+  Explanation ex;
+  const SetFit base = FitSet(c, model, b, folds, {}, options.gap);
+  const double gap_before = Gap(gap_score, null_median), gap_cv_before = Gap(base.heldout_gap, null_median);
+  std::vector<sim::EffectKind> chosen;
+  std::vector<SetFit> fits;
+  SetFit current = base;
+  auto add = [&](sim::EffectKind e, const SetFit& f) {
+    ExplanationStep s;
+    s.effect = e;
+    s.params = ParamsOf(e, f);
+    s.gap_after = f.gap_after;
+    s.cumulative_shrink = Shrink(Gap(f.gap_after, null_median), gap_before);
+    s.cumulative_heldout_shrink = Shrink(Gap(f.heldout_gap, null_median), gap_cv_before);
+    s.heldout_gain_nats = f.cv_loglik - current.cv_loglik;
+    chosen.push_back(e);
+    ex.steps.push_back(s);
+    current = f;
+  };
+  for (sim::EffectKind e : first) {
+    std::vector<sim::EffectKind> set = chosen;
+    set.push_back(e);
+    add(e, FitSet(c, model, b, folds, set, options.gap));
+  }
+  // Candidates worth trying: identifiable ones that gained held out alone.
+  std::vector<sim::EffectKind> pool;
+  for (const Candidate& cd : candidates)
+    if (cd.identifiable && cd.heldout_loglik_gain > 0.0 && !Contains(chosen, cd.effect)) pool.push_back(cd.effect);
+  ex.stop_reason = "the largest explanation considered";
+  while (static_cast<int>(chosen.size()) < options.max_effects) {
+    if (current.gap_after <= null_quantile) {
+      ex.stop_reason = "the remaining gap is not significant";
+      break;
+    }
+    std::vector<sim::EffectKind> remaining;
+    for (sim::EffectKind e : pool)
+      if (!Contains(chosen, e)) remaining.push_back(e);
+    if (remaining.empty()) {
+      ex.stop_reason = "no candidate left that gains held-out evidence on its own";
+      break;
+    }
+    std::vector<SetFit> trial(remaining.size());
+    ParallelFor(options.threads, static_cast<int>(remaining.size()), [&](int i) {
+      std::vector<sim::EffectKind> set = chosen;
+      set.push_back(remaining[static_cast<std::size_t>(i)]);
+      trial[static_cast<std::size_t>(i)] = FitSet(c, model, b, folds, set, options.gap);
+    });
+    std::size_t best = 0;
+    double best_evidence = -1e300;
+    for (std::size_t i = 0; i < remaining.size(); ++i) {
+      const double ev = trial[i].cv_loglik - current.cv_loglik - options.complexity_penalty_nats * Parameters(remaining[i]);
+      if (ev > best_evidence) {
+        best_evidence = ev;
+        best = i;
+      }
+    }
+    if (!(best_evidence > 0.0)) {
+      ex.stop_reason = "no further effect gains held-out evidence";
+      break;
+    }
+    add(remaining[best], trial[best]);
+  }
+  ex.gap_left = current.gap_after > null_quantile;
+  const PieceScatter scatter = Scatter(c, b);
+  for (ExplanationStep& s : ex.steps) {
+    Size(c, model, scatter, current, s.effect, s);
+    s.negligible = s.relative_size < options.negligible;
+  }
+  return ex;
+}
+
+}  // namespace umbmark::diag

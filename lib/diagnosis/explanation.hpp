@@ -1,0 +1,75 @@
+// Stage "explanation" of the diagnosis: real robots differ from the model in
+// more than one way, so the gap is explained by a SET of effects, added one
+// at a time (forward selection). At every step each remaining candidate is
+// fitted jointly with the effects already chosen (mean parameters with
+// E_d, E_b by weighted least squares; the noise refitted, with rho or bumps
+// when chosen) and cross-validated over runs; the one with the largest
+// held-out log-likelihood gain is added when it gains more than the
+// complexity penalty per parameter. Selection stops when no effect gains
+// held-out evidence or the remaining gap is no longer significant (G at or
+// below the null's 1 - alpha quantile).
+//
+// Practical significance: an effect's size is how far it moves the
+// predicted (measured) pose over a run -- the RMS over a run's ground-truth
+// samples of the change in predicted position [mm] and heading [mrad] when
+// the effect is removed (the others kept), median over an experiment's
+// runs, largest over the experiments -- relative to
+// the noise the diagnosis compares with: the baseline's scatter of one
+// piece's relative motion (wheel noise over a piece of up to 1 m or a spot
+// turn, plus the ground truth's noise at both ends; RMS over the pieces;
+// position and heading separately, the larger ratio counts). For the noise
+// effects it is the relative change of the wheel-noise standard deviation
+// they cause. Below `negligible` (default 0.25: a quarter of the noise) an
+// effect is negligible: reported, never named in the verdict, however
+// significant.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "diagnosis/candidates.hpp"
+
+namespace umbmark::diag {
+
+struct ExplanationOptions {
+  /// Most effects in the explanation. Default 4.
+  int max_effects = 4;
+  /// Held-out nats an added effect must gain per parameter. Default 2.
+  double complexity_penalty_nats = 2.0;
+  /// Relative size below which an effect is negligible. Default 0.25.
+  double negligible = 0.25;
+  /// Threads (>= 1); results do not depend on them. Default 2.
+  int threads = 2;
+  GapOptions gap;
+};
+
+struct ExplanationStep {
+  sim::EffectKind effect = sim::EffectKind::kScaleError;
+  /// Parameters of this effect as fitted jointly at this step.
+  std::map<std::string, double> params;
+  double gap_after = 0.0;                  ///< G with every effect so far
+  double cumulative_shrink = 0.0;          ///< in-sample
+  double cumulative_heldout_shrink = 0.0;  ///< on held-out runs
+  double heldout_gain_nats = 0.0;          ///< over the previous step, held out
+  /// Practical size (see the file comment), at the last step's joint fit.
+  double size_mm = 0.0, size_mrad = 0.0;
+  double relative_size = 0.0;
+  bool negligible = false;
+};
+
+struct Explanation {
+  std::vector<ExplanationStep> steps;  ///< in the order added
+  bool gap_left = true;  ///< G after the last step still above the null's 1 - alpha quantile
+  std::string stop_reason;
+};
+
+/// `first`: the effect to start with (the single-effect verdict), or none
+/// (empty) to select from scratch. gap_score, null_median, null_quantile:
+/// the baseline's G, the null's median G0 and 1 - alpha quantile.
+Explanation Explain(const CampaignData& c, const MeanModel& model, const BaselineFit& baseline,
+                    const Folds& folds, const std::vector<Candidate>& candidates,
+                    const std::vector<sim::EffectKind>& first, double gap_score, double null_median,
+                    double null_quantile, const ExplanationOptions& options);
+
+}  // namespace umbmark::diag
