@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (fuzz/*.cpp) with clang++ and runs each for
 # FUZZ_SECONDS (default 60), seeded from the test data (tests/data/good,
-# tests/data/bad, the shipped example data). Fails on any crash, sanitizer
+# tests/data/bad, the shipped example data; small MCAP files and CDR messages
+# of tests/data/rosbag2 for fuzz_mcap and fuzz_cdr). Fails on any crash, sanitizer
 # report, timeout or out-of-memory; the reproducer is left in
 # $FUZZ_BUILD_DIR/artifacts/.
 #   env: FUZZ_SECONDS (60), FUZZ_BUILD_DIR (build-fuzz), FUZZ_CXX (clang++)
@@ -87,6 +88,12 @@ for target in "${targets[@]}"; do
     fuzz_toml)
       dict=toml.dict
       find tests/data data -maxdepth 3 -type f -name '*.toml' -exec cp {} "$seeds/" \; ;;
+    fuzz_mcap)
+      dict=""
+      find tests/data/rosbag2 -type f -name '*.mcap' -size -64k -exec cp {} "$seeds/" \; ;;
+    fuzz_cdr)
+      dict=""
+      cp tests/data/rosbag2/cdr/*.bin "$seeds/" ;;
     *) dict="" ;;
   esac
   echo "== $target: $(ls "$seeds" | wc -l) seed files, $(ls "$corpus" | wc -l) corpus files, ${seconds} s"

@@ -20,6 +20,7 @@
 #include "io/atomic_write.hpp"
 #include "io/data_file.hpp"
 #include "io/manifest.hpp"
+#include "io/ros2_params.hpp"
 
 namespace umbmark::cli {
 
@@ -37,6 +38,7 @@ struct CalibrateOptions {
   double outlier_threshold = 3.5;
   JsonFlag json;
   std::string ros2;
+  std::string controller = "diff_drive_controller";
   std::string plot;
   bool refine = false;
   std::vector<std::string> fix, free;
@@ -291,22 +293,18 @@ void PrintResult(const CalibrateJobResult& r) {
   }
 }
 
-std::string Ros2Snippet(const CalibrateJobResult& r, const Chosen& chosen) {
-  const UmbmarkSummary& s = r.umbmark;
-  // Multipliers of the chosen calibration: wheelbase and each radius
-  // relative to the recorded ones.
-  const double sep = chosen.separation, left = chosen.left, right = chosen.right;
-  return fmt::format(
-      "# ros2_control diff_drive_controller parameters from umbmark calibrate: {} ({})\n"
-      "# Multipliers are relative to the parameters the runs were recorded with:\n"
-      "#   wheel_separation = {} m, left/right wheel diameter = {} / {} m.\n"
-      "diff_drive_controller:\n"
-      "  ros__parameters:\n"
-      "    wheel_separation_multiplier: {}\n"
-      "    left_wheel_radius_multiplier: {}\n"
-      "    right_wheel_radius_multiplier: {}\n",
-      chosen.method, r.label, s.recorded.wheelbase_m, s.recorded.wheel_diameter_left_m,
-      s.recorded.wheel_diameter_right_m, sep, left, right);
+// diff_drive_controller multipliers of the chosen calibration (--use): each
+// parameter relative to the one the runs were recorded with.
+std::string Ros2Parameters(const CalibrateJobResult& r, const Chosen& chosen, const std::string& controller) {
+  io::DiffDriveMultipliers m;
+  m.wheel_separation_multiplier = chosen.separation;
+  m.left_wheel_radius_multiplier = chosen.left;
+  m.right_wheel_radius_multiplier = chosen.right;
+  return io::FormatDiffDriveCalibration(
+      controller, m, r.umbmark.recorded,
+      {fmt::format("ros2_control diff_drive_controller parameters from umbmark calibrate: {} ({})", chosen.method,
+                   r.label),
+       "Load with: ros2 param load /" + controller + " FILE (or add to the controller's --param-file list)"});
 }
 
 int RunCalibrate(const CalibrateOptions& o) {
@@ -395,7 +393,7 @@ int RunCalibrate(const CalibrateOptions& o) {
                                                         jo.refine ? jo.refine->final_turn : true);
       const std::vector<std::string> warnings = TrustWarnings(r, heldout, check);
       const std::string tag = std::filesystem::path(in.path).stem().string() + "-" + std::to_string(rows.size() + 1);
-      if (!o.ros2.empty()) outs.Write(batch ? TaggedPath(o.ros2, tag) : o.ros2, Ros2Snippet(r, chosen));
+      if (!o.ros2.empty()) outs.Write(batch ? TaggedPath(o.ros2, tag) : o.ros2, Ros2Parameters(r, chosen, o.controller));
       if (!o.plot.empty()) {
         outs.Write(batch ? TaggedPath(o.plot, tag) : o.plot,
                    CalibrationPlotSvg(in, r, jo.integrator, chosen.parameters, chosen.method));
@@ -463,7 +461,10 @@ Command SetupCalibrate(CLI::App& parent) {
       ->capture_default_str();
   opts->json.Bind(*app);
   app->add_option("--ros2", opts->ros2,
-                  "Write a ros2_control diff_drive_controller parameter snippet (YAML) of the --use calibration");
+                  "Write a ros2_control diff_drive_controller parameter file (YAML for ros2 param load) of the --use "
+                  "calibration");
+  app->add_option("--controller", opts->controller, "Controller name at the top of the --ros2 file")
+      ->capture_default_str();
   app->add_option("--plot", opts->plot,
                   "Write an SVG of the return errors, centres of gravity and E_max,syst (after: the --use calibration)");
   app->add_option("--use", opts->use,

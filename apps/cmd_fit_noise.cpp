@@ -19,11 +19,13 @@
 #include "common.hpp"
 #include "core/angles.hpp"
 #include "core/errors.hpp"
+#include "error_models/odometry_covariance.hpp"
 #include "error_models/wheel_noise_fit.hpp"
 #include "error_models/wheel_noise_fit_data.hpp"
 #include "io/atomic_write.hpp"
 #include "io/data_file.hpp"
 #include "io/manifest.hpp"
+#include "io/ros2_params.hpp"
 #include "io/svg_plot.hpp"
 
 namespace umbmark::cli {
@@ -37,6 +39,9 @@ struct FitNoiseOptions {
   bool first_order = false;
   bool reml = false;
   std::string plot;
+  std::string ros2;
+  std::string controller = "diff_drive_controller";
+  OdometryCovarianceOptions covariance;
   JsonFlag json;
 };
 
@@ -45,6 +50,7 @@ struct Loaded {
   std::vector<std::string> sources;
   int skipped = 0;
   double sigma_xy = 0.0, sigma_theta = 0.0;
+  std::optional<double> wheelbase_m;  ///< of the (last) robot read, for --ros2
 };
 
 NoiseFitInputOptions InputOptions(const FitNoiseOptions& o, const std::optional<GroundTruthNoise>& manifest_gt) {
@@ -75,6 +81,7 @@ void AppendTrajectoryRuns(const TrajectoryData& t, const RobotParams& robot, con
 void AppendManifest(const std::string& path, const FitNoiseOptions& o, Loaded& out) {
   const Manifest m = io::ReadManifest(path);
   const RobotParams robot = o.robot.Resolve(m.robot);
+  out.wheelbase_m = robot.wheelbase_m;
   const NoiseFitInputOptions in = InputOptions(o, m.ground_truth);
   out.sigma_xy = in.sigma_xy_m;
   out.sigma_theta = in.sigma_theta_rad;
@@ -117,6 +124,7 @@ Loaded Load(const FitNoiseOptions& o) {
       continue;
     }
     const RobotParams robot = o.robot.Resolve();
+    out.wheelbase_m = robot.wheelbase_m;
     const NoiseFitInputOptions in = InputOptions(o, std::nullopt);
     out.sigma_xy = in.sigma_xy_m;
     out.sigma_theta = in.sigma_theta_rad;
@@ -193,6 +201,7 @@ int RunFitNoise(const FitNoiseOptions& o) {
   RegisterInputs(o.inputs, &o.robot);
   outs.AddOutput("--json", o.json.path);
   outs.AddOutput("--plot", o.plot);
+  outs.AddOutput("--ros2", o.ros2);
   outs.Check();
   Loaded data = Load(o);
   if (data.runs.empty()) throw InputError(o.inputs.front(), "no run with ground truth at its start and end");
@@ -221,7 +230,13 @@ int RunFitNoise(const FitNoiseOptions& o) {
                       {"runs", n},
                       {"systematic_mean", {s.group_means[g](0), s.group_means[g](1), s.group_means[g](2)}}});
   }
-  const nlohmann::json j = {{"k_L", s.k_L},
+  // diff_drive_controller covariance diagonals from the fitted noise.
+  std::optional<OdometryCovariance> cov;
+  if (!o.ros2.empty()) {
+    if (!data.wheelbase_m) throw InvalidOptions("--ros2 needs the robot's wheelbase (--robot or --wheelbase)");
+    cov = OdometryCovarianceFromWheelNoise(s.k_L, s.k_R, *data.wheelbase_m, o.covariance);
+  }
+  nlohmann::json j = {{"k_L", s.k_L},
                             {"k_R", s.k_R},
                             {"k_L_ci95", {JsonNumber(s.k_L_ci[0]), JsonNumber(s.k_L_ci[1])}},
                             {"k_R_ci95", {JsonNumber(s.k_R_ci[0]), JsonNumber(s.k_R_ci[1])}},
@@ -260,6 +275,26 @@ int RunFitNoise(const FitNoiseOptions& o) {
     if (flagged) fmt::print("  |z| > 3: the wheel noise model cannot explain that element (see docs/noise-model.md)\n");
   }
   if (!o.plot.empty()) CommandOutputs().Write(o.plot, PlotSvg(s));
+  if (cov) {
+    CommandOutputs().Write(
+        o.ros2,
+        io::FormatDiffDriveCovariance(
+            o.controller, cov->pose, cov->twist,
+            {fmt::format("ros2_control diff_drive_controller covariance from umbmark fit-noise: k_L = {:.4g}, k_R = {:.4g} "
+                         "m^1/2, wheelbase {} m", s.k_L, s.k_R, *data.wheelbase_m),
+             fmt::format("stated for {} m/s at {} Hz updates (variances scale with speed; derivation: docs/ros2.md)",
+                         o.covariance.speed_mps, o.covariance.rate_hz),
+             fmt::format("{} = not measured by planar odometry (z, roll, pitch and rates); {} = lateral velocity "
+                         "(non-holonomic constraint)", kUnmeasuredVariance, kConstraintVariance)}));
+    j["ros2"] = {{"file", o.ros2},
+                 {"controller", o.controller},
+                 {"rate_hz", o.covariance.rate_hz},
+                 {"speed_mps", o.covariance.speed_mps},
+                 {"pose_covariance_diagonal", cov->pose},
+                 {"twist_covariance_diagonal", cov->twist}};
+    if (o.json.PrintText()) fmt::print("  wrote {} (diff_drive_controller covariance at {} m/s, {} Hz)\n", o.ros2,
+                                       o.covariance.speed_mps, o.covariance.rate_hz);
+  }
   o.json.Emit(j);
   return 0;
 }
@@ -282,6 +317,15 @@ Command SetupFitNoise(CLI::App& parent) {
   app->add_flag("--first-order", opts->first_order, "Fit the first-order model only (no heading-squared term)");
   app->add_flag("--reml", opts->reml, "Restricted maximum likelihood (allow for the fitted systematic means)");
   app->add_option("--plot", opts->plot, "Write pairwise 95% ellipses, observed vs fitted, over the runs (SVG)");
+  app->add_option("--ros2", opts->ros2,
+                  "Write diff_drive_controller pose/twist_covariance_diagonal from k_L, k_R (YAML; docs/ros2.md)");
+  app->add_option("--controller", opts->controller, "Controller name at the top of the --ros2 file")->capture_default_str();
+  app->add_option("--rate", opts->covariance.rate_hz, "--ros2: odometry update rate [Hz]")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app->add_option("--speed", opts->covariance.speed_mps, "--ros2: driving speed the covariance is stated for [m/s]")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   opts->json.Bind(*app);
   return {app, [opts] { return RunFitNoise(*opts); }};
 }

@@ -28,6 +28,13 @@ struct ImportOptions {
   JsonFlag json;
 };
 
+void EnsureOutDir(const std::string& out) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (ec || !fs::is_directory(out)) throw InputError(out, "cannot create output directory: " + ec.message());
+}
+
 int RunImportOptiOdom(const ImportOptions& o) {
   namespace fs = std::filesystem;
   std::optional<std::string> category;
@@ -47,9 +54,7 @@ int RunImportOptiOdom(const ImportOptions& o) {
   outs.Check();
   const io::OptiOdomDataset ds = io::ImportOptiOdom(o.dir, category);
 
-  std::error_code ec;
-  fs::create_directories(o.out, ec);
-  if (ec || !fs::is_directory(o.out)) throw InputError(o.out, "cannot create output directory: " + ec.message());
+  EnsureOutDir(o.out);
   const std::string source = fmt::format("OptiOdom dataset {} ({}), imported by umbmark import optiodom", ds.id,
                                          ds.category);
   Manifest m;
@@ -96,14 +101,11 @@ struct Rosbag2Options {
   JsonFlag json;
 };
 
-void EnsureOutDir(const std::string& out) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec || !fs::is_directory(out)) throw InputError(out, "cannot create output directory: " + ec.message());
-}
-
 int RunRosbag2List(const Rosbag2Options& o) {
+  io::OutputSet& outs = CommandOutputs();
+  for (const auto& bag : o.bags) outs.AddInput(bag);
+  outs.AddOutput("--json", o.json.path);
+  outs.Check();
   nlohmann::json bags = nlohmann::json::array();
   std::vector<std::string> warnings;
   for (const auto& path : o.bags) {
@@ -156,6 +158,21 @@ int RunRosbag2(Rosbag2Options o) {
   opt.integrator = *IntegratorFromString(o.integrator);
   opt.time = o.time == "log" ? io::rosbag2::StampSource::kLog : io::rosbag2::StampSource::kHeader;
   const RobotParams robot = o.robot.Resolve();
+  // The recordings (and every file of a bag folder) are inputs; the two
+  // files written must not be one of them or another output.
+  io::OutputSet& outs = CommandOutputs();
+  for (const auto& bag : o.bags) {
+    outs.AddInput(bag);
+    std::error_code ec;
+    if (fs::is_directory(bag, ec))
+      for (const auto& entry : fs::directory_iterator(bag, ec)) outs.AddInput(entry.path().string());
+  }
+  const std::string runs_path = (fs::path(o.out) / "runs.csv").string();
+  const std::string manifest_path = (fs::path(o.out) / "campaign.toml").string();
+  outs.AddOutput("--out", runs_path);
+  outs.AddOutput("--out", manifest_path);
+  outs.AddOutput("--json", o.json.path);
+  outs.Check();
   const auto result = io::rosbag2::ImportRosbag2(o.bags, robot, opt);
 
   EnsureOutDir(o.out);
@@ -167,10 +184,8 @@ int RunRosbag2(Rosbag2Options o) {
   Manifest m;
   m.robot = robot;
   m.experiments.push_back(result.experiment);
-  const std::string runs_path = (fs::path(o.out) / "runs.csv").string();
-  const std::string manifest_path = (fs::path(o.out) / "campaign.toml").string();
-  io::WriteFileAtomically(runs_path, io::FormatTrajectoryCsv(result.runs, comment));
-  io::WriteFileAtomically(manifest_path, io::FormatManifest(m, {comment[0]}));
+  outs.Write(runs_path, io::FormatTrajectoryCsv(result.runs, comment));
+  outs.Write(manifest_path, io::FormatManifest(m, {comment[0]}));
 
   nlohmann::json recordings = nlohmann::json::array();
   for (const auto& r : result.recordings)
