@@ -1,6 +1,6 @@
 // Benchmark of `import rosbag2`: imports one recording (JointState wheels on
 // /joint_states, PoseStamped ground truth on /mocap/pose) and prints input
-// MB/s and decoded messages/s. scripts/bench_rosbag2.sh generates a >= 1 GB
+// MB/s and decoded messages/s. bench/rosbag2_bench.sh generates a >= 1 GB
 // recording and runs this next to the Node reader (@mcap/core +
 // @foxglove/rosmsg2-serialization) decoding the same two topics.
 //   bench_rosbag2 BAG ROBOT.toml

@@ -1,17 +1,17 @@
 #!/usr/bin/env bash
 # Import benchmark for `import rosbag2`: generates a recording of at least
 # 1 GB outside the repository (zstd chunks; JointState 100 Hz, PoseStamped
-# 120 Hz, 640x480 images 30 Hz), then imports it with build/bench_rosbag2
+# 120 Hz, 160x120 rgb8 images of random bytes 30 Hz), then imports it with build/bench_rosbag2
 # and decodes the same two topics with the Node reader (@mcap/core +
 # @foxglove/rosmsg2-serialization), each under /usr/bin/time -v, and prints
 # MB/s, messages/s, peak memory and the ratios. Deletes the recording.
-#   env: BENCH_DIR (/tmp), BENCH_MB (1100), BUILD_DIR (build)
+#   bench/rosbag2_bench.sh [BUILD_DIR]     env: BENCH_DIR (/tmp), BENCH_MB (1100)
 # Needs node + npm (installs tests/data/rosbag2/generator's pinned packages).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=${BENCH_DIR:-/tmp}
 mb=${BENCH_MB:-1100}
-build=${BUILD_DIR:-build}
+build=${1:-build}
 gen=tests/data/rosbag2/generator
 free_mb=$(df -Pm "$dir" | awk 'NR==2 {print $4}')
 if (( free_mb < mb * 2 )); then echo "bench_rosbag2: $dir has $free_mb MB free, need $((mb * 2))" >&2; exit 1; fi
