@@ -97,7 +97,9 @@ std::vector<CalibrateInput> LoadInputs(const std::string& path, const CalibrateO
   std::vector<CalibrateInput> out;
   auto from_file = [&](const std::string& file, const RobotParams& robot, double side, const std::string& label) {
     io::RunFile rf = io::ReadRunFile(file);
-    if (auto* t = std::get_if<TrajectoryData>(&rf)) return InputFromTrajectories(*t, robot, side, integrator, label);
+    if (auto* t = std::get_if<TrajectoryData>(&rf)) {
+      return InputFromTrajectories(std::move(*t), robot, side, integrator, label);
+    }
     return InputFromEndpoints(std::get<EndpointData>(rf), robot, side, label);
   };
   if (io::IsManifestPath(path)) {
@@ -405,7 +407,9 @@ int RunCalibrate(const CalibrateOptions& o) {
       } else {
         for (const auto& w : warnings) fmt::print(stderr, "{}: warning: {}\n", in.label, w);
       }
-      results.push_back(JsonResult(in, r, o, heldout, check, chosen, warnings));
+      // The JSON document only when asked for: with a million runs it is
+      // the largest thing the command builds.
+      if (!o.json.path.empty()) results.push_back(JsonResult(in, r, o, heldout, check, chosen, warnings));
       rows.push_back({in.label, std::move(r), ""});
     }
   }
@@ -426,7 +430,9 @@ int RunCalibrate(const CalibrateOptions& o) {
                  s.corrected.wheel_diameter_right_m, s.E_max_syst_m * 1e3, after);
     }
   }
-  if (rows.size() == 1 && rows.front().result) {
+  if (o.json.path.empty()) {
+    // No JSON asked for.
+  } else if (rows.size() == 1 && rows.front().result) {
     o.json.Emit(results.front());
   } else {
     o.json.Emit({{"results", results}, {"failed", status != 0}});

@@ -3,6 +3,7 @@
 // recorded parameters or a calibration, per run and over all runs.
 #include <cmath>
 #include <memory>
+#include <set>
 #include <variant>
 
 #include <fmt/format.h>
@@ -31,13 +32,16 @@ struct EvaluateOptions {
   std::string plot;
 };
 
+/// One file to evaluate: a trajectory CSV, or one experiment of a manifest.
 struct Source {
   std::string label;
   RobotParams recorded;
-  TrajectoryData data;
+  std::string path;
+  std::string manifest;  ///< the manifest it comes from (its endpoint files are skipped), or empty
 };
 
-std::vector<Source> LoadSources(const EvaluateOptions& o) {
+/// The files to read, in order (manifests are read here, the data files not).
+std::vector<Source> ListSources(const EvaluateOptions& o) {
   std::vector<Source> out;
   for (const auto& path : o.inputs) {
     if (io::IsManifestPath(path)) {
@@ -46,20 +50,21 @@ std::vector<Source> LoadSources(const EvaluateOptions& o) {
       int index = 0;
       for (const auto& e : m.experiments) {
         ++index;
-        io::RunFile rf = io::ReadRunFile(e.resolved_file);
-        if (auto* t = std::get_if<TrajectoryData>(&rf))
-          out.push_back({fmt::format("{}#{}:{}", path, index, ExperimentKindToString(e.kind)), robot, std::move(*t)});
+        out.push_back({fmt::format("{}#{}:{}", path, index, ExperimentKindToString(e.kind)), robot, e.resolved_file,
+                       path});
       }
-      if (out.empty()) throw InputError(path, "no experiment of the manifest has trajectory data to evaluate");
     } else {
-      io::RunFile rf = io::ReadRunFile(path);
-      auto* t = std::get_if<TrajectoryData>(&rf);
-      if (!t) throw InputError(path, "evaluate needs a trajectory CSV (ticks or wheel travel with ground truth)");
-      out.push_back({path, o.robot.Resolve(), std::move(*t)});
+      out.push_back({path, o.robot.Resolve(), path, ""});
     }
   }
   return out;
 }
+
+/// A run kept for the plot, with the source it came from.
+struct PlotRun {
+  const Source* source;
+  TrajectoryRun run;
+};
 
 // Reads calibrated parameters from a `calibrate` JSON: refined.parameters
 // when present, else parameters (contract).
@@ -121,45 +126,46 @@ void PrintSummary(const char* title, const EvaluationSummary& s) {
              Rad2Deg(s.max_max_heading_error_rad));
 }
 
-std::string PlotSvg(const std::vector<Source>& sources, const std::optional<RobotParams>& params, Integrator integ) {
+/// Runs drawn in the --plot figure (the first ones; keeps it readable).
+constexpr std::size_t kPlotRuns = 12;
+
+std::string PlotSvg(const std::vector<PlotRun>& runs, const std::optional<RobotParams>& params, Integrator integ) {
   std::vector<std::string> parts;
   const double size = 380;
   double x = 60, y = 40;
   int col = 0;
-  for (const auto& src : sources) {
-    for (const auto& run : src.data.runs) {
-      if (parts.size() >= 12) break;  // keep the figure readable
-      io::SvgPanel p(x, y, size, size, fmt::format("{} run {}", src.label, run.run));
-      const RunTrack before = TrackRun(run, src.data.path, src.recorded, src.recorded, integ);
-      std::vector<io::SvgPoint> gt, od, od2, all;
-      for (std::size_t i = 0; i < run.size(); ++i) {
-        if (before.has_ground_truth[i]) gt.push_back({before.ground_truth[i].x, before.ground_truth[i].y});
-        od.push_back({before.odometry[i].x, before.odometry[i].y});
-      }
-      all = gt;
-      all.insert(all.end(), od.begin(), od.end());
-      if (params) {
-        const RunTrack after = TrackRun(run, src.data.path, *params, src.recorded, integ);
-        for (const auto& q : after.odometry) od2.push_back({q.x, q.y});
-        all.insert(all.end(), od2.begin(), od2.end());
-      }
-      p.FitExtent(all, true, true);
-      p.Axes("x [m]", "y [m]");
-      p.Polyline(gt, "#111", 2.0);
-      p.Polyline(od, "#d62728", 1.2, "4,3");
-      if (params) p.Polyline(od2, "#2ca02c", 1.2);
-      std::vector<std::pair<std::string, std::string>> legend = {{"#111", "ground truth"},
-                                                                 {"#d62728", "odometry, recorded parameters"}};
-      if (params) legend.push_back({"#2ca02c", "odometry, --params"});
-      p.Legend(legend);
-      parts.push_back(p.Render());
-      if (++col == 3) {
-        col = 0;
-        x = 60;
-        y += size + 60;
-      } else {
-        x += size + 60;
-      }
+  for (const auto& [source, run] : runs) {
+    const Source& src = *source;
+    io::SvgPanel p(x, y, size, size, fmt::format("{} run {}", src.label, run.run));
+    const RunTrack before = TrackRun(run, src.path, src.recorded, src.recorded, integ);
+    std::vector<io::SvgPoint> gt, od, od2, all;
+    for (std::size_t i = 0; i < run.size(); ++i) {
+      if (before.has_ground_truth[i]) gt.push_back({before.ground_truth[i].x, before.ground_truth[i].y});
+      od.push_back({before.odometry[i].x, before.odometry[i].y});
+    }
+    all = gt;
+    all.insert(all.end(), od.begin(), od.end());
+    if (params) {
+      const RunTrack after = TrackRun(run, src.path, *params, src.recorded, integ);
+      for (const auto& q : after.odometry) od2.push_back({q.x, q.y});
+      all.insert(all.end(), od2.begin(), od2.end());
+    }
+    p.FitExtent(all, true, true);
+    p.Axes("x [m]", "y [m]");
+    p.Polyline(gt, "#111", 2.0);
+    p.Polyline(od, "#d62728", 1.2, "4,3");
+    if (params) p.Polyline(od2, "#2ca02c", 1.2);
+    std::vector<std::pair<std::string, std::string>> legend = {{"#111", "ground truth"},
+                                                               {"#d62728", "odometry, recorded parameters"}};
+    if (params) legend.push_back({"#2ca02c", "odometry, --params"});
+    p.Legend(legend);
+    parts.push_back(p.Render());
+    if (++col == 3) {
+      col = 0;
+      x = 60;
+      y += size + 60;
+    } else {
+      x += size + 60;
     }
   }
   const double rows = std::ceil(static_cast<double>(parts.size()) / 3.0);
@@ -174,17 +180,33 @@ int RunEvaluate(const EvaluateOptions& o) {
   outs.AddOutput("--json", o.json.path);
   outs.AddOutput("--plot", o.plot);
   outs.Check();
-  const std::vector<Source> sources = LoadSources(o);
+  const std::vector<Source> sources = ListSources(o);
   std::optional<RobotParams> params;
   if (!o.params_file.empty()) params = ReadParams(o.params_file, sources.front().recorded);
 
+  // Stream each file run by run: only the run in hand is in memory (and the
+  // first few, for --plot).
   std::vector<RunEvaluation> base_runs, param_runs;
+  std::vector<PlotRun> plot_runs;
+  std::set<std::string> manifests_with_trajectories;
   for (const auto& src : sources) {
-    auto b = EvaluateRuns(src.data, src.label, src.recorded, src.recorded, integ);
-    base_runs.insert(base_runs.end(), b.begin(), b.end());
-    if (params) {
-      auto a = EvaluateRuns(src.data, src.label, *params, src.recorded, integ);
-      param_runs.insert(param_runs.end(), a.begin(), a.end());
+    io::OpenedRunFile file = io::OpenRunFile(src.path);
+    auto* reader = std::get_if<io::TrajectoryReader>(&file);
+    if (reader == nullptr) {
+      if (!src.manifest.empty()) continue;
+      throw InputError(src.path, "evaluate needs a trajectory CSV (ticks or wheel travel with ground truth)");
+    }
+    manifests_with_trajectories.insert(src.manifest);
+    TrajectoryRun run;
+    while (reader->NextRun(run)) {
+      base_runs.push_back(EvaluateRun(run, src.path, src.label, src.recorded, src.recorded, integ));
+      if (params) param_runs.push_back(EvaluateRun(run, src.path, src.label, *params, src.recorded, integ));
+      if (!o.plot.empty() && plot_runs.size() < kPlotRuns) plot_runs.push_back({&src, run});
+    }
+  }
+  for (const auto& src : sources) {
+    if (!src.manifest.empty() && manifests_with_trajectories.count(src.manifest) == 0) {
+      throw InputError(src.manifest, "no experiment of the manifest has trajectory data to evaluate");
     }
   }
   const EvaluationSummary base = Summarise(std::move(base_runs));
@@ -207,7 +229,7 @@ int RunEvaluate(const EvaluateOptions& o) {
                      {"runs", JsonEvaluationRuns(base)},
                      {"summary", JsonEvaluationSummary(base)}};
   }
-  if (!o.plot.empty()) outs.Write(o.plot, PlotSvg(sources, params, integ));
+  if (!o.plot.empty()) outs.Write(o.plot, PlotSvg(plot_runs, params, integ));
   o.json.Emit(j);
   return 0;
 }

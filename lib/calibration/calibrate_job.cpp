@@ -11,7 +11,7 @@
 
 namespace umbmark {
 
-CalibrateInput InputFromTrajectories(const TrajectoryData& data, const RobotParams& recorded, double side_m,
+CalibrateInput InputFromTrajectories(TrajectoryData data, const RobotParams& recorded, double side_m,
                                      Integrator integrator, const std::string& label) {
   CalibrateInput in;
   in.label = label;
@@ -28,7 +28,7 @@ CalibrateInput InputFromTrajectories(const TrajectoryData& data, const RobotPara
                                    e.direction, Rad2Deg(*e.gt_total_rotation_rad), gt_dir));
     }
   }
-  in.trajectories = data;
+  in.trajectories = std::move(data);
   return in;
 }
 

@@ -58,7 +58,8 @@ struct CalibrateJobResult {
 /// Builds the input from trajectories: return errors with the recorded
 /// parameters, and a check that every run's cw/ccw label agrees with the
 /// sign of its ground-truth total rotation. Throws InputError otherwise.
-CalibrateInput InputFromTrajectories(const TrajectoryData& data, const RobotParams& recorded, double side_m,
+/// The runs are kept in the input (pass them with std::move to avoid a copy).
+CalibrateInput InputFromTrajectories(TrajectoryData data, const RobotParams& recorded, double side_m,
                                      Integrator integrator, const std::string& label);
 CalibrateInput InputFromEndpoints(const EndpointData& data, const RobotParams& recorded, double side_m,
                                   const std::string& label);

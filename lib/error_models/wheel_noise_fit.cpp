@@ -40,6 +40,9 @@ struct Grouping {
   std::vector<int> of_run;
   std::vector<std::string> names;
   std::vector<int> count, count_theta;
+  /// Plain mean error of each group (etheta over the runs that have it), a
+  /// centre that keeps ProfiledNll's one-pass sums free of cancellation.
+  std::vector<Eigen::Vector3d> centre;
 };
 
 Grouping MakeGroups(const std::vector<WheelNoiseFitRun>& runs) {
@@ -56,21 +59,31 @@ Grouping MakeGroups(const std::vector<WheelNoiseFitRun>& runs) {
     ++g.count[static_cast<std::size_t>(it->second)];
     if (r.has_theta) ++g.count_theta[static_cast<std::size_t>(it->second)];
   }
+  g.centre.assign(g.names.size(), Eigen::Vector3d::Zero());
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const auto k = static_cast<std::size_t>(g.of_run[i]);
+    g.centre[k].head<2>() += runs[i].error.head<2>() / g.count[k];
+    if (runs[i].has_theta) g.centre[k](2) += runs[i].error(2) / g.count_theta[k];
+  }
   return g;
 }
 
 /// Profiled negative log-likelihood (group means by GLS) for k_L^2 = qL,
 /// k_R^2 = qR. Returns false when some S_i is not positive definite.
+/// One pass over the runs, storing nothing per run (a fit evaluates this a
+/// few thousand times, so with 10^6 runs its memory traffic is the cost):
+/// with d_i = e_i - c_g (c_g the group's centre) and b_g = sum S_i^-1 d_i,
+///   sum_i (d_i - m_g)^T S_i^-1 (d_i - m_g) = sum_i d_i^T S_i^-1 d_i - b_g^T m_g
+/// at the GLS mean m_g = W_g^-1 b_g, W_g = sum S_i^-1.
 template <typename T>
 bool ProfiledNll(const std::vector<WheelNoiseFitRun>& runs, const Grouping& grp, const T& qL, const T& qR, T* nll,
                  std::vector<Eigen::Matrix<T, 3, 1>>* means = nullptr, bool restricted = false) {
   using M3 = Eigen::Matrix<T, 3, 3>;
   using V3 = Eigen::Matrix<T, 3, 1>;
   const std::size_t n = runs.size(), G = grp.names.size();
-  std::vector<M3> inv(n);
-  std::vector<T> logdet(n);
   std::vector<M3> W(G, M3::Zero());
   std::vector<V3> b(G, V3::Zero());
+  T total(0.0);
   for (std::size_t i = 0; i < n; ++i) {
     const WheelNoiseFitRun& r = runs[i];
     const SecondOrderBasis& q2 = r.second_order;
@@ -80,38 +93,38 @@ bool ProfiledNll(const std::vector<WheelNoiseFitRun>& runs, const Grouping& grp,
     const T m1 = S(0, 0), m2 = S(0, 0) * S(1, 1) - S(0, 1) * S(1, 0);
     if (!(m1 > T(0.0)) || !(m2 > T(0.0))) return false;
     M3 Si = M3::Zero();
+    T logdet;
     if (r.has_theta) {
       const T det = S.determinant();
       if (!(det > T(0.0))) return false;
       Si = S.inverse();
-      logdet[i] = log(det);
+      logdet = log(det);
     } else {
       const Eigen::Matrix<T, 2, 2> S2 = S.template topLeftCorner<2, 2>();
       Si.template topLeftCorner<2, 2>() = S2.inverse();
-      logdet[i] = log(m2);
+      logdet = log(m2);
     }
-    inv[i] = Si;
     const auto g = static_cast<std::size_t>(grp.of_run[i]);
+    const V3 d = (r.error - grp.centre[g]).cast<T>();  // d(2) meets only zeros of Si without etheta
+    const V3 Sd = Si * d;
     W[g] += Si;
-    b[g] += Si * r.error.cast<T>();
+    b[g] += Sd;
+    total += T(0.5) * (d.dot(Sd) + logdet);
   }
   std::vector<V3> mu(G, V3::Zero());
-  T total(0.0);
   for (std::size_t g = 0; g < G; ++g) {
+    V3 m = V3::Zero();
     if (grp.count_theta[g] > 0) {
-      mu[g] = W[g].inverse() * b[g];
+      m = W[g].inverse() * b[g];
       if (restricted) total += T(0.5) * log(W[g].determinant());
     } else {
       const Eigen::Matrix<T, 2, 2> W2 = W[g].template topLeftCorner<2, 2>();
       const Eigen::Matrix<T, 2, 1> m2 = W2.inverse() * b[g].template head<2>();
-      mu[g] << m2(0), m2(1), T(0.0);
+      m << m2(0), m2(1), T(0.0);
       if (restricted) total += T(0.5) * log(W2.determinant());
     }
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    V3 res = runs[i].error.cast<T>() - mu[static_cast<std::size_t>(grp.of_run[i])];
-    if (!runs[i].has_theta) res(2) = T(0.0);
-    total += T(0.5) * (res.dot(inv[i] * res) + logdet[i]);
+    total -= T(0.5) * b[g].dot(m);
+    mu[g] = m + grp.centre[g].cast<T>();  // centre(2) is 0 in a group without etheta
   }
   *nll = total;
   if (means) *means = mu;

@@ -10,34 +10,37 @@
 
 namespace umbmark {
 
+RunEvaluation EvaluateRun(const TrajectoryRun& run, const std::string& file, const std::string& experiment,
+                          const RobotParams& params, const RobotParams& recorded, Integrator integrator) {
+  const RunTrack track = TrackRun(run, file, params, recorded, integrator);
+  RunEvaluation ev;
+  ev.experiment = experiment;
+  ev.run = run.run;
+  ev.direction = run.direction;
+  for (std::size_t i = 0; i < run.size(); ++i) {
+    if (!track.has_ground_truth[i]) continue;
+    const Pose2& gt = track.ground_truth[i];
+    const Pose2& odo = track.odometry[i];
+    const double pos = std::hypot(gt.x - odo.x, gt.y - odo.y);
+    const double head = std::abs(WrapAngle(gt.theta - odo.theta));
+    ev.max_position_error_m = std::max(ev.max_position_error_m, pos);
+    ev.max_heading_error_rad = std::max(ev.max_heading_error_rad, head);
+  }
+  const std::size_t k = track.last_gt;
+  const Pose2& gt = track.ground_truth[k];
+  const Pose2& odo = track.odometry[k];
+  ev.final_position_error_m = std::hypot(gt.x - odo.x, gt.y - odo.y);
+  ev.final_heading_error_rad = std::abs(WrapAngle(gt.theta - odo.theta));
+  ev.return_error = {gt.x - odo.x, gt.y - odo.y, WrapAngle(gt.theta - odo.theta)};
+  return ev;
+}
+
 std::vector<RunEvaluation> EvaluateRuns(const TrajectoryData& data, const std::string& experiment,
                                         const RobotParams& params, const RobotParams& recorded,
                                         Integrator integrator) {
   std::vector<RunEvaluation> out;
   out.reserve(data.runs.size());
-  for (const auto& run : data.runs) {
-    const RunTrack track = TrackRun(run, data.path, params, recorded, integrator);
-    RunEvaluation ev;
-    ev.experiment = experiment;
-    ev.run = run.run;
-    ev.direction = run.direction;
-    for (std::size_t i = 0; i < run.size(); ++i) {
-      if (!track.has_ground_truth[i]) continue;
-      const Pose2& gt = track.ground_truth[i];
-      const Pose2& odo = track.odometry[i];
-      const double pos = std::hypot(gt.x - odo.x, gt.y - odo.y);
-      const double head = std::abs(WrapAngle(gt.theta - odo.theta));
-      ev.max_position_error_m = std::max(ev.max_position_error_m, pos);
-      ev.max_heading_error_rad = std::max(ev.max_heading_error_rad, head);
-    }
-    const std::size_t k = track.last_gt;
-    const Pose2& gt = track.ground_truth[k];
-    const Pose2& odo = track.odometry[k];
-    ev.final_position_error_m = std::hypot(gt.x - odo.x, gt.y - odo.y);
-    ev.final_heading_error_rad = std::abs(WrapAngle(gt.theta - odo.theta));
-    ev.return_error = {gt.x - odo.x, gt.y - odo.y, WrapAngle(gt.theta - odo.theta)};
-    out.push_back(std::move(ev));
-  }
+  for (const auto& run : data.runs) out.push_back(EvaluateRun(run, data.path, experiment, params, recorded, integrator));
   return out;
 }
 

@@ -32,6 +32,12 @@ struct EvaluationSummary {
   double mean_max_heading_error_rad = 0.0, max_max_heading_error_rad = 0.0;
 };
 
+/// Evaluates one run of the file `file` (named in messages) with odometry
+/// parameters `params`. Throws InputError for a run without ground truth at
+/// its start.
+RunEvaluation EvaluateRun(const TrajectoryRun& run, const std::string& file, const std::string& experiment,
+                          const RobotParams& params, const RobotParams& recorded, Integrator integrator);
+
 /// Evaluates every run of `data` with odometry parameters `params`.
 /// Throws InputError (naming data.path) for runs without ground truth at start.
 std::vector<RunEvaluation> EvaluateRuns(const TrajectoryData& data, const std::string& experiment,

@@ -20,6 +20,7 @@
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
+#include "io/file_text.hpp"
 
 namespace umbmark::io {
 namespace {
@@ -288,30 +289,6 @@ void InstallTemporaryFileCleanup() {
   }
 }
 
-std::string ReadWholeFile(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) throw InputError(path, fmt::format("cannot open: {}", ErrnoText(errno)));
-  FdGuard guard(fd);
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) throw InputError(path, fmt::format("cannot read: {}", ErrnoText(errno)));
-  if (S_ISDIR(st.st_mode)) throw InputError(path, "cannot read: it is a directory");
-  // Regular files: one read of the known size (+1 to see the end at once);
-  // pipes and devices: grow as data comes.
-  std::string out;
-  out.resize(S_ISREG(st.st_mode) ? static_cast<std::size_t>(st.st_size) + 1 : std::size_t{1} << 16);
-  std::size_t len = 0;
-  for (;;) {
-    if (len == out.size()) out.resize(out.size() * 2);
-    const ssize_t n = ::read(fd, out.data() + len, out.size() - len);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      throw InputError(path, fmt::format("cannot read: {}", ErrnoText(errno)));
-    }
-    if (n == 0) break;
-    len += static_cast<std::size_t>(n);
-  }
-  out.resize(len);
-  return out;
-}
+std::string ReadWholeFile(const std::string& path) { return detail::ReadLimitedFile(path); }
 
 }  // namespace umbmark::io

@@ -56,7 +56,8 @@ void DiscardStagingDirectory(const std::string& staging) noexcept;
 /// process as before. Apps call it once at start-up.
 void InstallTemporaryFileCleanup();
 
-/// Reads a whole file. Throws InputError(path, reason) when it cannot.
+/// Reads a whole file (at most 64 MiB, see io/file_text.hpp). Throws
+/// InputError(path, reason) when it cannot or when it is larger.
 std::string ReadWholeFile(const std::string& path);
 
 }  // namespace umbmark::io

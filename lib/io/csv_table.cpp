@@ -2,10 +2,12 @@
 // csv_table.hpp for the format it accepts).
 #include "io/csv_table.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstring>
 #include <system_error>
+#include <unordered_map>
 
 #include <fast_float/fast_float.h>
 #include <fmt/format.h>
@@ -24,6 +26,64 @@ inline std::string_view Trim(const char* b, const char* e) {
   while (b < e && IsBlank(*b)) ++b;
   while (e > b && IsBlank(e[-1])) --e;
   return {b, static_cast<std::size_t>(e - b)};
+}
+
+/// Length of the well-formed UTF-8 sequence at text[i] (no overlong forms,
+/// surrogates or code points past U+10FFFF), 0 when it is not one.
+std::size_t Utf8Length(std::string_view text, std::size_t i) {
+  const auto at = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
+  const unsigned char c = at(i);
+  std::size_t n = 0;
+  unsigned char lo = 0x80, hi = 0xBF;
+  if (c >= 0xC2 && c <= 0xDF) {
+    n = 2;
+  } else if (c >= 0xE0 && c <= 0xEF) {
+    n = 3;
+    lo = c == 0xE0 ? 0xA0 : 0x80;
+    hi = c == 0xED ? 0x9F : 0xBF;
+  } else if (c >= 0xF0 && c <= 0xF4) {
+    n = 4;
+    lo = c == 0xF0 ? 0x90 : 0x80;
+    hi = c == 0xF4 ? 0x8F : 0xBF;
+  } else {
+    return 0;
+  }
+  if (i + n > text.size() || at(i + 1) < lo || at(i + 1) > hi) return 0;
+  for (std::size_t k = 2; k < n; ++k) {
+    if ((at(i + k) & 0xC0) != 0x80) return 0;
+  }
+  return n;
+}
+
+char32_t DecodeUtf8(std::string_view seq) {
+  const auto b = [&](std::size_t k) { return static_cast<char32_t>(static_cast<unsigned char>(seq[k])); };
+  switch (seq.size()) {
+    case 2: return ((b(0) & 0x1F) << 6) | (b(1) & 0x3F);
+    case 3: return ((b(0) & 0x0F) << 12) | ((b(1) & 0x3F) << 6) | (b(2) & 0x3F);
+    default: return ((b(0) & 0x07) << 18) | ((b(1) & 0x3F) << 12) | ((b(2) & 0x3F) << 6) | (b(3) & 0x3F);
+  }
+}
+
+/// Characters a terminal shows as nothing (or as a plain space).
+bool IsInvisible(char32_t cp) {
+  return (cp >= 0x80 && cp <= 0xA0) || cp == 0xAD || (cp >= 0x200B && cp <= 0x200F) ||
+         (cp >= 0x2028 && cp <= 0x202E) || (cp >= 0x2060 && cp <= 0x2064) || cp == 0xFEFF;
+}
+
+/// Where a line that is really several CR-only lines has its first line
+/// end: a carriage return (not of a CRLF) after text with a comma and no
+/// control character, as a CSV header is. Null otherwise (binary data keeps
+/// the readers' usual messages).
+const char* CrOnlyLineEnd(const char* b, const char* e) {
+  const auto* cr = static_cast<const char*>(std::memchr(b, '\r', static_cast<std::size_t>(e - b)));
+  if (cr == nullptr || cr + 1 == e || cr[1] == '\n') return nullptr;
+  bool comma = false;
+  for (const char* p = b; p < cr; ++p) {
+    const auto c = static_cast<unsigned char>(*p);
+    if ((c < 0x20 && c != '\t') || c == 0x7F) return nullptr;
+    comma = comma || c == ',';
+  }
+  return comma ? cr : nullptr;
 }
 
 /// Unit suffixes a quantity accepts, with their factor to SI.
@@ -90,51 +150,80 @@ std::string QuoteForMessage(std::string_view text) {
       ++i;
       continue;
     }
-    // Pass a well-formed UTF-8 sequence through; escape anything else.
-    std::size_t len = c >= 0xF0 && c < 0xF5 ? 4 : c >= 0xE0 ? 3 : c >= 0xC2 && c < 0xE0 ? 2 : 0;
-    bool valid = len > 0 && i + len <= text.size();
-    for (std::size_t k = 1; valid && k < len; ++k) {
-      valid = (static_cast<unsigned char>(text[i + k]) & 0xC0) == 0x80;
-    }
-    if (valid) {
-      out.append(text.substr(i, len));
-      i += len;
-    } else {
+    // Pass a well-formed UTF-8 sequence through, except characters that are
+    // invisible in a terminal (a stray BOM, zero-width and bidi marks,
+    // no-break space): those are shown as \uXXXX. Escape anything else.
+    const std::size_t len = Utf8Length(text, i);
+    if (len == 0) {
       out += fmt::format("\\x{:02X}", static_cast<unsigned>(c));
       ++i;
+      continue;
     }
+    const char32_t cp = DecodeUtf8(text.substr(i, len));
+    if (IsInvisible(cp)) {
+      out += fmt::format("\\u{:04X}", static_cast<std::uint32_t>(cp));
+    } else {
+      out.append(text.substr(i, len));
+    }
+    i += len;
   }
   return out + "'";
 }
 
-CsvReader::CsvReader(std::string_view text, std::string name) : text_(text), name_(std::move(name)) {
-  if (text_.substr(0, kBom.size()) == kBom) text_.remove_prefix(kBom.size());
+CsvReader::CsvReader(std::string_view text, std::string name, std::size_t max_chunk, std::size_t buffer_bytes)
+    : CsvReader(InputStream(text, max_chunk), std::move(name),
+                buffer_bytes > 0 ? buffer_bytes : std::min(kDefaultBufferBytes, text.size() + 1)) {}
+
+CsvReader::CsvReader(InputStream in, std::string name, std::size_t buffer_bytes)
+    : in_(std::move(in)), name_(std::move(name)) {
+  capacity_ = std::max<std::size_t>(buffer_bytes, 1);
+  buf_ = std::make_unique<char[]>(capacity_ + kPadding);
+  // One BOM is allowed; a second one (a file saved twice by an editor that
+  // adds one) would hide inside the first column name.
+  while (len_ < 2 * kBom.size() && Fill()) {
+  }
+  if (std::string_view(buf_.get(), len_).substr(0, kBom.size()) == kBom) pos_ = kBom.size();
+  if (std::string_view(buf_.get() + pos_, len_ - pos_).substr(0, kBom.size()) == kBom) {
+    throw InputError(name_, 1, 1,
+                     "the file starts with two byte-order marks (\\uFEFF\\uFEFF); remove the second one");
+  }
   if (!NextContentLine()) FailFile("empty file: no header row");
   header_line_ = line_;
-  header_bytes_ = static_cast<std::size_t>(line_end_ - line_begin_) + 1;
-  const char* c = line_begin_;
-  for (;;) {
-    const char* e = c;
-    while (e < line_end_ && *e != ',') ++e;
-    const std::string_view cell = Trim(c, e);
-    header_.push_back(cell);
-    header_columns_.push_back(ColumnOf(cell.data()));
-    if (e == line_end_) break;
-    c = e + 1;
-  }
-  for (std::size_t i = 0; i < header_.size(); ++i) {
-    if (header_[i].empty()) FailHeader(i, fmt::format("empty column name in header (column {})", i + 1));
-    for (std::size_t j = 0; j < i; ++j) {
-      if (header_[j] == header_[i]) {
-        FailHeader(i, fmt::format("duplicated column {} (also at column {})", QuoteForMessage(header_[i]),
-                                  header_columns_[j]));
-      }
-    }
-  }
+  header_text_.assign(line_begin_, line_end_);
+  CheckHeader();
   cells_.resize(header_.size());
 }
 
-std::size_t CsvReader::EstimatedRows() const { return text_.size() / header_bytes_ + 1; }
+void CsvReader::CheckHeader() {
+  // Split, keeping each name's 1-based column (counted once, left to right,
+  // so a long header costs linear time).
+  const char* const begin = header_text_.data();
+  const char* const end = begin + header_text_.size();
+  const char* c = begin;
+  const char* counted = begin;
+  std::size_t column = 1;
+  for (;;) {
+    const char* e = c;
+    while (e < end && *e != ',') ++e;
+    const std::string_view cell = Trim(c, e);
+    column += ColumnIn(counted, cell.data()) - 1;
+    counted = cell.data();
+    header_.push_back(cell);
+    header_columns_.push_back(column);
+    if (e == end) break;
+    c = e + 1;
+  }
+  std::unordered_map<std::string_view, std::size_t> first;  // name -> index of its first column
+  first.reserve(header_.size());
+  for (std::size_t i = 0; i < header_.size(); ++i) {
+    if (header_[i].empty()) FailHeader(i, fmt::format("empty column name in header (column {})", i + 1));
+    const auto [it, inserted] = first.emplace(header_[i], i);
+    if (!inserted) {
+      FailHeader(i, fmt::format("duplicated column {} (also at column {})", QuoteForMessage(header_[i]),
+                                header_columns_[it->second]));
+    }
+  }
+}
 
 std::vector<ResolvedColumn> CsvReader::Resolve(std::span<const ColumnSpec> specs) const {
   std::vector<ResolvedColumn> out(specs.size());
@@ -198,41 +287,100 @@ std::vector<ResolvedColumn> CsvReader::Resolve(std::span<const ColumnSpec> specs
   return out;
 }
 
-bool CsvReader::NextContentLine() {
-  const char* const data = text_.data();
-  const std::size_t size = text_.size();
-  while (pos_ < size) {
-    const char* b = data + pos_;
-    const auto* nl = static_cast<const char*>(std::memchr(b, '\n', size - pos_));
-    const char* e = nl != nullptr ? nl : data + size;
-    pos_ = nl != nullptr ? static_cast<std::size_t>(nl - data) + 1 : size;
-    line_ = next_line_++;
-    const char* le = e;
-    if (le > b && le[-1] == '\r') --le;
+bool CsvReader::Fill() {
+  if (eof_) return false;
+  const std::size_t keep = len_ - pos_;
+  if (keep >= kMaxLineBytes) FailLongLine();
+  if (keep > 0 && pos_ > 0) std::memmove(buf_.get(), buf_.get() + pos_, keep);
+  len_ = keep;
+  pos_ = 0;
+  if (len_ == capacity_) {  // one line fills the buffer: grow it
+    const std::size_t grown = std::max<std::size_t>(2 * capacity_, 64);
+    auto bigger = std::make_unique<char[]>(grown + kPadding);
+    std::memcpy(bigger.get(), buf_.get(), len_);
+    buf_ = std::move(bigger);
+    capacity_ = grown;
+  }
+  const std::size_t n = in_.Read(buf_.get() + len_, capacity_ - len_);
+  if (n == 0) {
+    eof_ = true;
+    return false;
+  }
+  len_ += n;
+  return true;
+}
+
+bool CsvReader::SkipIfBlankOrComment() {
+  for (;;) {
+    const char* const b = buf_.get() + pos_;
+    const char* const end = buf_.get() + len_;
     const char* q = b;
-    while (q < le && IsBlank(*q)) ++q;
-    if (q == le || *q == '#') continue;
-    line_begin_ = b;
-    line_end_ = le;
+    while (q < end && IsBlank(*q)) ++q;
+    if ((q == end || (*q == '\r' && q + 1 == end)) && !eof_) {
+      Fill();  // undecided until the rest of the line is read
+      continue;
+    }
+    if (q < end && *q == '\r' && (q + 1 == end || q[1] == '\n')) ++q;
+    if (q < end && *q != '#' && *q != '\n') return false;
+    // Blank or comment: drop it up to its line end, without keeping it.
+    for (;;) {
+      const char* const stop = buf_.get() + len_;
+      const auto* nl = static_cast<const char*>(std::memchr(q, '\n', static_cast<std::size_t>(stop - q)));
+      if (nl != nullptr) {
+        pos_ = static_cast<std::size_t>(nl - buf_.get()) + 1;
+        break;
+      }
+      pos_ = len_;
+      if (!Fill()) break;
+      q = buf_.get();
+    }
+    ++next_line_;
     return true;
   }
-  return false;
 }
 
-bool CsvReader::HasNoDataRows() const {
-  CsvReader copy = *this;
-  return !copy.NextContentLine();
+bool CsvReader::SkipToContent() {
+  for (;;) {
+    if (pos_ == len_ && !Fill()) return false;
+    if (!SkipIfBlankOrComment()) return true;
+  }
 }
 
-bool CsvReader::SkipIfBlankOrComment(const char* b) {
-  const char* const end = text_.data() + text_.size();
-  const char* q = b;
-  while (q < end && IsBlank(*q)) ++q;
-  if (q < end && *q == '\r' && (q + 1 == end || q[1] == '\n')) ++q;
-  if (q < end && *q != '#' && *q != '\n') return false;
-  const auto* nl = static_cast<const char*>(std::memchr(q, '\n', static_cast<std::size_t>(end - q)));
-  pos_ = nl != nullptr ? static_cast<std::size_t>(nl - text_.data()) + 1 : text_.size();
-  return true;
+bool CsvReader::NextContentLine() {
+  if (!SkipToContent()) return false;
+  for (;;) {
+    const char* const b = buf_.get() + pos_;
+    const auto* nl = static_cast<const char*>(std::memchr(b, '\n', len_ - pos_));
+    if (nl == nullptr && !eof_) {
+      Fill();
+      continue;
+    }
+    const char* const e = nl != nullptr ? nl : buf_.get() + len_;
+    line_ = next_line_++;
+    line_begin_ = b;
+    line_end_ = e > b && e[-1] == '\r' ? e - 1 : e;
+    pos_ = static_cast<std::size_t>(e - buf_.get()) + (nl != nullptr ? 1 : 0);
+    if (const char* cr = CrOnlyLineEnd(b, line_end_); cr != nullptr) {
+      throw InputError(name_, line_, ColumnOf(cr),
+                       "carriage return (\\r) inside the line: the file uses CR-only line ends (classic Mac OS); "
+                       "convert them to \\n or \\r\\n");
+    }
+    return true;
+  }
+}
+
+bool CsvReader::HasNoDataRows() { return !SkipToContent(); }
+
+void CsvReader::FailLongLine() const {
+  const std::string_view rest(buf_.get() + pos_, len_ - pos_);
+  const char* what = "not a CSV file of this format?";
+  if (CrOnlyLineEnd(rest.data(), rest.data() + rest.size()) != nullptr) {
+    what = "the file uses CR-only line ends (classic Mac OS)? convert them to \\n or \\r\\n";
+  } else if (rest.find('\0') != std::string_view::npos) {
+    what = "binary data (NUL bytes)?";
+  }
+  throw InputError(name_, next_line_, 0,
+                   fmt::format("line is longer than the {} limit ({})", FormatBytes(kMaxLineBytes), what));
 }
 
 void CsvReader::FailCellCount(std::size_t n) const {

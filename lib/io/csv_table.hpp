@@ -5,19 +5,29 @@
 // Cells are trimmed of spaces and tabs; quoting is not part of the format
 // (a `"` in a text cell is rejected rather than half-interpreted).
 //
-// The reader works on text already in memory and never allocates per cell:
-// a row is a vector of string_views into the text. Line numbers are tracked
-// per row; the column of a cell (1-based, in UTF-8 characters) is computed
-// only when an error is reported.
+// The reader streams: it read()s the input into one buffer (1 MiB, grown
+// only for a longer line, up to kMaxLineBytes) and hands out one row at a
+// time as string_views into it, so memory does not grow with the file. It
+// never allocates per cell; delimiters are found 16 bytes at a time (SSE2).
+// Line numbers are tracked per row; the column of a cell (1-based, in UTF-8
+// characters) is computed only when an error is reported.
 #pragma once
 
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include "io/file_text.hpp"
 
 namespace umbmark::io::detail {
 
@@ -52,17 +62,25 @@ std::string QuoteForMessage(std::string_view text);
 
 class CsvReader {
  public:
+  /// Read buffer of a file (grown for a longer line, up to kMaxLineBytes).
+  static constexpr std::size_t kDefaultBufferBytes = std::size_t{1} << 20;
+
   /// Skips BOM, comments and blank lines and splits the header row. Throws
-  /// InputError(name, ...) for an empty file (no header) and for an empty or
-  /// duplicated header name.
-  CsvReader(std::string_view text, std::string name);
+  /// InputError(name, ...) for an empty file (no header), an empty or
+  /// duplicated header name, a second BOM, CR-only line ends, and a line
+  /// longer than kMaxLineBytes. `buffer_bytes` is the initial read buffer
+  /// (tests use a few bytes to exercise every chunk boundary).
+  CsvReader(InputStream in, std::string name, std::size_t buffer_bytes = kDefaultBufferBytes);
+  /// Text in memory, read through the same buffer (in chunks of at most
+  /// `max_chunk` bytes when given).
+  CsvReader(std::string_view text, std::string name, std::size_t max_chunk = 0, std::size_t buffer_bytes = 0);
+  CsvReader(const CsvReader&) = delete;
+  CsvReader& operator=(const CsvReader&) = delete;
 
   const std::string& name() const { return name_; }
   std::size_t num_columns() const { return header_.size(); }
   std::string_view header(std::size_t i) const { return header_[i]; }
   std::size_t header_line() const { return header_line_; }
-  /// Rough number of data rows (text size / header-line size), for reserve().
-  std::size_t EstimatedRows() const;
 
   /// Resolves every header name against `specs` (one result per spec, same
   /// order). Throws InputError at the header cell for a known quantity with a
@@ -71,20 +89,19 @@ class CsvReader {
   /// error on purpose: a typo (`ex_n`, `ticks_lef`) must not silently drop data.
   std::vector<ResolvedColumn> Resolve(std::span<const ColumnSpec> specs) const;
 
-  /// Advances to the next data row; false at the end of the text. Throws
-  /// InputError at the row when its cell count differs from the header's.
+  /// Advances to the next data row; false at the end of the input. The
+  /// cells stay valid until the next call. Throws InputError at the row when
+  /// its cell count differs from the header's or it is too long.
   inline bool Next();
-  /// True when no data row follows the header (call before Next()).
-  bool HasNoDataRows() const;
+  /// True when no data row follows (call before Next(); skips the blank and
+  /// comment lines in between).
+  bool HasNoDataRows();
 
   std::size_t line() const { return line_; }
   std::string_view cell(std::size_t i) const { return cells_[i]; }
 
   /// 1-based column (UTF-8 characters) of cell i of the current row.
   std::size_t Column(std::size_t i) const;
-  /// Start of the current row in the text (stays valid while the text does),
-  /// for reporting a fault in an earlier row with ColumnIn().
-  const char* row_begin() const { return line_begin_; }
   /// 1-based column of `p` in the row starting at `row_begin`.
   static std::size_t ColumnIn(const char* row_begin, const char* p);
 
@@ -104,12 +121,24 @@ class CsvReader {
   inline std::string_view Text(const ResolvedColumn& c) const;
 
  private:
-  /// Finds the next line that is neither blank nor a comment, starting at
-  /// pos_. Sets line_, line_begin_, line_end_ (without \r). False at end.
+  /// Bytes of padding after the buffer, so the delimiter scan may load a
+  /// whole vector past the last byte.
+  static constexpr std::size_t kPadding = 64;
+
+  /// Makes room and reads more input, keeping the bytes from pos_ on (the
+  /// line being scanned); pos_ becomes 0. False at the end of the input.
+  /// Fails when the kept line has reached kMaxLineBytes.
+  bool Fill();
+  /// The line at pos_ is blank or a comment: skips it and returns true;
+  /// false when it holds content. Reads more input as needed.
+  bool SkipIfBlankOrComment();
+  /// Skips blank and comment lines; false at the end of the input.
+  bool SkipToContent();
+  /// Reads the next content line whole (header): sets line_, line_begin_,
+  /// line_end_ (without \r) and advances pos_. False at the end.
   bool NextContentLine();
-  /// The line at `b` (whose first byte is a blank, `#` or a line end) is
-  /// blank or a comment: skips it (advancing pos_) and returns true.
-  bool SkipIfBlankOrComment(const char* b);
+  void CheckHeader();
+  [[noreturn]] void FailLongLine() const;
   std::size_t ColumnOf(const char* p) const;
   /// The general number parser (fast_float) with all the checks.
   double ParseNumberSlow(const ResolvedColumn& c, std::string_view s) const;
@@ -120,16 +149,21 @@ class CsvReader {
   [[noreturn]] void FailHeader(std::size_t i, const std::string& message) const;
   [[noreturn]] void FailNumber(const ResolvedColumn& c, std::string_view cell, const char* what) const;
 
-  std::string_view text_;
+  InputStream in_;
   std::string name_;
-  std::size_t pos_ = 0;  ///< offset of the next unread line
+  std::unique_ptr<char[]> buf_;
+  std::size_t capacity_ = 0;  ///< usable bytes of buf_ (kPadding more are allocated)
+  std::size_t len_ = 0;       ///< bytes of input in buf_
+  std::size_t pos_ = 0;       ///< offset of the next unread line in buf_
+  bool eof_ = false;
+  bool bom_checked_ = false;
   std::size_t line_ = 0;
   std::size_t next_line_ = 1;  ///< number of the line at pos_
   const char* line_begin_ = nullptr;
   const char* line_end_ = nullptr;
   const char* extra_ = nullptr;
   std::size_t header_line_ = 0;
-  std::size_t header_bytes_ = 1;
+  std::string header_text_;  ///< the header line (header_ views into it)
   std::vector<std::string_view> header_;
   std::vector<std::size_t> header_columns_;  ///< 1-based column of each name
   std::vector<std::string_view> cells_;
@@ -194,26 +228,47 @@ inline bool ParseSimpleCount(const char* p, const char* end, std::int64_t& out) 
   return true;
 }
 
+/// First ',' or '\n' in [p, end), or end. Reads up to 15 bytes past `end`
+/// (the reader's buffer is padded for that); what lies there is ignored.
+inline const char* FindDelimiter(const char* p, const char* end) {
+#if defined(__SSE2__)
+  const __m128i comma = _mm_set1_epi8(',');
+  const __m128i newline = _mm_set1_epi8('\n');
+  for (; p < end; p += 16) {
+    const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p));
+    const auto mask = static_cast<unsigned>(
+        _mm_movemask_epi8(_mm_or_si128(_mm_cmpeq_epi8(v, comma), _mm_cmpeq_epi8(v, newline))));
+    if (mask != 0) {
+      const char* const q = p + __builtin_ctz(mask);
+      return q < end ? q : end;
+    }
+  }
+  return end;
+#else
+  while (p < end && *p != ',' && *p != '\n') ++p;
+  return p;
+#endif
+}
+
 }  // namespace csv_internal
 
 inline bool CsvReader::Next() {
   using csv_internal::IsBlank;
-  const char* const data = text_.data();
-  const char* const end = data + text_.size();
   for (;;) {
-    const char* const b = data + pos_;
-    if (b >= end) return false;
-    line_ = next_line_++;
+    if (pos_ == len_ && !Fill()) return false;
+    const char* const b = buf_.get() + pos_;
     const char c0 = *b;
-    if ((c0 == '#' || c0 == '\n' || c0 == '\r' || IsBlank(c0)) && SkipIfBlankOrComment(b)) continue;
+    if ((c0 == '#' || c0 == '\n' || c0 == '\r' || IsBlank(c0)) && SkipIfBlankOrComment()) continue;
     // One pass: split at commas up to the line end.
+    const char* const end = buf_.get() + len_;
     const std::size_t expected = cells_.size();
     std::string_view* const cells = cells_.data();
     std::size_t n = 0;
     const char* c = b;
     const char* e = b;
     for (;;) {
-      while (e < end && *e != ',' && *e != '\n') ++e;
+      e = csv_internal::FindDelimiter(c, end);
+      if (e == end && !eof_) break;  // the line goes on past the buffer
       if (n < expected) {
         cells[n] = std::string_view(c, static_cast<std::size_t>(e - c));
       } else if (n == expected) {
@@ -221,9 +276,14 @@ inline bool CsvReader::Next() {
       }
       ++n;
       if (e == end || *e == '\n') break;
-      c = ++e;
+      c = e + 1;
     }
-    pos_ = static_cast<std::size_t>(e - data) + (e < end ? 1 : 0);
+    if (e == end && !eof_) {
+      Fill();  // keeps this line, then scans it again
+      continue;
+    }
+    line_ = next_line_++;
+    pos_ = static_cast<std::size_t>(e - buf_.get()) + (e < end ? 1 : 0);
     line_begin_ = b;
     line_end_ = e > b && e[-1] == '\r' ? e - 1 : e;
     if (n != expected) FailCellCount(n);

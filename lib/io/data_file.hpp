@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "core/runs.hpp"
+#include "io/trajectory_csv.hpp"
 
 namespace umbmark::io {
 
@@ -15,5 +16,11 @@ using RunFile = std::variant<EndpointData, TrajectoryData>;
 
 /// Throws InputError on any fault (see the two readers).
 RunFile ReadRunFile(const std::string& path);
+
+/// Same, but a trajectory file is returned as a reader positioned after its
+/// header, to be read run by run (memory bounded by the largest run); an
+/// endpoint file (small by nature) is read whole.
+using OpenedRunFile = std::variant<EndpointData, TrajectoryReader>;
+OpenedRunFile OpenRunFile(const std::string& path);
 
 }  // namespace umbmark::io

@@ -44,8 +44,9 @@ void RequireColumns(const CsvReader& csv, const std::vector<ResolvedColumn>& col
 
 }  // namespace
 
-EndpointData ParseEndpointCsv(std::string_view text, const std::string& name) {
-  CsvReader csv(text, name);
+namespace detail {
+
+EndpointData ReadEndpointRows(CsvReader& csv) {
   const std::vector<ResolvedColumn> cols = csv.Resolve(kSpecs);
 
   const bool error_form = cols[kEx].present() || cols[kEy].present() || cols[kEtheta].present();
@@ -67,7 +68,7 @@ EndpointData ParseEndpointCsv(std::string_view text, const std::string& name) {
   if (csv.HasNoDataRows()) csv.FailFile("no data rows after the header");
 
   EndpointData data;
-  data.path = name;
+  data.path = csv.name();
   // (run, direction) -> line, to reject a run given twice.
   std::unordered_map<std::string, std::size_t> seen;
   while (csv.Next()) {
@@ -106,9 +107,16 @@ EndpointData ParseEndpointCsv(std::string_view text, const std::string& name) {
   return data;
 }
 
+}  // namespace detail
+
+EndpointData ParseEndpointCsv(std::string_view text, const std::string& name) {
+  CsvReader csv(text, name);
+  return detail::ReadEndpointRows(csv);
+}
+
 EndpointData ReadEndpointCsv(const std::string& path) {
-  const detail::FileText text(path);
-  return ParseEndpointCsv(text.view(), path);
+  CsvReader csv(detail::InputStream(path), path);
+  return detail::ReadEndpointRows(csv);
 }
 
 }  // namespace umbmark::io

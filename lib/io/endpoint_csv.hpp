@@ -27,4 +27,11 @@ EndpointData ReadEndpointCsv(const std::string& path);
 /// Same, from text already in memory; `name` is used in error messages.
 EndpointData ParseEndpointCsv(std::string_view text, const std::string& name);
 
+namespace detail {
+class CsvReader;
+/// The rows after the header, from a tokenizer whose header has been read
+/// (ReadRunFile decides the format by the header, then continues here).
+EndpointData ReadEndpointRows(CsvReader& csv);
+}  // namespace detail
+
 }  // namespace umbmark::io

@@ -1,31 +1,80 @@
-// Internal to io/: the whole text of an input file for the CSV readers.
-// Regular files are memory-mapped (read-only, pre-faulted), which for a large
-// trajectory log saves the copy and the page faults of read() into a buffer
-// (about 0.2 s per 500 MB); pipes, devices and empty files are read instead.
-// Caveat of mapping: a file truncated by another process while it is being
-// parsed can end the process with SIGBUS, as with any mmap-based reader.
+// Internal to io/: how input files are read, and the size limits that keep a
+// hostile or mistaken input (a device, a pipe that never ends, a file with
+// no line breaks) from growing memory without bound.
+//
+// Files are read with read() in chunks, never memory-mapped: a file that
+// another process truncates while it is being read then only ends early
+// (the readers report a truncated row), instead of killing the process with
+// SIGBUS as a mapping would.
+//
+// Limits (documented in docs/formats.md, "Size limits"):
+//  - kMaxLineBytes: a CSV line (header or row) longer than 1 MiB is an error
+//    (so /dev/zero given as a data file fails after 1 MiB).
+//  - kMaxStreamBytes: a CSV read from a pipe or device stops with an error
+//    after 4 GiB (a regular file is read to its end, whatever its size).
+//  - kMaxWholeFileBytes: small text inputs read whole (TOML robot files and
+//    manifests, JSON parameter files, OptiOdom CSVs) stop with an error after
+//    64 MiB, regular file or not (`--robot /dev/zero` fails at once instead
+//    of growing memory).
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 
 namespace umbmark::io::detail {
 
-class FileText {
- public:
-  /// Throws InputError(path, reason) when the file cannot be opened or read.
-  explicit FileText(const std::string& path);
-  ~FileText();
-  FileText(const FileText&) = delete;
-  FileText& operator=(const FileText&) = delete;
+inline constexpr std::size_t kMaxLineBytes = std::size_t{1} << 20;
+inline constexpr std::uint64_t kMaxStreamBytes = std::uint64_t{4} << 30;
+inline constexpr std::size_t kMaxWholeFileBytes = std::size_t{64} << 20;
 
-  std::string_view view() const { return map_ != nullptr ? std::string_view(map_, size_) : owned_; }
+/// "1 MiB", "4 GiB": a byte limit for messages.
+std::string FormatBytes(std::uint64_t bytes);
+
+/// A sequence of bytes read in chunks: an open file (regular, pipe, device)
+/// or text in memory (optionally handed out in small chunks, so tests and
+/// fuzzers exercise every chunk boundary of the streaming readers).
+class InputStream {
+ public:
+  /// Opens `path` for reading. Throws InputError(path, reason) when it cannot
+  /// be opened or is a directory.
+  explicit InputStream(const std::string& path);
+  /// Text in memory (not copied: it must outlive the stream); Read() hands
+  /// out at most `max_chunk` bytes per call (0 = no limit).
+  InputStream(std::string_view text, std::size_t max_chunk = 0);
+  ~InputStream();
+  InputStream(const InputStream&) = delete;
+  InputStream& operator=(const InputStream&) = delete;
+  InputStream(InputStream&& other) noexcept;
+  InputStream& operator=(InputStream&&) = delete;
+
+  /// Reads up to `n` bytes into `dst`; 0 only at the end. Throws
+  /// InputError(name, reason) on a read error and when a non-regular input
+  /// passes kMaxStreamBytes.
+  std::size_t Read(char* dst, std::size_t n);
+
+  const std::string& name() const { return name_; }
+  /// True for a regular file or text in memory (its size is known).
+  bool sized() const { return sized_; }
+  /// The size of a regular file or of the text; 0 when not known.
+  std::uint64_t size() const { return size_; }
+  std::uint64_t bytes_read() const { return bytes_read_; }
 
  private:
-  const char* map_ = nullptr;
-  std::size_t size_ = 0;
-  std::string owned_;
+  std::string name_;
+  int fd_ = -1;
+  std::string_view text_;
+  std::size_t max_chunk_ = 0;
+  bool sized_ = false;
+  std::uint64_t size_ = 0;
+  std::uint64_t bytes_read_ = 0;
 };
+
+/// Reads a whole text file of at most `max_bytes` (regular or not). Throws
+/// InputError(path, reason) when it cannot be read, is a directory, or is
+/// larger than the limit (the message names the limit).
+std::string ReadLimitedFile(const std::string& path, std::size_t max_bytes = kMaxWholeFileBytes);
 
 }  // namespace umbmark::io::detail

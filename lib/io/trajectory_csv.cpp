@@ -1,13 +1,16 @@
 // Trajectory CSV reader (contract: run,direction,t_s,ticks_left,ticks_right,
 // x_gt_m,y_gt_m,theta_gt_rad, or dist_left_m,dist_right_m instead of ticks).
-// Built for large logs: one pass over text in memory, no allocation per cell,
-// strings allocated only when a run starts.
+// Built for large logs: streams through the tokenizer one row at a time, no
+// allocation per cell, strings allocated only when a run starts, one run in
+// memory at a time (plus the one the caller holds).
 #include "io/trajectory_csv.hpp"
 
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <unordered_map>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -67,14 +70,42 @@ void CheckTickJump(const CsvReader& csv, const ResolvedColumn& c, std::int64_t p
 
 }  // namespace
 
-TrajectoryData ParseTrajectoryCsv(std::string_view text, const std::string& name) {
-  CsvReader csv(text, name);
-  const std::vector<ResolvedColumn> cols = csv.Resolve(kSpecs);
+struct TrajectoryReader::State {
+  std::unique_ptr<CsvReader> csv;
+  std::vector<ResolvedColumn> cols;
+  bool ticks = false;
+  const ResolvedColumn* c_run = nullptr;
+  const ResolvedColumn* c_dir = nullptr;
+  const ResolvedColumn* c_t = nullptr;
+  const ResolvedColumn* c_left = nullptr;
+  const ResolvedColumn* c_right = nullptr;
+  const ResolvedColumn* c_gt[3] = {nullptr, nullptr, nullptr};
 
-  const bool ticks = cols[kTicksL].present() || cols[kTicksR].present();
+  TrajectoryRun current;  ///< the run being read
+  bool have_current = false;
+  /// Run id -> last line of its (finished) block, to reject a run split in two.
+  std::unordered_map<std::string, std::size_t> finished;
+  // Where the current run's last sample is, to report missing ground truth there.
+  std::size_t last_line = 0;
+  std::size_t last_gt_column = 0;
+  bool last_has_gt = false;
+  std::size_t previous_size = 0;
+
+  explicit State(std::unique_ptr<CsvReader> reader);
+  void FinishRun();
+  /// A run id seen before (in an earlier block) is an error naming both lines.
+  void CheckNewId(std::string_view run_id) const;
+  /// Makes `current` an empty run with this id (keeping vector capacity).
+  void StartRun(std::string_view run_id, std::string_view direction);
+  void AddRow();
+};
+
+TrajectoryReader::State::State(std::unique_ptr<CsvReader> reader) : csv(std::move(reader)) {
+  cols = csv->Resolve(kSpecs);
+  ticks = cols[kTicksL].present() || cols[kTicksR].present();
   const bool dist = cols[kDistL].present() || cols[kDistR].present();
   if (ticks && dist) {
-    csv.FailLine(csv.header_line(), "header gives both ticks_* and dist_*_m columns; give one of the two");
+    csv->FailLine(csv->header_line(), "header gives both ticks_* and dist_*_m columns; give one of the two");
   }
   std::vector<Col> required = {kRun, kDirection, kT};
   if (dist) {
@@ -85,153 +116,208 @@ TrajectoryData ParseTrajectoryCsv(std::string_view text, const std::string& name
   required.insert(required.end(), {kXGt, kYGt, kThetaGt});
   for (const Col c : required) {
     if (!cols[c].present()) {
-      csv.FailLine(csv.header_line(),
-                   fmt::format("missing column '{}'{}", MissingName(c),
-                               c == kTicksL || c == kTicksR ? " (or give dist_left_m,dist_right_m)" : ""));
+      csv->FailLine(csv->header_line(),
+                    fmt::format("missing column '{}'{}", MissingName(c),
+                                c == kTicksL || c == kTicksR ? " (or give dist_left_m,dist_right_m)" : ""));
     }
   }
-  if (csv.HasNoDataRows()) csv.FailFile("no data rows after the header");
+  if (csv->HasNoDataRows()) csv->FailFile("no data rows after the header");
+  c_run = &cols[kRun];
+  c_dir = &cols[kDirection];
+  c_t = &cols[kT];
+  c_left = &cols[ticks ? kTicksL : kDistL];
+  c_right = &cols[ticks ? kTicksR : kDistR];
+  c_gt[0] = &cols[kXGt];
+  c_gt[1] = &cols[kYGt];
+  c_gt[2] = &cols[kThetaGt];
+}
 
-  const ResolvedColumn& c_run = cols[kRun];
-  const ResolvedColumn& c_dir = cols[kDirection];
-  const ResolvedColumn& c_t = cols[kT];
-  const ResolvedColumn& c_left = cols[ticks ? kTicksL : kDistL];
-  const ResolvedColumn& c_right = cols[ticks ? kTicksR : kDistR];
-  const ResolvedColumn* c_gt[3] = {&cols[kXGt], &cols[kYGt], &cols[kThetaGt]};
+void TrajectoryReader::State::FinishRun() {
+  if (!last_has_gt) {
+    csv->FailAt(last_line, last_gt_column,
+                fmt::format("run {} has no ground truth at its last sample (each run needs {}, {}, {} at its "
+                            "first and last sample)",
+                            QuoteForMessage(current.run), c_gt[0]->header, c_gt[1]->header, c_gt[2]->header));
+  }
+  finished.emplace(current.run, last_line);
+  previous_size = current.size();
+}
 
-  TrajectoryData data;
-  data.path = name;
-  TrajectoryRun* run = nullptr;
-  // Run id -> last line of its (finished) block, to reject a run split in two.
-  std::unordered_map<std::string, std::size_t> finished;
-  // Where the current run's last sample is, to report missing ground truth there.
-  std::size_t last_line = 0;
-  const char* last_row = nullptr;
-  const char* last_gt_cell = nullptr;
-  bool last_has_gt = false;
-  std::size_t previous_size = 0;
+void TrajectoryReader::State::CheckNewId(std::string_view run_id) const {
+  if (const auto it = finished.find(std::string(run_id)); it != finished.end()) {
+    csv->FailCell(c_run->index, fmt::format("run {} appears again after run {}: the rows of a run must be "
+                                            "contiguous (its first block ended on line {})",
+                                            QuoteForMessage(run_id), QuoteForMessage(current.run), it->second));
+  }
+}
 
-  const auto finish_run = [&] {
-    if (run == nullptr) return;
-    if (!last_has_gt) {
-      csv.FailAt(last_line, CsvReader::ColumnIn(last_row, last_gt_cell),
-                 fmt::format("run {} has no ground truth at its last sample (each run needs {}, {}, {} at its "
-                             "first and last sample)",
-                             QuoteForMessage(run->run), c_gt[0]->header, c_gt[1]->header, c_gt[2]->header));
+void TrajectoryReader::State::StartRun(std::string_view run_id, std::string_view direction) {
+  TrajectoryRun& r = current;
+  r.run.assign(run_id);
+  r.direction.assign(direction);
+  for (auto* v : {&r.t_s, &r.dist_left_m, &r.dist_right_m, &r.gt_x_m, &r.gt_y_m, &r.gt_theta_rad}) v->clear();
+  r.ticks_left.clear();
+  r.ticks_right.clear();
+  r.lines.clear();
+  // Runs of one file tend to be alike in length: a long run reserves the
+  // previous one's size (short ones grow by doubling, which costs little).
+  if (previous_size > 4096) {
+    const std::size_t reserve = previous_size + previous_size / 8;
+    r.t_s.reserve(reserve);
+    r.lines.reserve(reserve);
+    if (ticks) {
+      r.ticks_left.reserve(reserve);
+      r.ticks_right.reserve(reserve);
+    } else {
+      r.dist_left_m.reserve(reserve);
+      r.dist_right_m.reserve(reserve);
     }
-    finished.emplace(run->run, last_line);
-    previous_size = run->size();
-    // Give back a reserve that was far too generous (the first run's guess
-    // from the file size); a close fit is kept, so a single big run is never
-    // copied.
-    if (run->t_s.capacity() > 2 * run->size() + 1024) {
-      for (auto* v : {&run->t_s, &run->dist_left_m, &run->dist_right_m, &run->gt_x_m, &run->gt_y_m,
-                      &run->gt_theta_rad}) {
-        v->shrink_to_fit();
-      }
-      run->ticks_left.shrink_to_fit();
-      run->ticks_right.shrink_to_fit();
-      run->lines.shrink_to_fit();
-    }
-  };
+    r.gt_x_m.reserve(reserve);
+    r.gt_y_m.reserve(reserve);
+    r.gt_theta_rad.reserve(reserve);
+  }
+}
 
-  while (csv.Next()) {
+void TrajectoryReader::State::AddRow() {
+  TrajectoryRun& run = current;
+  const CsvReader& in = *csv;
+  const double t = in.Number(*c_t);
+  if (!run.t_s.empty() && !(t > run.t_s.back())) {
+    in.FailCell(c_t->index, fmt::format("{} = {} does not increase (previous sample of run {}, line {}, has {})",
+                                        c_t->header, in.cell(c_t->index), QuoteForMessage(run.run),
+                                        run.lines.back(), run.t_s.back()));
+  }
+  if (ticks) {
+    const std::int64_t left = in.Count(*c_left);
+    const std::int64_t right = in.Count(*c_right);
+    if (!run.ticks_left.empty()) {
+      CheckTickJump(in, *c_left, run.ticks_left.back(), left);
+      CheckTickJump(in, *c_right, run.ticks_right.back(), right);
+    }
+    run.ticks_left.push_back(left);
+    run.ticks_right.push_back(right);
+  } else {
+    run.dist_left_m.push_back(in.Number(*c_left));
+    run.dist_right_m.push_back(in.Number(*c_right));
+  }
+
+  double gt[3] = {0.0, 0.0, 0.0};
+  bool has[3] = {false, false, false};
+  for (int k = 0; k < 3; ++k) has[k] = in.OptionalNumber(*c_gt[k], gt[k]);
+  const bool has_gt = has[0] && has[1] && has[2];
+  if (!has_gt && (has[0] || has[1] || has[2])) {
+    const int empty = !has[0] ? 0 : !has[1] ? 1 : 2;
+    const int given = has[0] ? 0 : has[1] ? 1 : 2;
+    in.FailCell(c_gt[empty]->index,
+                fmt::format("partial ground truth: {} is empty while {} is given (give all three or none)",
+                            c_gt[empty]->header, c_gt[given]->header));
+  }
+  if (!has_gt && run.t_s.empty()) {
+    in.FailCell(c_gt[0]->index,
+                fmt::format("run {} has no ground truth at its first sample (each run needs {}, {}, {} at its "
+                            "first and last sample)",
+                            QuoteForMessage(run.run), c_gt[0]->header, c_gt[1]->header, c_gt[2]->header));
+  }
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  run.gt_x_m.push_back(has_gt ? gt[0] : kNaN);
+  run.gt_y_m.push_back(has_gt ? gt[1] : kNaN);
+  run.gt_theta_rad.push_back(has_gt ? gt[2] : kNaN);
+  run.t_s.push_back(t);
+  run.lines.push_back(in.line());
+
+  last_line = in.line();
+  last_has_gt = has_gt;
+  // The row is gone once the next is read: keep the column a missing
+  // ground truth at the run's end would be reported at.
+  if (!has_gt) last_gt_column = in.Column(c_gt[0]->index);
+}
+
+TrajectoryReader::TrajectoryReader(std::unique_ptr<detail::CsvReader> csv)
+    : state_(std::make_unique<State>(std::move(csv))) {}
+
+TrajectoryReader::TrajectoryReader(const std::string& path)
+    : TrajectoryReader(std::make_unique<CsvReader>(detail::InputStream(path), path)) {}
+
+TrajectoryReader::TrajectoryReader(std::string_view text, const std::string& name, std::size_t max_chunk,
+                                   std::size_t buffer_bytes)
+    : TrajectoryReader(std::make_unique<CsvReader>(text, name, max_chunk, buffer_bytes)) {}
+
+TrajectoryReader::~TrajectoryReader() = default;
+TrajectoryReader::TrajectoryReader(TrajectoryReader&&) noexcept = default;
+TrajectoryReader& TrajectoryReader::operator=(TrajectoryReader&&) noexcept = default;
+
+const std::string& TrajectoryReader::path() const { return state_->csv->name(); }
+
+bool TrajectoryReader::has_ticks() const { return state_->ticks; }
+
+bool TrajectoryReader::NextRun(TrajectoryRun& out) {
+  State& s = *state_;
+  CsvReader& csv = *s.csv;
+  for (;;) {
+    if (!csv.Next()) {
+      if (!s.have_current) return false;
+      s.FinishRun();
+      std::swap(out, s.current);
+      s.have_current = false;
+      return true;
+    }
     // Run id and direction are validated (Text) when a run starts; later rows
     // only compare them with the run's, which they must equal.
-    std::string_view run_id = csv.cell(c_run.index);
-    std::string_view direction = csv.cell(c_dir.index);
-    if (run == nullptr || run_id != run->run) {
-      run_id = csv.Text(c_run);
-      direction = csv.Text(c_dir);
-      finish_run();
-      if (const auto it = finished.find(std::string(run_id)); it != finished.end()) {
-        csv.FailCell(c_run.index, fmt::format("run {} appears again after run {}: the rows of a run must be "
-                                              "contiguous (its first block ended on line {})",
-                                              QuoteForMessage(run_id), QuoteForMessage(run->run), it->second));
+    std::string_view run_id = csv.cell(s.c_run->index);
+    std::string_view direction = csv.cell(s.c_dir->index);
+    if (!s.have_current || run_id != s.current.run) {
+      run_id = csv.Text(*s.c_run);
+      direction = csv.Text(*s.c_dir);
+      const bool handed_out = s.have_current;
+      if (handed_out) {
+        // The run before is complete: check it, hand it out, and reuse the
+        // caller's previous run (its vectors' capacity) for the new one.
+        s.FinishRun();
+        s.CheckNewId(run_id);
+        std::swap(out, s.current);
       }
-      run = &data.runs.emplace_back();
-      run->run = std::string(run_id);
-      run->direction = std::string(direction);
-      // Runs of one file tend to be alike in length; the first gets a size
-      // estimated from the file (untouched capacity costs no memory).
-      const std::size_t reserve = data.runs.size() == 1 ? std::min<std::size_t>(csv.EstimatedRows(), 1u << 24)
-                                                        : previous_size + previous_size / 8 + 16;
-      run->t_s.reserve(reserve);
-      run->lines.reserve(reserve);
-      if (ticks) {
-        run->ticks_left.reserve(reserve);
-        run->ticks_right.reserve(reserve);
-      } else {
-        run->dist_left_m.reserve(reserve);
-        run->dist_right_m.reserve(reserve);
-      }
-      run->gt_x_m.reserve(reserve);
-      run->gt_y_m.reserve(reserve);
-      run->gt_theta_rad.reserve(reserve);
-    } else if (direction != run->direction) {
-      direction = csv.Text(c_dir);
-      csv.FailCell(c_dir.index, fmt::format("direction changes from {} to {} within run {} (a run keeps one direction; give "
-                                            "each run its own id)",
-                                            QuoteForMessage(run->direction), QuoteForMessage(direction),
-                                            QuoteForMessage(run->run)));
+      s.StartRun(run_id, direction);
+      s.have_current = true;
+      s.AddRow();
+      if (handed_out) return true;
+      continue;
     }
-
-    const double t = csv.Number(c_t);
-    if (!run->t_s.empty() && !(t > run->t_s.back())) {
-      csv.FailCell(c_t.index, fmt::format("{} = {} does not increase (previous sample of run {}, line {}, has {})",
-                                          c_t.header, csv.cell(c_t.index), QuoteForMessage(run->run),
-                                          run->lines.back(), run->t_s.back()));
+    if (direction != s.current.direction) {
+      direction = csv.Text(*s.c_dir);
+      csv.FailCell(s.c_dir->index,
+                   fmt::format("direction changes from {} to {} within run {} (a run keeps one direction; give "
+                               "each run its own id)",
+                               QuoteForMessage(s.current.direction), QuoteForMessage(direction),
+                               QuoteForMessage(s.current.run)));
     }
-    if (ticks) {
-      const std::int64_t left = csv.Count(c_left);
-      const std::int64_t right = csv.Count(c_right);
-      if (!run->ticks_left.empty()) {
-        CheckTickJump(csv, c_left, run->ticks_left.back(), left);
-        CheckTickJump(csv, c_right, run->ticks_right.back(), right);
-      }
-      run->ticks_left.push_back(left);
-      run->ticks_right.push_back(right);
-    } else {
-      run->dist_left_m.push_back(csv.Number(c_left));
-      run->dist_right_m.push_back(csv.Number(c_right));
-    }
-
-    double gt[3] = {0.0, 0.0, 0.0};
-    bool has[3] = {false, false, false};
-    for (int k = 0; k < 3; ++k) has[k] = csv.OptionalNumber(*c_gt[k], gt[k]);
-    const bool has_gt = has[0] && has[1] && has[2];
-    if (!has_gt && (has[0] || has[1] || has[2])) {
-      const int empty = !has[0] ? 0 : !has[1] ? 1 : 2;
-      const int given = has[0] ? 0 : has[1] ? 1 : 2;
-      csv.FailCell(c_gt[empty]->index,
-                   fmt::format("partial ground truth: {} is empty while {} is given (give all three or none)",
-                               c_gt[empty]->header, c_gt[given]->header));
-    }
-    if (!has_gt && run->t_s.empty()) {
-      csv.FailCell(c_gt[0]->index,
-                   fmt::format("run {} has no ground truth at its first sample (each run needs {}, {}, {} at its "
-                               "first and last sample)",
-                               QuoteForMessage(run->run), c_gt[0]->header, c_gt[1]->header, c_gt[2]->header));
-    }
-    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-    run->gt_x_m.push_back(has_gt ? gt[0] : kNaN);
-    run->gt_y_m.push_back(has_gt ? gt[1] : kNaN);
-    run->gt_theta_rad.push_back(has_gt ? gt[2] : kNaN);
-    run->t_s.push_back(t);
-    run->lines.push_back(csv.line());
-
-    last_line = csv.line();
-    last_row = csv.row_begin();
-    last_gt_cell = csv.cell(c_gt[0]->index).data();
-    last_has_gt = has_gt;
+    s.AddRow();
   }
-  finish_run();
+}
+
+TrajectoryData TrajectoryReader::ReadAll() {
+  TrajectoryData data;
+  data.path = path();
+  for (;;) {
+    TrajectoryRun run;
+    if (!NextRun(run)) break;
+    // Give back capacity that growth left far beyond the run's size.
+    if (run.t_s.capacity() > run.size() + run.size() / 4 + 1024) {
+      for (auto* v : {&run.t_s, &run.dist_left_m, &run.dist_right_m, &run.gt_x_m, &run.gt_y_m, &run.gt_theta_rad}) {
+        v->shrink_to_fit();
+      }
+      run.ticks_left.shrink_to_fit();
+      run.ticks_right.shrink_to_fit();
+      run.lines.shrink_to_fit();
+    }
+    data.runs.push_back(std::move(run));
+  }
   return data;
 }
 
-TrajectoryData ReadTrajectoryCsv(const std::string& path) {
-  const detail::FileText text(path);
-  return ParseTrajectoryCsv(text.view(), path);
+TrajectoryData ParseTrajectoryCsv(std::string_view text, const std::string& name) {
+  return TrajectoryReader(text, name).ReadAll();
 }
+
+TrajectoryData ReadTrajectoryCsv(const std::string& path) { return TrajectoryReader(path).ReadAll(); }
 
 }  // namespace umbmark::io

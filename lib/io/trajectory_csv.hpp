@@ -6,8 +6,15 @@
 // first and last sample. A run is identified by its run id: its rows must be
 // contiguous, its direction constant and t_s strictly increasing. Unknown
 // columns are an error (a typo must not silently drop data).
+//
+// Streaming: TrajectoryReader hands out one run at a time, so a consumer
+// that needs one run at a time (evaluate) holds the largest run in memory,
+// not the file. Memory beyond the run in hand: the read buffer (1 MiB) and
+// the ids of the runs already read (to report a run id that comes back
+// after another run: an error naming both lines).
 #pragma once
 
+#include <memory>
 #include <string>
 #include <string_view>
 
@@ -15,19 +22,57 @@
 
 namespace umbmark::io {
 
-/// Reads a trajectory CSV file. Throws InputError (file, line, column) on any
-/// fault (see ParseTrajectoryCsv).
+namespace detail {
+class CsvReader;
+}
+
+/// Reads the runs of a trajectory CSV one by one. Faults (InputError with
+/// file, line, column): missing/duplicated/unknown-unit column, text or
+/// NaN/Inf in a number, truncated row, non-increasing time, a run id that
+/// reappears after another run (rows of a run must be contiguous), missing
+/// ground truth at a run's first/last sample, partial ground truth in a row,
+/// a direction change within a run, a tick count that is not a signed 64-bit
+/// integer, an encoder jump that can only be a counter wrap (|delta| >= 2^30
+/// ticks between two samples), an empty file or no data rows, a line over
+/// 1 MiB. Header faults are thrown by the constructor, the others by
+/// NextRun() when it reaches them (a run is handed out only once its last
+/// row has been read and checked).
+class TrajectoryReader {
+ public:
+  /// Opens a file (read with read() in 1 MiB chunks, never mapped).
+  explicit TrajectoryReader(const std::string& path);
+  /// Text in memory; `name` is used in error messages. `max_chunk` > 0 feeds
+  /// the tokenizer at most that many bytes at a time and `buffer_bytes` > 0
+  /// sets its initial buffer (tests of chunk boundaries).
+  TrajectoryReader(std::string_view text, const std::string& name, std::size_t max_chunk = 0,
+                   std::size_t buffer_bytes = 0);
+  /// Continues from a tokenizer whose header has been read (ReadRunFile).
+  explicit TrajectoryReader(std::unique_ptr<detail::CsvReader> csv);
+  ~TrajectoryReader();
+  TrajectoryReader(TrajectoryReader&&) noexcept;
+  TrajectoryReader& operator=(TrajectoryReader&&) noexcept;
+
+  /// The name given for messages (the path for a file).
+  const std::string& path() const;
+  /// True when the file gives ticks_* (false: dist_*_m).
+  bool has_ticks() const;
+
+  /// Reads the next run into `run` (replacing its contents; the capacity of
+  /// its vectors is reused). Returns false after the last run.
+  bool NextRun(TrajectoryRun& run);
+
+  /// Reads every remaining run.
+  TrajectoryData ReadAll();
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+/// Reads a whole trajectory CSV file (TrajectoryReader(path).ReadAll()).
 TrajectoryData ReadTrajectoryCsv(const std::string& path);
 
-/// Same, from text in memory; `name` is used in error messages. Faults:
-/// missing/duplicated/unknown-unit column, text or NaN/Inf in a number,
-/// truncated row, non-increasing time, a run split over non-adjacent rows,
-/// missing ground truth at a run's first/last sample, partial ground truth in
-/// a row, a direction change within a run, a tick count that is not a signed
-/// 64-bit integer, an encoder jump that can only be a counter wrap
-/// (|delta| >= 2^30 ticks between two samples), an empty file or no data rows.
-/// Designed for large logs (one pass, no allocation per cell; several
-/// hundred MB/s, see bench/parse_bench.sh).
+/// Same, from text in memory; `name` is used in error messages.
 TrajectoryData ParseTrajectoryCsv(std::string_view text, const std::string& name);
 
 }  // namespace umbmark::io
