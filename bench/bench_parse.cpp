@@ -1,7 +1,9 @@
 // Parse throughput of the trajectory CSV reader (target: >= 300 MB/s on one
-// core). Two modes:
-//   bench_parse --generate FILE SIZE_MB [SEED]   write a realistic trajectory CSV
-//   bench_parse FILE [REPEATS]                   time ReadTrajectoryCsv on it
+// core). Modes:
+//   bench_parse --generate FILE SIZE_MB [SEED]            write a realistic trajectory CSV
+//   bench_parse --generate-runs FILE RUNS ROWS [SEED]     the same, RUNS runs of ROWS rows each
+//   bench_parse FILE [REPEATS]                            time ReadTrajectoryCsv on it
+//   bench_parse --stream FILE [REPEATS]                   time TrajectoryReader, run by run
 // The generated file has several runs of UMBmark-like squares (cw/ccw) with
 // encoder ticks at 100 Hz and ground truth on 4 of 5 samples (the others
 // empty), as a motion-capture log merged with an encoder log looks.
@@ -14,6 +16,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -27,13 +30,15 @@ namespace {
 
 using namespace umbmark;
 
-int Generate(const std::string& path, double size_mb, std::uint64_t seed) {
+/// Writes runs until the file reaches `size_mb` or, when `runs` > 0, exactly
+/// `runs` runs of `rows_per_run` rows each.
+int Generate(const std::string& path, double size_mb, int runs, int rows_per_run, std::uint64_t seed) {
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (f == nullptr) {
     fmt::print(stderr, "cannot write {}\n", path);
     return 1;
   }
-  const auto target_bytes = static_cast<std::size_t>(size_mb * 1e6);
+  const auto target_bytes = runs > 0 ? std::numeric_limits<std::size_t>::max() : static_cast<std::size_t>(size_mb * 1e6);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> noise(0.0, 1.0);
   // Robot: 0.34 m wheelbase, 0.1524 m wheels, 2048 ticks/rev; square side 4 m.
@@ -43,17 +48,21 @@ int Generate(const std::string& path, double size_mb, std::uint64_t seed) {
   buf += "run,direction,t_s,ticks_left,ticks_right,x_gt_m,y_gt_m,theta_gt_rad\n";
   std::size_t written = 0, rows = 0;
   int run = 0;
-  while (written + buf.size() < target_bytes) {
+  while (runs > 0 ? run < runs : written + buf.size() < target_bytes) {
     ++run;
+    int run_rows = 0;
     const bool cw = run % 2 == 1;
     const char* direction = cw ? "cw" : "ccw";
     double x = 0, y = 0, theta = 0, travel_l = 0, travel_r = 0, t = 0;
     // Four legs and four turns per square, several squares per run.
-    for (int segment = 0; segment < 8 * 6 && written + buf.size() < target_bytes; ++segment) {
+    const int segments = runs > 0 ? 1 << 30 : 8 * 6;
+    for (int segment = 0; segment < segments && written + buf.size() < target_bytes; ++segment) {
+      if (runs > 0 && run_rows >= rows_per_run) break;
       const bool turn = segment % 2 == 1;
       const double duration = turn ? (kPi / 2) / kTurnRate : kSide / kSpeed;
       const int steps = static_cast<int>(duration / kDt);
-      for (int k = 0; k < steps; ++k) {
+      for (int k = 0; k < steps && !(runs > 0 && run_rows >= rows_per_run); ++k) {
+        const bool last = runs > 0 ? run_rows + 1 == rows_per_run : k + 1 == steps;
         const double v = turn ? 0.0 : kSpeed;
         const double w = turn ? (cw ? -kTurnRate : kTurnRate) : 0.0;
         const double dl = (v - w * kWheelbase / 2) * kDt * (1 + 0.01 * noise(rng));
@@ -67,14 +76,21 @@ int Generate(const std::string& path, double size_mb, std::uint64_t seed) {
         t += kDt;
         const auto ticks_l = static_cast<std::int64_t>(std::floor(travel_l / kMetresPerTick));
         const auto ticks_r = static_cast<std::int64_t>(std::floor(travel_r / kMetresPerTick));
-        if (rows % 5 == 4 && k + 1 < steps && (segment > 0 || k > 0)) {
-          fmt::format_to(std::back_inserter(buf), "{},{},{:.3f},{},{},,,\n", run, direction, t, ticks_l, ticks_r);
+        // --generate-runs writes a recorder's log: absolute time stamps (10
+        // us), counters that do not start at 0, 7-decimal ground truth.
+        const double stamp = runs > 0 ? 1591000000.0 + 1000.0 * run + t : t;
+        const std::int64_t offset = runs > 0 ? 1000000 : 0;
+        const int t_digits = runs > 0 ? 5 : 3, gt_digits = runs > 0 ? 7 : 6;
+        if (rows % 5 == 4 && !last && k + 1 < steps && (segment > 0 || k > 0)) {
+          fmt::format_to(std::back_inserter(buf), "{},{},{:.{}f},{},{},,,\n", run, direction, stamp, t_digits,
+                         ticks_l + offset, ticks_r + offset);
         } else {
-          fmt::format_to(std::back_inserter(buf), "{},{},{:.3f},{},{},{:.6f},{:.6f},{:.6f}\n", run, direction, t,
-                         ticks_l, ticks_r, x + 2e-4 * noise(rng), y + 2e-4 * noise(rng),
-                         WrapAngle(theta + 1.7e-3 * noise(rng)));
+          fmt::format_to(std::back_inserter(buf), "{},{},{:.{}f},{},{},{:.{}f},{:.{}f},{:.{}f}\n", run, direction,
+                         stamp, t_digits, ticks_l + offset, ticks_r + offset, x + 2e-4 * noise(rng), gt_digits,
+                         y + 2e-4 * noise(rng), gt_digits, WrapAngle(theta + 1.7e-3 * noise(rng)), gt_digits);
         }
         ++rows;
+        ++run_rows;
         if (buf.size() > (1u << 22)) {
           written += std::fwrite(buf.data(), 1, buf.size(), f);
           buf.clear();
@@ -98,22 +114,29 @@ double CpuSeconds() {
   return secs(u.ru_utime) + secs(u.ru_stime);
 }
 
-int Time(const std::string& path, int repeats) {
+int Time(const std::string& path, int repeats, bool stream) {
   double best = 1e300, best_cpu = 1e300;
   std::size_t samples = 0, runs = 0, gt = 0;
   for (int r = 0; r < repeats; ++r) {
     const double cpu_start = CpuSeconds();
     const auto start = std::chrono::steady_clock::now();
-    const TrajectoryData data = io::ReadTrajectoryCsv(path);
+    runs = samples = gt = 0;
+    const auto count = [&](const TrajectoryRun& run) {
+      ++runs;
+      samples += run.size();
+      for (std::size_t i = 0; i < run.size(); ++i) gt += run.HasGroundTruth(i) ? 1 : 0;
+    };
+    if (stream) {
+      io::TrajectoryReader reader(path);
+      TrajectoryRun run;
+      while (reader.NextRun(run)) count(run);
+    } else {
+      const TrajectoryData data = io::ReadTrajectoryCsv(path);
+      for (const auto& run : data.runs) count(run);
+    }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     best = std::min(best, seconds);
     best_cpu = std::min(best_cpu, CpuSeconds() - cpu_start);
-    runs = data.runs.size();
-    samples = gt = 0;
-    for (const auto& run : data.runs) {
-      samples += run.size();
-      for (std::size_t i = 0; i < run.size(); ++i) gt += run.HasGroundTruth(i) ? 1 : 0;
-    }
   }
   std::FILE* f = std::fopen(path.c_str(), "rb");
   std::fseek(f, 0, SEEK_END);
@@ -132,11 +155,19 @@ int Time(const std::string& path, int repeats) {
 int main(int argc, char** argv) {
   try {
     const std::string first = argc > 1 ? argv[1] : "";
+    constexpr std::uint64_t kSeed = 20240611u;
     if (first == "--generate" && argc >= 4) {
-      return Generate(argv[2], std::atof(argv[3]), argc > 4 ? std::strtoull(argv[4], nullptr, 10) : 20240611u);
+      return Generate(argv[2], std::atof(argv[3]), 0, 0, argc > 4 ? std::strtoull(argv[4], nullptr, 10) : kSeed);
     }
-    if (argc >= 2 && first != "--generate") return Time(first, argc > 2 ? std::atoi(argv[2]) : 3);
-    fmt::print(stderr, "usage: bench_parse --generate FILE SIZE_MB [SEED] | bench_parse FILE [REPEATS]\n");
+    if (first == "--generate-runs" && argc >= 5) {
+      return Generate(argv[2], 0.0, std::atoi(argv[3]), std::atoi(argv[4]),
+                      argc > 5 ? std::strtoull(argv[5], nullptr, 10) : kSeed);
+    }
+    if (first == "--stream" && argc >= 3) return Time(argv[2], argc > 3 ? std::atoi(argv[3]) : 3, true);
+    if (argc >= 2 && first[0] != '-') return Time(first, argc > 2 ? std::atoi(argv[2]) : 3, false);
+    fmt::print(stderr,
+               "usage: bench_parse --generate FILE SIZE_MB [SEED] | --generate-runs FILE RUNS ROWS [SEED] | "
+               "[--stream] FILE [REPEATS]\n");
     return 2;
   } catch (const InputError& e) {
     fmt::print(stderr, "{}\n", e.what());
