@@ -16,6 +16,7 @@
 
 #include "core/robot.hpp"
 #include "evaluation/return_error.hpp"
+#include "model/true_robot.hpp"
 
 namespace umbmark {
 
@@ -120,9 +121,7 @@ UmbmarkEstimate EstimateFromCentres(double cw_cg, double ccw_cg, bool x_axis, do
 /// cluster of return position errors (ex, ey) [m].
 ClusterStats ClusterOf(const std::vector<std::pair<double, double>>& errors_m);
 
-/// Correction factors c_L = 2/(E_d+1) (eq. 4.31), c_R = 2/(1/E_d+1) (eq. 4.32).
-inline double CorrectionLeft(double E_d) { return 2.0 / (E_d + 1.0); }
-inline double CorrectionRight(double E_d) { return 2.0 / (1.0 / E_d + 1.0); }
+/// Correction factors c_L, c_R: CorrectionLeft/Right (model/true_robot.hpp).
 
 /// Corrected parameters relative to `recorded` (wheelbase E_b*b, c_L*D_L, c_R*D_R).
 RobotParams ApplyCorrection(const RobotParams& recorded, double E_d, double E_b);

@@ -11,7 +11,7 @@
 #include <fmt/format.h>
 
 #include "diagnosis/mean_fit.hpp"
-#include "diagnosis/parallel.hpp"
+#include "core/parallel_for.hpp"
 
 namespace umbmark::diag {
 

@@ -10,7 +10,7 @@
 #include <Eigen/Dense>
 
 #include "diagnosis/mean_fit.hpp"
-#include "diagnosis/parallel.hpp"
+#include "core/parallel_for.hpp"
 #include "simulation/rng.hpp"
 
 namespace umbmark::diag {

@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
-#include "kinematics/diff_drive.hpp"
+#include "model/true_robot.hpp"
 #include "simulation/rng.hpp"
 
 namespace umbmark::sim {
@@ -51,16 +51,11 @@ struct StepRecord {
   double slide_x_m = 0.0, slide_y_m = 0.0;
 };
 
-/// Exact constant-curvature step with the heading change scaled by
-/// heading_factor (turn_scrub) and a sideways slide (floor_slope).
+/// The true robot's step (TrueStep) plus a sideways slide (floor_slope).
 Pose2 AdvancePose(const Pose2& p, double l, double r, double wheelbase, double heading_factor, double slide_x,
                   double slide_y) {
-  const double ds = 0.5 * (l + r);
-  const double dtheta = (r - l) / wheelbase * heading_factor;
-  const double half = 0.5 * dtheta;
-  const double chord = ds * Sinc(half);
-  const double heading = p.theta + half;
-  return {p.x + chord * std::cos(heading) + slide_x, p.y + chord * std::sin(heading) + slide_y, p.theta + dtheta};
+  const Pose2 q = TrueStep(p, l, r, wheelbase, heading_factor);
+  return {q.x + slide_x, q.y + slide_y, q.theta};
 }
 
 }  // namespace
@@ -157,13 +152,7 @@ SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::
     for (int w = 0; w < 2; ++w) {
       if (truth.ticks) {
         const double target = std::round(commanded[w] / nominal_per_tick[w]);
-        const double count = std::floor(p[w]);
-        if (target > count)
-          p_end[w] = target;
-        else if (target < count)
-          p_end[w] = target + 1.0 - 1e-9;
-        else
-          p_end[w] = p[w];
+        p_end[w] = EncoderStopPosition(target, std::floor(p[w]), p[w], kStopBelowTicks);
       } else {
         p_end[w] = commanded[w];
       }

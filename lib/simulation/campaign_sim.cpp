@@ -11,6 +11,7 @@
 #include "core/errors.hpp"
 #include "evaluation/return_error.hpp"
 #include "kinematics/odometry.hpp"
+#include "model/true_robot.hpp"
 #include "simulation/campaign_run.hpp"
 #include "simulation/effects_motion.hpp"
 
@@ -134,8 +135,7 @@ RunPlan ReplayPlan(const TrajectoryRun& run, const RobotParams& robot) {
 }  // namespace
 
 std::string CampaignTruth::Check() const {
-  if (!(E_d > 0.0) || !std::isfinite(E_d)) return fmt::format("E_d = {} must be a finite number > 0", E_d);
-  if (!(E_b > 0.0) || !std::isfinite(E_b)) return fmt::format("E_b = {} must be a finite number > 0", E_b);
+  if (auto e = TrueRobot{E_d, E_b, 0.0}.Check(); !e.empty()) return e;
   if (!(k_L >= 0.0) || !std::isfinite(k_L)) return fmt::format("k_L = {} must be a finite number >= 0", k_L);
   if (!(k_R >= 0.0) || !std::isfinite(k_R)) return fmt::format("k_R = {} must be a finite number >= 0", k_R);
   return {};
@@ -257,7 +257,7 @@ SimulatedCampaign SimulateCampaign(const Manifest& manifest, const CampaignSimOp
                                      options.effects.drift_r, total - 1));
 
   const CampaignTruth& tr = options.truth;
-  const double c_L = 2.0 / (tr.E_d + 1.0), c_R = 2.0 / (1.0 / tr.E_d + 1.0);
+  const double c_L = CorrectionLeft(tr.E_d), c_R = CorrectionRight(tr.E_d);
   const double scale = 1.0 + options.effects.scale_s;
   GroundTruthNoise gt;
   if (options.ground_truth)
@@ -321,7 +321,7 @@ SimulatedCampaign SimulateCampaign(const Manifest& manifest, const CampaignSimOp
 nlohmann::json CampaignTruthJson(const SimulatedCampaign& campaign, const CampaignSimOptions& options) {
   const CampaignTruth& tr = options.truth;
   const RobotParams& robot = campaign.manifest.robot;
-  const double c_L = 2.0 / (tr.E_d + 1.0), c_R = 2.0 / (1.0 / tr.E_d + 1.0);
+  const double c_L = CorrectionLeft(tr.E_d), c_R = CorrectionRight(tr.E_d);
   const double scale = 1.0 + options.effects.scale_s;
   nlohmann::json effects = nlohmann::json::array();
   for (EffectKind k : options.effects.ActiveKinds()) {

@@ -3,13 +3,13 @@
 #include "simulation/monte_carlo.hpp"
 
 #include <algorithm>
-#include <atomic>
+#include <array>
 #include <chrono>
-#include <thread>
 
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
+#include "core/parallel_for.hpp"
 #include "simulation/monte_carlo_kernel.hpp"
 
 namespace umbmark::sim {
@@ -22,6 +22,9 @@ std::string MonteCarloOptions::Check() const {
 
 namespace {
 
+/// Runs per work item (a multiple of kSimLanes).
+constexpr std::int64_t kBlock = 64;
+
 /// Sums of one block, centred on a reference point to limit cancellation.
 struct BlockSums {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -33,10 +36,8 @@ struct BlockSums {
 MonteCarloSummary RunMonteCarlo(const SimPlan& plan, const MonteCarloOptions& options) {
   if (auto e = options.Check(); !e.empty()) throw InvalidOptions(e);
   const std::int64_t runs = options.runs;
-  const std::int64_t block = 64;  // runs per work item (a multiple of kSimLanes)
-  const std::int64_t nblocks = (runs + block - 1) / block;
-  int threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
-  threads = static_cast<int>(std::clamp<std::int64_t>(threads, 1, nblocks));
+  const std::int64_t nblocks = (runs + kBlock - 1) / kBlock;
+  const int threads = static_cast<int>(std::clamp<std::int64_t>(ResolveThreads(options.threads), 1, nblocks));
 
   // Reference: the noise-free true final pose (the plan with zero noise is
   // not needed; the first run is close enough and deterministic).
@@ -47,28 +48,21 @@ MonteCarloSummary RunMonteCarlo(const SimPlan& plan, const MonteCarloOptions& op
   std::vector<BlockSums> sums(static_cast<std::size_t>(nblocks));
   MonteCarloSummary out;
   if (options.keep_runs) out.finals.resize(static_cast<std::size_t>(runs));
-  std::atomic<std::int64_t> next{0};
-  auto worker = [&]() {
-    std::vector<Pose2> poses(static_cast<std::size_t>(block));
-    for (std::int64_t k = next.fetch_add(1); k < nblocks; k = next.fetch_add(1)) {
-      const std::int64_t first = k * block;
-      const std::int64_t n = std::min(block, runs - first);
-      SimulateFinalPoses(plan, options.seed, first, n, poses.data());
-      BlockSums& s = sums[static_cast<std::size_t>(k)];
-      for (std::int64_t i = 0; i < n; ++i) {
-        const Pose2& p = poses[static_cast<std::size_t>(i)];
-        const Eigen::Vector3d d = Eigen::Vector3d(p.x, p.y, p.theta) - r0;
-        s.sum += d;
-        s.outer += d * d.transpose();
-        if (options.keep_runs) out.finals[static_cast<std::size_t>(first + i)] = p;
-      }
-    }
-  };
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
+  ParallelFor(threads, nblocks, [&](std::int64_t k) {
+    std::array<Pose2, kBlock> poses;
+    const std::int64_t first = k * kBlock;
+    const std::int64_t n = std::min(kBlock, runs - first);
+    SimulateFinalPoses(plan, options.seed, first, n, poses.data());
+    BlockSums& s = sums[static_cast<std::size_t>(k)];
+    for (std::int64_t i = 0; i < n; ++i) {
+      const Pose2& p = poses[static_cast<std::size_t>(i)];
+      const Eigen::Vector3d d = Eigen::Vector3d(p.x, p.y, p.theta) - r0;
+      s.sum += d;
+      s.outer += d * d.transpose();
+      if (options.keep_runs) out.finals[static_cast<std::size_t>(first + i)] = p;
+    }
+  });
   const auto t1 = std::chrono::steady_clock::now();
 
   BlockSums total;

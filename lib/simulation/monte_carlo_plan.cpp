@@ -14,10 +14,7 @@ namespace umbmark::sim {
 
 std::string SimulationModel::Check() const {
   if (auto e = nominal.Check(); !e.empty()) return "nominal." + e;
-  if (!std::isfinite(truth.E_d) || !(truth.E_d > 0.0)) return fmt::format("E_d = {} must be > 0", truth.E_d);
-  if (!std::isfinite(truth.E_b) || !(truth.E_b > 0.0)) return fmt::format("E_b = {} must be > 0", truth.E_b);
-  if (!std::isfinite(truth.scale) || !(truth.scale > -1.0))
-    return fmt::format("scale = {} must be > -1", truth.scale);
+  if (auto e = truth.Check(); !e.empty()) return e;
   if (auto e = noise.Check(); !e.empty()) return e;
   if (quantise_encoders && !nominal.ticks_per_rev) return "quantise_encoders needs nominal.ticks_per_rev";
   if (!initial_covariance.allFinite() || !initial_covariance.isApprox(initial_covariance.transpose(), 1e-12))
@@ -40,9 +37,7 @@ SimPlan CompilePlan(const SimulationModel& model, const std::vector<WheelSegment
   if (auto e = model.Check(); !e.empty()) throw InvalidOptions(e);
   if (partitions < 1) throw InvalidOptions(fmt::format("partitions = {} must be >= 1", partitions));
   const RobotParams& nom = model.nominal;
-  const double E_d = model.truth.E_d;
-  const double c_L = 2.0 / (E_d + 1.0), c_R = 2.0 / (1.0 / E_d + 1.0);  // contract, c_L and c_R
-  const double g_L = c_L * (1.0 + model.truth.scale), g_R = c_R * (1.0 + model.truth.scale);
+  const double g_L = model.truth.WheelFactorLeft(), g_R = model.truth.WheelFactorRight();
 
   SimPlan plan;
   plan.nominal_wheelbase_m = nom.wheelbase_m;
@@ -81,12 +76,9 @@ SimPlan CompilePlan(const SimulationModel& model, const std::vector<WheelSegment
     cum_R += commanded[k].right_m;
     const auto target_L = static_cast<std::int64_t>(std::llround(cum_L / mpt_L));
     const auto target_R = static_cast<std::int64_t>(std::llround(cum_R / mpt_R));
-    auto stop = [](std::int64_t target, std::int64_t previous, double p) {
-      if (target > previous) return static_cast<double>(target);        // forward: reaches count T at p = T
-      if (target < previous) return static_cast<double>(target) + 1.0;  // backward: just below T + 1
-      return p;                                                         // wheel does not move
-    };
-    const double np_L = stop(target_L, T_L, p_L), np_R = stop(target_R, T_R, p_R);
+    // The counts are kept here (target_*), so the backward stop is the limit T + 1.
+    const double np_L = EncoderStopPosition(static_cast<double>(target_L), static_cast<double>(T_L), p_L);
+    const double np_R = EncoderStopPosition(static_cast<double>(target_R), static_cast<double>(T_R), p_R);
     if (plan.phase_segment_left < 0 && target_L != T_L) plan.phase_segment_left = static_cast<int>(k);
     if (plan.phase_segment_right < 0 && target_R != T_R) plan.phase_segment_right = static_cast<int>(k);
     SimSegment s;

@@ -7,7 +7,7 @@
 // so commanded wheel rotations are the nominal ones. The physical robot has
 // true wheel diameters D_true = c * (1 + s) * D_nom, with c_L = 2/(E_d + 1),
 // c_R = 2/(1/E_d + 1) (contract, "Precise points") and s = scale error, and
-// a true wheelbase E_b * b_nom. Each segment is split into P equal
+// a true wheelbase E_b * b_nom (TrueRobot, model/true_robot.hpp). Each segment is split into P equal
 // partitions; in each, each wheel's ground travel is its mean true travel
 // plus white noise of variance k^2 |travel| (eq. 4), and the pose advances
 // by an exact constant-curvature arc (no small-angle approximation).
@@ -16,7 +16,8 @@
 // reads floor(p); it starts at a random phase p0 ~ U[0, 1); the controller
 // stops a wheel's motion the instant its count reaches the target
 // round(cumulative nominal travel / metres-per-tick), i.e. at p = T moving
-// forward and just below p = T + 1 moving backward. The odometry integrates
+// forward and just below p = T + 1 moving backward (EncoderStopPosition,
+// model/true_robot.hpp). The odometry integrates
 // whole ticks with the nominal parameters.
 //
 // Adding an effect later: give SimulationModel a field, and express the
@@ -33,19 +34,9 @@
 #include "error_models/path_spec.hpp"
 #include "error_models/wheel_noise.hpp"
 #include "core/pose2.hpp"
+#include "model/true_robot.hpp"
 
 namespace umbmark::sim {
-
-/// The physical robot relative to the parameters its odometry uses.
-struct TrueRobot {
-  /// Wheel diameter ratio error (Borenstein & Feng): true D_R/D_L over the
-  /// nominal ratio. > 0.
-  double E_d = 1.0;
-  /// Wheelbase error: true wheelbase / nominal. > 0.
-  double E_b = 1.0;
-  /// scale_error s: both true diameters (1 + s) times the model's. > -1.
-  double scale = 0.0;
-};
 
 struct SimulationModel {
   /// What the odometry uses (wheelbase, diameters; ticks_per_rev when
