@@ -15,6 +15,8 @@
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
+#include "stats/distributions.hpp"
+#include "stats/optimize.hpp"
 
 namespace umbmark {
 
@@ -198,70 +200,6 @@ Minimum Minimise(const NllCost& cost, std::vector<double> start, int max_iterati
   return m;
 }
 
-/// Brent's minimisation of f on [a, b] (parabolic interpolation with golden
-/// section fallback; Brent 1973, ch. 5), to an absolute tolerance tol in x.
-template <typename F>
-double BrentMinimum(F f, double a, double b, double tol, double* fmin) {
-  constexpr double kGolden = 0.3819660112501051;
-  double x = a + kGolden * (b - a), w = x, v = x;
-  double fx = f(x), fw = fx, fv = fx;
-  double d = 0.0, e = 0.0;
-  for (int it = 0; it < 200; ++it) {
-    const double m = 0.5 * (a + b);
-    const double tol1 = tol + 1e-12 * std::abs(x), tol2 = 2.0 * tol1;
-    if (std::abs(x - m) <= tol2 - 0.5 * (b - a)) break;
-    bool golden = true;
-    if (std::abs(e) > tol1 && std::isfinite(fx) && std::isfinite(fw) && std::isfinite(fv)) {
-      double r = (x - w) * (fx - fv), q = (x - v) * (fx - fw), p = (x - v) * q - (x - w) * r;
-      q = 2.0 * (q - r);
-      if (q > 0.0) p = -p;
-      q = std::abs(q);
-      const double e_prev = e;
-      e = d;
-      if (std::abs(p) < std::abs(0.5 * q * e_prev) && p > q * (a - x) && p < q * (b - x)) {
-        d = p / q;
-        const double u = x + d;
-        if (u - a < tol2 || b - u < tol2) d = x < m ? tol1 : -tol1;
-        golden = false;
-      }
-    }
-    if (golden) {
-      e = (x < m ? b : a) - x;
-      d = kGolden * e;
-    }
-    const double u = std::abs(d) >= tol1 ? x + d : x + (d > 0 ? tol1 : -tol1);
-    const double fu = f(u);
-    if (fu <= fx) {
-      (u < x ? b : a) = x;
-      v = w, fv = fw;
-      w = x, fw = fx;
-      x = u, fx = fu;
-    } else {
-      (u < x ? a : b) = u;
-      if (fu <= fw || w == x) {
-        v = w, fv = fw;
-        w = u, fw = fu;
-      } else if (fu <= fv || v == x || v == w) {
-        v = u, fv = fu;
-      }
-    }
-  }
-  *fmin = fx;
-  return x;
-}
-
-/// Inverse of the standard normal CDF by bisection on erfc (ample for a
-/// confidence level).
-double NormalQuantile(double p) {
-  double lo = -40.0, hi = 40.0;
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    if (0.5 * std::erfc(-mid / std::sqrt(2.0)) < p) lo = mid;
-    else hi = mid;
-  }
-  return 0.5 * (lo + hi);
-}
-
 }  // namespace
 
 double WheelNoiseNegLogLikelihood(const std::vector<WheelNoiseFitRun>& runs, double k_L, double k_R) {
@@ -341,8 +279,7 @@ WheelNoiseFitSummary FitWheelNoise(const std::vector<WheelNoiseFitRun>& runs, co
   out.groups = grp.names;
 
   // 4. Profile-likelihood intervals.
-  const double zq = NormalQuantile(0.5 * (1.0 + options.confidence));
-  const double delta = 0.5 * zq * zq;  // chi^2_1 quantile / 2
+  const double delta = 0.5 * ChiSquareQuantile(options.confidence, 1.0);
   // Profile NLL: with one k fixed, minimise over the other by Brent's method
   // in log k (one-dimensional and robust where the likelihood is flat, e.g.
   // when the other k is at its boundary 0), also trying the other k = 0.
@@ -354,38 +291,17 @@ WheelNoiseFitSummary FitWheelNoise(const std::vector<WheelNoiseFitRun>& runs, co
     return ok ? v : std::numeric_limits<double>::infinity();
   };
   auto profile = [&](int which, double k, double other_log_start) {
-    double best_v = 0.0;
-    BrentMinimum([&](double u) { return nll_at(which, k, std::exp(u)); }, other_log_start - 15.0,
-                 other_log_start + 5.0, 1e-7, &best_v);
-    return std::min(best_v, nll_at(which, k, 0.0));
+    // 28 bits: |log k| <= ~15, so ~1e-7 in log k, as precise as the NLL is flat.
+    const ScalarMinimum m = MinimizeBrent([&](double u) { return nll_at(which, k, std::exp(u)); },
+                                          other_log_start - 15.0, other_log_start + 5.0, 28);
+    return std::min(m.f, nll_at(which, k, 0.0));
   };
   auto interval = [&](int which) -> std::array<double, 2> {
     const double khat = which == 0 ? out.k_L : out.k_R;
     const double other = which == 0 ? best.params[1] : best.params[0];
     auto g = [&](double k) { return profile(which, k, other) - best.nll - delta; };
-    // Root of g between a (g <= 0, the optimum side) and b (g > 0): Illinois
-    // false position, falling back to bisection when g is not finite.
-    auto bisect = [&](double a, double b) {
-      double ga = g(a), gb = g(b);
-      int side = 0;
-      for (int it = 0; it < 100 && std::abs(b - a) > 1e-6 * khat; ++it) {
-        double c = 0.5 * (a + b);
-        if (std::isfinite(ga) && std::isfinite(gb) && gb != ga) c = b - gb * (b - a) / (gb - ga);
-        if (!(std::abs(c - a) > 1e-3 * std::abs(b - a) && std::abs(b - c) > 1e-3 * std::abs(b - a))) c = 0.5 * (a + b);
-        const double gc = g(c);
-        if (gc > 0.0) {
-          b = c, gb = gc;
-          if (side == -1) ga *= 0.5;
-          side = -1;
-        } else {
-          a = c, ga = gc;
-          if (side == 1) gb *= 0.5;
-          side = 1;
-        }
-        if (std::abs(gc) < 1e-10) break;
-      }
-      return std::abs(ga) < std::abs(gb) ? a : b;
-    };
+    // Root of g between khat (g <= 0, the optimum) and b (g > 0).
+    auto bisect = [&](double a, double b) { return FindRoot(g, a, b, 1e-6 * khat); };
     std::array<double, 2> ci{0.0, std::numeric_limits<double>::infinity()};
     if (g(0.0) > 0.0) ci[0] = bisect(khat, 0.0);
     double hi = khat * 1.25 + 1e-12;
