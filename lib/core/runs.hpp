@@ -17,15 +17,18 @@
 
 namespace umbmark {
 
-/// One run of an endpoint CSV: the return error e = absolute - odometry
-/// (Borenstein & Feng eq. 3.1) in the run's start frame.
-struct EndpointRun {
+/// The return error of one run, e = absolute - odometry (Borenstein & Feng
+/// eq. 3.1) in the run's start frame: a row of an endpoint CSV, or computed
+/// from a trajectory (evaluation/return_error.hpp). The one record for it.
+struct ReturnError {
   std::string run;        ///< run id as written in the file
   std::string direction;  ///< "cw", "ccw", or free text
   double ex_m = 0.0;
   double ey_m = 0.0;
-  std::optional<double> etheta_rad;  ///< empty cell -> not measured
-  std::size_t line = 0;              ///< 1-based source line (for messages)
+  std::optional<double> etheta_rad;  ///< empty cell -> not measured; wrapped to (-pi, pi]
+  std::size_t line = 0;              ///< 1-based source line (first sample of a trajectory run)
+  /// Ground-truth total rotation [rad] (computed from a trajectory only).
+  std::optional<double> gt_total_rotation_rad;
 };
 
 /// One run of a trajectory CSV, samples in file order.
@@ -52,7 +55,7 @@ struct TrajectoryRun {
 
 struct EndpointData {
   std::string path;
-  std::vector<EndpointRun> runs;
+  std::vector<ReturnError> runs;
 };
 
 struct TrajectoryData {

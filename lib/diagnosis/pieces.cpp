@@ -357,13 +357,8 @@ void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, co
   }
 }
 
-struct ReturnErrorRow {
-  double ex = 0, ey = 0;
-  std::optional<double> etheta;
-};
-
 /// Synthetic commanded square for an endpoint run: still, motion, still, ...
-void BuildEndpointRun(DiagRun& r, const ReturnErrorRow& e, double side_m, const RobotParams& robot) {
+void BuildEndpointRun(DiagRun& r, const ReturnError& e, double side_m, const RobotParams& robot) {
   const auto dir = SquareDirectionFromString(r.direction);
   const auto motions = CommandedSquare(*dir, side_m, robot.wheelbase_m, true);
   double t = 0.0, L = 0.0, R = 0.0;
@@ -391,9 +386,9 @@ void BuildEndpointRun(DiagRun& r, const ReturnErrorRow& e, double side_m, const 
   r.has_gt.assign(n, false);
   r.gt[0] = Pose2{};
   r.has_gt[0] = true;
-  r.gt[n - 1] = Pose2{odo.x + e.ex, odo.y + e.ey, odo.theta + e.etheta.value_or(0.0)};
+  r.gt[n - 1] = Pose2{odo.x + e.ex_m, odo.y + e.ey_m, odo.theta + e.etheta_rad.value_or(0.0)};
   r.has_gt[n - 1] = true;
-  r.has_heading = e.etheta.has_value();
+  r.has_heading = e.etheta_rad.has_value();
 }
 
 }  // namespace
@@ -426,7 +421,7 @@ CampaignData BuildCampaign(const Manifest& manifest, const std::vector<std::vari
         throw InputError(fname, fmt::format("experiment {} ({}): endpoint data is only usable for squares", e + 1,
                                             ExperimentKindToString(ex.kind)));
       info.endpoint = true;
-      for (const EndpointRun& er : ep->runs) {
+      for (const ReturnError& er : ep->runs) {
         if (!SquareDirectionFromString(er.direction))
           throw InputError(fname, er.line, 0, fmt::format("run {}: direction '{}' must be cw or ccw", er.run, er.direction));
         DiagRun r;
@@ -436,7 +431,7 @@ CampaignData BuildCampaign(const Manifest& manifest, const std::vector<std::vari
         r.id = er.run;
         r.direction = er.direction;
         r.endpoint = true;
-        BuildEndpointRun(r, ReturnErrorRow{er.ex_m, er.ey_m, er.etheta_rad}, ex.side_m, manifest.robot);
+        BuildEndpointRun(r, er, ex.side_m, manifest.robot);
         sim::MotionOptions mo = options.motion;
         mo.min_stand_intervals = 2;
         r.motions = sim::SegmentMotions(r.left, r.right, manifest.robot.wheelbase_m, mo);

@@ -22,7 +22,7 @@ std::vector<WheelNoiseFitRun> NoiseRunsFromEndpoints(const EndpointData& data, c
   if (options.second_order) q2 = SecondOrderHeadingBasis(wheels, wheelbase_m);
   const PoseCovariance M = MeasurementCovariance(options.sigma_xy_m, options.sigma_theta_rad, pc.mean);
   std::vector<WheelNoiseFitRun> out;
-  for (const EndpointRun& r : data.runs) {
+  for (const ReturnError& r : data.runs) {
     WheelNoiseFitRun f;
     f.group = group_prefix + r.direction;
     f.run = r.run;

@@ -8,18 +8,9 @@
 namespace umbmark {
 
 std::vector<ReturnError> ReturnErrorsFromEndpoints(const EndpointData& data) {
-  std::vector<ReturnError> out;
-  out.reserve(data.runs.size());
-  for (const auto& r : data.runs) {
-    ReturnError e;
-    e.run = r.run;
-    e.direction = r.direction;
-    e.ex_m = r.ex_m;
-    e.ey_m = r.ey_m;
-    if (r.etheta_rad) e.etheta_rad = WrapAngle(*r.etheta_rad);
-    e.line = r.line;
-    out.push_back(std::move(e));
-  }
+  std::vector<ReturnError> out = data.runs;
+  for (ReturnError& e : out)
+    if (e.etheta_rad) e.etheta_rad = WrapAngle(*e.etheta_rad);
   return out;
 }
 

@@ -14,11 +14,14 @@
 namespace umbmark::io {
 
 namespace {
-// CSV cell for free text: the contract has no quoting, so commas and line
-// breaks are replaced rather than emitted.
+// CSV cell for free text (run ids, directions): the contract has no quoting
+// and its readers refuse a double quote, so commas and line breaks become
+// spaces and double quotes single ones rather than being emitted.
 std::string CleanCell(std::string s) {
-  for (char& c : s)
+  for (char& c : s) {
     if (c == ',' || c == '\n' || c == '\r') c = ' ';
+    if (c == '"') c = '\'';
+  }
   return s;
 }
 
@@ -86,7 +89,7 @@ std::string FormatEndpointCsv(const EndpointData& data, const std::vector<std::s
   for (const auto& line : comment) out += "# " + line + "\n";
   out += "run,direction,ex_m,ey_m,etheta_rad\n";
   for (const auto& r : data.runs) {
-    out += fmt::format("{},{},{},{},", r.run, r.direction, r.ex_m, r.ey_m);
+    out += fmt::format("{},{},{},{},", CleanCell(r.run), CleanCell(r.direction), r.ex_m, r.ey_m);
     if (r.etheta_rad) out += fmt::format("{}", *r.etheta_rad);
     out += "\n";
   }

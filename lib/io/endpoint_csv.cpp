@@ -72,7 +72,7 @@ EndpointData ReadEndpointRows(CsvReader& csv) {
   // (run, direction) -> line, to reject a run given twice.
   std::unordered_map<std::string, std::size_t> seen;
   while (csv.Next()) {
-    EndpointRun r;
+    ReturnError r;
     r.line = csv.line();
     r.run = std::string(csv.Text(cols[kRun]));
     r.direction = std::string(csv.Text(cols[kDirection]));

@@ -132,6 +132,53 @@ RunPlan ReplayPlan(const TrajectoryRun& run, const RobotParams& robot) {
   return plan;
 }
 
+/// One run to simulate: its plan, id and direction.
+struct PlannedRun {
+  RunPlan plan;
+  std::string id, direction;
+};
+
+/// The runs of every experiment of `manifest`, in file order.
+std::vector<std::vector<PlannedRun>> PlanCampaign(const Manifest& manifest, const CampaignSimOptions& options,
+                                                  const std::vector<std::optional<TrajectoryData>>& free_templates) {
+  const RobotParams& robot = manifest.robot;
+  std::vector<std::vector<PlannedRun>> plans(manifest.experiments.size());
+  for (std::size_t e = 0; e < manifest.experiments.size(); ++e) {
+    const Experiment& ex = manifest.experiments[e];
+    auto& list = plans[e];
+    switch (ex.kind) {
+      case ExperimentKind::kSquare:
+        for (int i = 0; i < 2 * options.square_runs_per_direction; ++i) {
+          const bool cw = i % 2 == 0;
+          list.push_back({SquarePlan(cw, ex.side_m, robot.wheelbase_m, options), std::to_string(i + 1),
+                          cw ? "cw" : "ccw"});
+        }
+        break;
+      case ExperimentKind::kBackAndForth:
+        for (int i = 0; i < options.back_and_forth_runs; ++i)
+          list.push_back({BackAndForthPlan(ex.distance_m, options), std::to_string(i + 1), "fwd_back"});
+        break;
+      case ExperimentKind::kFree:
+        if (e < free_templates.size() && free_templates[e]) {
+          for (const TrajectoryRun& r : free_templates[e]->runs) {
+            if (r.size() < 2) continue;
+            list.push_back({ReplayPlan(r, robot), r.run, r.direction});
+          }
+          if (list.empty()) throw InvalidOptions(fmt::format("simulate: free experiment {} template has no runs", e + 1));
+        } else {
+          if (!(options.free_radius_m > 0.5 * robot.wheelbase_m))
+            throw InvalidOptions(fmt::format("simulate: free_radius_m = {} must exceed half the wheelbase ({})",
+                                             options.free_radius_m, 0.5 * robot.wheelbase_m));
+          for (int i = 0; i < options.free_runs; ++i)
+            list.push_back({FigureEightPlan(options.free_radius_m, robot.wheelbase_m, options), std::to_string(i + 1),
+                            "figure_eight"});
+        }
+        break;
+    }
+  }
+  return plans;
+}
+
 }  // namespace
 
 std::string CampaignTruth::Check() const {
@@ -211,44 +258,7 @@ SimulatedCampaign SimulateCampaign(const Manifest& manifest, const CampaignSimOp
   const bool ticks = robot.ticks_per_rev.has_value();
 
   // Run plans per experiment, then the campaign's run count (drift check).
-  struct PlannedRun {
-    RunPlan plan;
-    std::string id, direction;
-  };
-  std::vector<std::vector<PlannedRun>> plans(manifest.experiments.size());
-  for (std::size_t e = 0; e < manifest.experiments.size(); ++e) {
-    const Experiment& ex = manifest.experiments[e];
-    auto& list = plans[e];
-    switch (ex.kind) {
-      case ExperimentKind::kSquare:
-        for (int i = 0; i < 2 * options.square_runs_per_direction; ++i) {
-          const bool cw = i % 2 == 0;
-          list.push_back({SquarePlan(cw, ex.side_m, robot.wheelbase_m, options), std::to_string(i + 1),
-                          cw ? "cw" : "ccw"});
-        }
-        break;
-      case ExperimentKind::kBackAndForth:
-        for (int i = 0; i < options.back_and_forth_runs; ++i)
-          list.push_back({BackAndForthPlan(ex.distance_m, options), std::to_string(i + 1), "fwd_back"});
-        break;
-      case ExperimentKind::kFree:
-        if (e < free_templates.size() && free_templates[e]) {
-          for (const TrajectoryRun& r : free_templates[e]->runs) {
-            if (r.size() < 2) continue;
-            list.push_back({ReplayPlan(r, robot), r.run, r.direction});
-          }
-          if (list.empty()) throw InvalidOptions(fmt::format("simulate: free experiment {} template has no runs", e + 1));
-        } else {
-          if (!(options.free_radius_m > 0.5 * robot.wheelbase_m))
-            throw InvalidOptions(fmt::format("simulate: free_radius_m = {} must exceed half the wheelbase ({})",
-                                             options.free_radius_m, 0.5 * robot.wheelbase_m));
-          for (int i = 0; i < options.free_runs; ++i)
-            list.push_back({FigureEightPlan(options.free_radius_m, robot.wheelbase_m, options), std::to_string(i + 1),
-                            "figure_eight"});
-        }
-        break;
-    }
-  }
+  const std::vector<std::vector<PlannedRun>> plans = PlanCampaign(manifest, options, free_templates);
   int total = 0;
   for (const auto& l : plans) total += static_cast<int>(l.size());
   const double last_drift = 1.0 + options.effects.drift_r * static_cast<double>(std::max(0, total - 1));
@@ -301,15 +311,7 @@ SimulatedCampaign SimulateCampaign(const Manifest& manifest, const CampaignSimOp
     if (ex.kind == ExperimentKind::kSquare && options.endpoint_squares) {
       EndpointData ep;
       ep.path = ex.file;
-      for (const ReturnError& r : ReturnErrorsFromTrajectories(data, robot, robot, Integrator::kArc)) {
-        EndpointRun er;
-        er.run = r.run;
-        er.direction = r.direction;
-        er.ex_m = r.ex_m;
-        er.ey_m = r.ey_m;
-        er.etheta_rad = r.etheta_rad;
-        ep.runs.push_back(er);
-      }
+      ep.runs = ReturnErrorsFromTrajectories(data, robot, robot, Integrator::kArc);
       out.data.emplace_back(std::move(ep));
     } else {
       out.data.emplace_back(std::move(data));
