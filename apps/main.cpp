@@ -12,6 +12,7 @@
 #include <exception>
 #include <filesystem>
 #include <new>
+#include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -22,6 +23,7 @@
 #include "commands.hpp"
 #include "core/errors.hpp"
 #include "core/utf8.hpp"
+#include "umbmark/version.hpp"
 #include "io/atomic_write.hpp"
 
 namespace {
@@ -80,7 +82,7 @@ int main(int argc, char** argv) {
 
   CLI::App app{"umbmark: odometry calibration and sim-to-real diagnosis for differential-drive robots"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "umbmark 0.1.0");
+  app.set_version_flag("--version", std::string("umbmark ") + kVersion);
 
   std::vector<cli::Command> commands;
   // Registered subcommands (one cmd_*.cpp each).

@@ -42,6 +42,56 @@ class NormalSource {
   bool has_spare_ = false;
 };
 
+/// Wheel noise (Chong & Kleeman eq. 4, left/right correlation rho
+/// [correlated_noise]) and bumps (N(0, sigma_b^2) per bump, bumps arriving
+/// per wheel as a Poisson process in travelled distance [bump_outliers]) on
+/// each step's true wheel travel, from the run's own streams.
+class WheelDisturbance {
+ public:
+  WheelDisturbance(const RunTruth& truth, std::uint64_t seed, std::uint64_t run_index)
+      : wheel_rng_(StreamSeed(seed, run_index, kCampaignStreamWheelNoise)),
+        bump_rng_(StreamSeed(seed, run_index, kCampaignStreamBumps)),
+        k_{truth.k_L, truth.k_R},
+        rho_(truth.effects.noise_rho),
+        rho_c_(std::sqrt(std::max(0.0, 1.0 - rho_ * rho_))),
+        bump_rate_(truth.effects.bump_rate),
+        bump_sigma_(truth.effects.bump_sigma),
+        bumps_(bump_rate_ > 0.0 && bump_sigma_ > 0.0) {
+    if (bumps_) {
+      to_bump_[0] = bump_rng_.Exponential() / bump_rate_;
+      to_bump_[1] = bump_rng_.Exponential() / bump_rate_;
+    }
+  }
+
+  /// Adds the noise and the bumps of one step to travel[0] (left), travel[1]
+  /// (right) [m]; counts the bumps in out.
+  void Apply(double (&travel)[2], SimulatedRun& out) {
+    const double z0 = wheel_rng_.Next(), z1 = wheel_rng_.Next();
+    const double mean_abs[2] = {std::abs(travel[0]), std::abs(travel[1])};
+    travel[0] += k_[0] * std::sqrt(mean_abs[0]) * z0;
+    travel[1] += k_[1] * std::sqrt(mean_abs[1]) * (rho_ * z0 + rho_c_ * z1);
+    if (!bumps_) return;
+    for (int w = 0; w < 2; ++w) {
+      double left_to_roll = mean_abs[w];
+      while (to_bump_[w] <= left_to_roll) {
+        travel[w] += bump_sigma_ * bump_rng_.Next();
+        left_to_roll -= to_bump_[w];
+        to_bump_[w] = bump_rng_.Exponential() / bump_rate_;
+        (w == 0 ? out.bumps_left : out.bumps_right) += 1;
+      }
+      to_bump_[w] -= left_to_roll;
+    }
+  }
+
+ private:
+  NormalSource wheel_rng_, bump_rng_;
+  double k_[2];
+  double rho_, rho_c_;
+  double bump_rate_, bump_sigma_;
+  bool bumps_;
+  double to_bump_[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+};
+
 /// One executed step: enough to re-evaluate the pose at any time inside it.
 struct StepRecord {
   double ta = 0.0, tb = 0.0;
@@ -58,12 +108,9 @@ Pose2 AdvancePose(const Pose2& p, double l, double r, double wheelbase, double h
   return {q.x + slide_x, q.y + slide_y, q.theta};
 }
 
-}  // namespace
-
-SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::uint64_t seed, std::uint64_t run_index,
-                         const std::string& run_id, const std::string& direction) {
-  const Effects& fx = truth.effects;
-  if (!(truth.true_wheelbase_m > 0.0)) throw InvalidOptions("SimulateLoggedRun: true wheelbase must be > 0");
+/// The plan's sample times (given, or every 1/sample_rate_hz from 0 until
+/// the plan ends), checked against the plan. Throws InvalidOptions.
+std::vector<double> SampleTimes(const RunPlan& plan) {
   double total = 0.0;
   for (const auto& m : plan.motions) {
     if (!(m.duration_s >= 0.0) || !std::isfinite(m.duration_s))
@@ -83,8 +130,70 @@ SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::
     if (!(ts[j] > ts[j - 1])) throw InvalidOptions("SimulateLoggedRun: sample times must increase strictly");
   if (ts.back() < total - 1e-9) throw InvalidOptions("SimulateLoggedRun: the samples end before the plan does");
 
-  NormalSource wheel_rng(StreamSeed(seed, run_index, kCampaignStreamWheelNoise));
-  NormalSource bump_rng(StreamSeed(seed, run_index, kCampaignStreamBumps));
+  return ts;
+}
+
+/// True pose at any time (time_offset): the step containing it, partially
+/// executed; the start pose before the first step, the last pose after it.
+Pose2 PoseAt(const std::vector<StepRecord>& steps, double time, double wheelbase) {
+  if (steps.empty() || time < steps.front().ta) return Pose2{};
+  auto it = std::upper_bound(steps.begin(), steps.end(), time, [](double v, const StepRecord& s) { return v < s.ta; });
+  const StepRecord& s = *(it - 1);
+  if (time >= s.tb || s.tb <= s.ta) return s.end;
+  const double f = (time - s.ta) / (s.tb - s.ta);
+  return AdvancePose(s.start, f * s.left_m, f * s.right_m, wheelbase, s.heading_factor, f * s.slide_x_m,
+                     f * s.slide_y_m);
+}
+
+/// What the logger writes at the sample times: encoder counts (or nominal
+/// travel) and ground truth with gt_offset, time_offset, gt_yaw_misalignment
+/// and measurement noise (from gt_rng).
+void WriteLog(const std::vector<double>& ts, const std::vector<Pose2>& sample_pose,
+              const std::vector<double> (&sample_p)[2], const std::vector<StepRecord>& steps, const RunTruth& truth,
+              NormalSource& gt_rng, TrajectoryRun& run) {
+  const Effects& fx = truth.effects;
+  const std::size_t n = ts.size();
+  run.t_s = ts;
+  run.lines.assign(n, 0);
+  run.gt_x_m.resize(n);
+  run.gt_y_m.resize(n);
+  run.gt_theta_rad.resize(n);
+  if (truth.ticks) {
+    run.ticks_left.resize(n);
+    run.ticks_right.resize(n);
+  } else {
+    run.dist_left_m.resize(n);
+    run.dist_right_m.resize(n);
+  }
+  for (std::size_t j = 0; j < n; ++j) {
+    if (truth.ticks) {
+      run.ticks_left[j] = static_cast<std::int64_t>(std::floor(sample_p[0][j]));
+      run.ticks_right[j] = static_cast<std::int64_t>(std::floor(sample_p[1][j]));
+    } else {
+      run.dist_left_m[j] = sample_p[0][j];
+      run.dist_right_m[j] = sample_p[1][j];
+    }
+    const Pose2 q = fx.time_tau != 0.0 ? PoseAt(steps, ts[j] - fx.time_tau, truth.true_wheelbase_m) : sample_pose[j];
+    const double c = std::cos(q.theta), s = std::sin(q.theta);
+    const double nx = gt_rng.Next(), ny = gt_rng.Next(), nt = gt_rng.Next();
+    run.gt_x_m[j] = q.x + c * fx.gt_dx - s * fx.gt_dy + truth.gt_sigma_xy_m * nx;
+    run.gt_y_m[j] = q.y + s * fx.gt_dx + c * fx.gt_dy + truth.gt_sigma_xy_m * ny;
+    run.gt_theta_rad[j] = q.theta + fx.yaw_delta + truth.gt_sigma_theta_rad * nt;
+  }
+}
+
+}  // namespace
+
+// Longer than 80 lines on purpose: one loop over the motions and their steps
+// that shares the wheel positions, the pose and the sample cursor; the
+// pieces with state of their own (sample times, wheel disturbance, logger,
+// pose at any time) are the helpers above.
+SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::uint64_t seed, std::uint64_t run_index,
+                         const std::string& run_id, const std::string& direction) {
+  const Effects& fx = truth.effects;
+  if (!(truth.true_wheelbase_m > 0.0)) throw InvalidOptions("SimulateLoggedRun: true wheelbase must be > 0");
+  const std::vector<double> ts = SampleTimes(plan);
+
   NormalSource gt_rng(StreamSeed(seed, run_index, kCampaignStreamGroundTruth));
   NormalSource phase_rng(StreamSeed(seed, run_index, kCampaignStreamPhase));
 
@@ -104,15 +213,7 @@ SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::
   out.phase_right = p[1];
   const double nominal_per_tick[2] = {truth.nominal_per_tick_left, truth.nominal_per_tick_right};
   const double true_per_tick[2] = {truth.true_per_tick_left, truth.true_per_tick_right};
-  const double k_wheel[2] = {truth.k_L, truth.k_R};
-  const double rho = fx.noise_rho;
-  const double rho_c = std::sqrt(std::max(0.0, 1.0 - rho * rho));
-  const bool bumps = fx.bump_rate > 0.0 && fx.bump_sigma > 0.0;
-  double to_bump[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-  if (bumps) {
-    to_bump[0] = bump_rng.Exponential() / fx.bump_rate;
-    to_bump[1] = bump_rng.Exponential() / fx.bump_rate;
-  }
+  WheelDisturbance disturbance(truth, seed, run_index);
   const double slide_cos = std::cos(fx.slope_dir), slide_sin = std::sin(fx.slope_dir);
 
   double commanded[2] = {0.0, 0.0};
@@ -177,23 +278,7 @@ SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::
         const double asym = dp[w] < 0.0 ? 1.0 + fx.asymmetry_a : 1.0;
         travel[w] = dp[w] * true_per_tick[w] * asym;
       }
-      // Wheel noise (eq. 4) with left/right correlation rho.
-      const double z0 = wheel_rng.Next(), z1 = wheel_rng.Next();
-      const double mean_abs[2] = {std::abs(travel[0]), std::abs(travel[1])};
-      travel[0] += k_wheel[0] * std::sqrt(mean_abs[0]) * z0;
-      travel[1] += k_wheel[1] * std::sqrt(mean_abs[1]) * (rho * z0 + rho_c * z1);
-      if (bumps) {
-        for (int w = 0; w < 2; ++w) {
-          double left_to_roll = mean_abs[w];
-          while (to_bump[w] <= left_to_roll) {
-            travel[w] += fx.bump_sigma * bump_rng.Next();
-            left_to_roll -= to_bump[w];
-            to_bump[w] = bump_rng.Exponential() / fx.bump_rate;
-            (w == 0 ? out.bumps_left : out.bumps_right) += 1;
-          }
-          to_bump[w] -= left_to_roll;
-        }
-      }
+      disturbance.Apply(travel, out);
       StepRecord s;
       s.ta = ta;
       s.tb = tb;
@@ -223,48 +308,8 @@ SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::
   }
   record_samples_upto(ts.back());
 
-  // Pose at any time (time_offset): the step containing it, partially
-  // executed; the start pose before the first step, the last pose after it.
-  auto pose_at = [&](double time) -> Pose2 {
-    if (steps.empty() || time < steps.front().ta) return Pose2{};
-    auto it = std::upper_bound(steps.begin(), steps.end(), time,
-                               [](double v, const StepRecord& s) { return v < s.ta; });
-    const StepRecord& s = *(it - 1);
-    if (time >= s.tb || s.tb <= s.ta) return s.end;
-    const double f = (time - s.ta) / (s.tb - s.ta);
-    return AdvancePose(s.start, f * s.left_m, f * s.right_m, truth.true_wheelbase_m, s.heading_factor,
-                       f * s.slide_x_m, f * s.slide_y_m);
-  };
-
-  const std::size_t n = ts.size();
-  run.t_s = ts;
-  run.lines.assign(n, 0);
-  run.gt_x_m.resize(n);
-  run.gt_y_m.resize(n);
-  run.gt_theta_rad.resize(n);
-  if (truth.ticks) {
-    run.ticks_left.resize(n);
-    run.ticks_right.resize(n);
-  } else {
-    run.dist_left_m.resize(n);
-    run.dist_right_m.resize(n);
-  }
   out.true_pose = sample_pose;
-  for (std::size_t j = 0; j < n; ++j) {
-    if (truth.ticks) {
-      run.ticks_left[j] = static_cast<std::int64_t>(std::floor(sample_p[0][j]));
-      run.ticks_right[j] = static_cast<std::int64_t>(std::floor(sample_p[1][j]));
-    } else {
-      run.dist_left_m[j] = sample_p[0][j];
-      run.dist_right_m[j] = sample_p[1][j];
-    }
-    const Pose2 q = fx.time_tau != 0.0 ? pose_at(ts[j] - fx.time_tau) : sample_pose[j];
-    const double c = std::cos(q.theta), s = std::sin(q.theta);
-    const double nx = gt_rng.Next(), ny = gt_rng.Next(), nt = gt_rng.Next();
-    run.gt_x_m[j] = q.x + c * fx.gt_dx - s * fx.gt_dy + truth.gt_sigma_xy_m * nx;
-    run.gt_y_m[j] = q.y + s * fx.gt_dx + c * fx.gt_dy + truth.gt_sigma_xy_m * ny;
-    run.gt_theta_rad[j] = q.theta + fx.yaw_delta + truth.gt_sigma_theta_rad * nt;
-  }
+  WriteLog(ts, sample_pose, sample_p, steps, truth, gt_rng, run);
   return out;
 }
 

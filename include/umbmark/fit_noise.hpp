@@ -1,0 +1,8 @@
+// Public facade: maximum-likelihood fit of Chong & Kleeman's wheel noise
+// constants k_L, k_R from return errors or trajectories (docs/noise-model.md).
+//   NoiseRunsFromEndpoints / NoiseRunsFromTrajectories -> FitWheelNoise.
+#pragma once
+
+#include "error_models/wheel_noise_fit.hpp"
+#include "error_models/wheel_noise_fit_data.hpp"
+#include "umbmark/io.hpp"

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Installs the build in ${BUILD_DIR:-build} into a temporary prefix, builds
+# the consumer project tests/consumer against it (CMake package) and runs
+# it, compiles the same program with pkg-config's flags and runs that, and
+# builds the .deb with CPack, unpacks it and runs its binary.
+# Usage: check_install.sh   (after scripts/build.sh; exit 0 when both work)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BUILD_DIR=${BUILD_DIR:-build}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+cmake --install "$BUILD_DIR" --prefix "$tmp/prefix" >/dev/null
+test -x "$tmp/prefix/bin/umbmark"
+"$tmp/prefix/bin/umbmark" --version
+launcher=()
+if command -v ccache >/dev/null 2>&1; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+cmake -S tests/consumer -B "$tmp/consumer" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$tmp/prefix" \
+  "${launcher[@]}" >/dev/null
+cmake --build "$tmp/consumer" >/dev/null
+"$tmp/consumer/consumer" "$tmp/campaign-cmake"
+libdir=$(dirname "$(find "$tmp/prefix" -name umbmark.pc -print -quit)")
+PKG_CONFIG_PATH="$libdir" pkg-config --modversion umbmark
+# shellcheck disable=SC2046
+c++ -std=c++20 -O1 tests/consumer/main.cpp -o "$tmp/consumer-pc" $(PKG_CONFIG_PATH="$libdir" pkg-config --cflags --libs umbmark)
+"$tmp/consumer-pc" "$tmp/campaign-pkgconfig"
+# The Debian package: build it, unpack it (no root needed) and run the binary.
+(cd "$BUILD_DIR" && cpack -G DEB -B "$tmp/deb" >/dev/null)
+deb=$(find "$tmp/deb" -maxdepth 1 -name 'umbmark_*.deb' -print -quit)
+dpkg-deb --info "$deb" | grep -E '^ (Package|Version|Depends):'
+dpkg-deb -x "$deb" "$tmp/debroot"
+"$tmp/debroot/usr/bin/umbmark" --version
+echo "install: CMake package, pkg-config and .deb OK"
