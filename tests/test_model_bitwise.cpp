@@ -8,6 +8,7 @@
 #include <catch2/catch.hpp>
 
 #include <cstdint>
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <variant>
@@ -18,6 +19,7 @@
 #include "calibration/umbmark.hpp"
 #include "io/campaign_writer.hpp"
 #include "model/commanded_square.hpp"
+#include "model/true_robot.hpp"
 #include "simulation/campaign_sim.hpp"
 #include "simulation/monte_carlo_kernel.hpp"
 #include "simulation/monte_carlo_plan.hpp"
@@ -170,4 +172,31 @@ TEST_CASE("calibration's commanded square and corrections bit for bit as recorde
   h.Number(c.wheel_diameter_left_m);
   h.Number(c.wheel_diameter_right_m);
   CHECK(h.Hex() == "87ca8c106be72769");
+}
+
+TEST_CASE("true-robot model: correction factors, step and stop rule", "[model]") {
+  for (const double E_d : {0.98, 1.0, 1.0123}) {
+    // c_R / c_L = E_d and (c_L + c_R) / 2 = 1 (B&F eqs. 4.31, 4.32).
+    CHECK(CorrectionRight(E_d) / CorrectionLeft(E_d) == Approx(E_d).epsilon(1e-15));
+    CHECK(0.5 * (CorrectionLeft(E_d) + CorrectionRight(E_d)) == Approx(1.0).epsilon(1e-15));
+  }
+  const TrueRobot robot{1.01, 0.99, 0.02};
+  CHECK(robot.WheelFactorRight() / robot.WheelFactorLeft() == Approx(1.01).epsilon(1e-15));
+  CHECK(robot.Check().empty());
+  CHECK(TrueRobot{1.0, 0.0, 0.0}.Check().rfind("E_b", 0) == 0);
+  CHECK(TrueRobot{1.0, 1.0, -1.0}.Check().rfind("scale", 0) == 0);
+  // Heading factor 1: the kinematic arc step, bit for bit.
+  const Pose2 p{0.3, -0.2, 0.7};
+  const Pose2 a = TrueStep(p, 0.11, 0.13, 0.34, 1.0), b = DiffDriveStep(p, 0.11, 0.13, 0.34);
+  CHECK(a.x == b.x);
+  CHECK(a.y == b.y);
+  CHECK(a.theta == b.theta);
+  // Turn scrub k = 0.1: the heading change is 0.9 (r - l) / b.
+  CHECK(TrueStep(Pose2{}, -0.1, 0.1, 0.4, 0.9).theta == Approx(0.9 * 0.5).epsilon(1e-15));
+  // Stop rule: forward at T, backward at the top of tick T, else stay.
+  CHECK(EncoderStopPosition(318.0, 0.0, 0.4) == 318.0);
+  CHECK(EncoderStopPosition(5.0, 318.0, 318.0) == 6.0);
+  CHECK(EncoderStopPosition(5.0, 318.0, 318.0, kStopBelowTicks) < 6.0);
+  CHECK(std::floor(EncoderStopPosition(5.0, 318.0, 318.0, kStopBelowTicks)) == 5.0);
+  CHECK(EncoderStopPosition(7.0, 7.0, 7.25) == 7.25);
 }

@@ -189,7 +189,7 @@ void WriteLog(const std::vector<double>& ts, const std::vector<Pose2>& sample_po
 // pieces with state of their own (sample times, wheel disturbance, logger,
 // pose at any time) are the helpers above.
 SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::uint64_t seed, std::uint64_t run_index,
-                         const std::string& run_id, const std::string& direction) {
+                               const std::string& run_id, const std::string& direction) {
   const Effects& fx = truth.effects;
   if (!(truth.true_wheelbase_m > 0.0)) throw InvalidOptions("SimulateLoggedRun: true wheelbase must be > 0");
   const std::vector<double> ts = SampleTimes(plan);
