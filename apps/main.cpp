@@ -23,8 +23,8 @@
 #include "commands.hpp"
 #include "core/errors.hpp"
 #include "core/utf8.hpp"
-#include "umbmark/version.hpp"
 #include "io/atomic_write.hpp"
+#include "umbmark/version.hpp"
 
 namespace {
 

@@ -9,7 +9,7 @@
 
 #include "core/angles.hpp"
 #include "diagnosis/mean_fit.hpp"
-#include "diagnosis/parallel.hpp"
+#include "core/parallel_for.hpp"
 
 namespace umbmark::diag {
 
