@@ -10,6 +10,7 @@
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <tuple>
 #include <variant>
 
 #include <fmt/format.h>
@@ -43,7 +44,37 @@ struct FitNoiseOptions {
   std::string controller = "diff_drive_controller";
   OdometryCovarianceOptions covariance;
   JsonFlag json;
+  std::string params_json;            // --params CAL.json: the calibrated robot
+  std::string systematic = "none";    // none | estimate
 };
+
+/// The calibrated robot of a `calibrate --json` file: what --ros2 used
+/// (outputs_use), else the refined result, else the classic one.
+RobotParams CalibratedRobot(const std::string& path) {
+  const std::string text = io::ReadWholeFile(path);
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(path, 0, e.byte, fmt::format("not valid JSON: {}", e.what()));
+  }
+  const nlohmann::json* p = nullptr;
+  if (j.contains("outputs_use") && j["outputs_use"].contains("parameters")) p = &j["outputs_use"]["parameters"];
+  else if (j.contains("refined") && j["refined"].contains("parameters")) p = &j["refined"]["parameters"];
+  else if (j.contains("parameters")) p = &j["parameters"];
+  if (!p) throw InputError(path, "no `parameters` object (expected the JSON of `umbmark calibrate --json`)");
+  RobotParams r;
+  try {
+    r.wheelbase_m = p->at("wheelbase_m").get<double>();
+    r.wheel_diameter_left_m = p->at("wheel_diameter_left_m").get<double>();
+    r.wheel_diameter_right_m = p->at("wheel_diameter_right_m").get<double>();
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path, fmt::format("parameters: {}", e.what()));
+  }
+  if (!(r.wheelbase_m > 0.0) || !(r.wheel_diameter_left_m > 0.0) || !(r.wheel_diameter_right_m > 0.0))
+    throw InputError(path, "parameters must be positive");
+  return r;
+}
 
 struct Loaded {
   std::vector<WheelNoiseFitRun> runs;
@@ -51,11 +82,20 @@ struct Loaded {
   int skipped = 0;
   double sigma_xy = 0.0, sigma_theta = 0.0;
   std::optional<double> wheelbase_m;  ///< of the (last) robot read, for --ros2
+  bool ground_truth = false;  ///< trajectories or a manifest: the errors come from a ground-truth system
+  SystematicErrors systematic;  ///< what the runs were built with (last input)
 };
 
-NoiseFitInputOptions InputOptions(const FitNoiseOptions& o, const std::optional<GroundTruthNoise>& manifest_gt) {
+NoiseFitInputOptions InputOptions(const FitNoiseOptions& o, const std::optional<GroundTruthNoise>& manifest_gt,
+                                  const RobotParams& robot, const SystematicErrors& estimated) {
   NoiseFitInputOptions in;
   in.second_order = !o.first_order;
+  in.systematic = estimated;
+  if (!o.params_json.empty()) {
+    const RobotParams cal = CalibratedRobot(o.params_json);
+    in.systematic = {cal.wheelbase_m / robot.wheelbase_m, cal.wheel_diameter_left_m / robot.wheel_diameter_left_m,
+                     cal.wheel_diameter_right_m / robot.wheel_diameter_right_m};
+  }
   if (!o.meas_sigma.empty()) {
     if (o.meas_sigma.size() > 2) throw InvalidOptions("--meas-sigma takes SXY or SXY,STHETA");
     in.sigma_xy_m = o.meas_sigma[0];
@@ -78,11 +118,13 @@ void AppendTrajectoryRuns(const TrajectoryData& t, const RobotParams& robot, con
   out.runs.insert(out.runs.end(), runs.begin(), runs.end());
 }
 
-void AppendManifest(const std::string& path, const FitNoiseOptions& o, Loaded& out) {
+void AppendManifest(const std::string& path, const FitNoiseOptions& o, const SystematicErrors& sys, Loaded& out) {
   const Manifest m = io::ReadManifest(path);
   const RobotParams robot = o.robot.Resolve(m.robot);
   out.wheelbase_m = robot.wheelbase_m;
-  const NoiseFitInputOptions in = InputOptions(o, m.ground_truth);
+  const NoiseFitInputOptions in = InputOptions(o, m.ground_truth, robot, sys);
+  out.ground_truth = true;
+  out.systematic = in.systematic;
   out.sigma_xy = in.sigma_xy_m;
   out.sigma_theta = in.sigma_theta_rad;
   int index = 0;
@@ -116,22 +158,24 @@ void AppendManifest(const std::string& path, const FitNoiseOptions& o, Loaded& o
   }
 }
 
-Loaded Load(const FitNoiseOptions& o) {
+Loaded Load(const FitNoiseOptions& o, const SystematicErrors& sys = {}) {
   Loaded out;
   for (const std::string& path : o.inputs) {
     if (io::IsManifestPath(path)) {
-      AppendManifest(path, o, out);
+      AppendManifest(path, o, sys, out);
       continue;
     }
     const RobotParams robot = o.robot.Resolve();
     out.wheelbase_m = robot.wheelbase_m;
-    const NoiseFitInputOptions in = InputOptions(o, std::nullopt);
+    const NoiseFitInputOptions in = InputOptions(o, std::nullopt, robot, sys);
+    out.systematic = in.systematic;
     out.sigma_xy = in.sigma_xy_m;
     out.sigma_theta = in.sigma_theta_rad;
     const std::string prefix = o.inputs.size() > 1 ? path + ":" : "";
     io::RunFile rf = io::ReadRunFile(path);
     if (auto* t = std::get_if<TrajectoryData>(&rf)) {
       AppendTrajectoryRuns(*t, robot, prefix, in, out);
+      out.ground_truth = true;
     } else {
       if (!o.distance_m)
         throw InvalidOptions(path + " holds endpoint errors: give --distance D (each run drove D forward, then D back)");
@@ -203,15 +247,40 @@ int RunFitNoise(const FitNoiseOptions& o) {
   outs.AddOutput("--plot", o.plot);
   outs.AddOutput("--ros2", o.ros2);
   outs.Check();
+  if (!o.params_json.empty() && o.systematic == "estimate")
+    throw InvalidOptions("--params and --systematic estimate contradict each other (give one)");
   Loaded data = Load(o);
   if (data.runs.empty()) throw InputError(o.inputs.front(), "no run with ground truth at its start and end");
   WheelNoiseFitOptions fo;
   fo.restricted = o.reml;
   WheelNoiseFitSummary s;
+  std::optional<SystematicErrors> estimated;
   try {
-    s = FitWheelNoise(data.runs, fo);
+    if (o.systematic == "estimate") {
+      SystematicErrors e;
+      s = FitWheelNoiseWithSystematics([&](const SystematicErrors& x) { return Load(o, x).runs; }, fo, &e);
+      estimated = e;
+    } else {
+      s = FitWheelNoise(data.runs, fo);
+    }
   } catch (const InputError& e) {
     throw InputError(o.inputs.front(), e.message());
+  }
+  // k at its boundary 0: the data bound it from above only.
+  auto determined = [](double k, const std::array<double, 2>& ci) { return !(ci[0] <= 0.0 && k < 0.01 * ci[1]); };
+  const bool kL_det = determined(s.k_L, s.k_L_ci), kR_det = determined(s.k_R, s.k_R_ci);
+  std::vector<std::string> warnings;
+  if (data.ground_truth && data.sigma_xy == 0.0 && data.sigma_theta == 0.0) {
+    warnings.push_back(
+        "the reference noise is 0 although the return errors come from a ground-truth system: its noise is then read "
+        "as wheel noise and k comes out high; give --meas-sigma SXY,STHETA (or the manifest's [ground_truth])");
+  }
+  for (const auto& [name, det, ci] : {std::tuple{"k_L", kL_det, s.k_L_ci}, std::tuple{"k_R", kR_det, s.k_R_ci}}) {
+    if (!det) {
+      warnings.push_back(fmt::format("{} is not determined: the data put it at the boundary 0 and bound it above by "
+                                     "{:.3g} m^1/2 (95 %); more or longer runs would determine it",
+                                     name, ci[1]));
+    }
   }
 
   nlohmann::json gof = nlohmann::json::array();
@@ -251,11 +320,34 @@ int RunFitNoise(const FitNoiseOptions& o) {
                             {"observed_covariance", JsonMatrix(s.observed_covariance)},
                             {"predicted_covariance", JsonMatrix(s.predicted_covariance)},
                             {"inputs", data.sources}};
+  j["k_L_determined"] = kL_det;
+  j["k_R_determined"] = kR_det;
+  j["k_L_upper95"] = JsonNumber(s.k_L_ci[1]);
+  j["k_R_upper95"] = JsonNumber(s.k_R_ci[1]);
+  const SystematicErrors used = estimated ? *estimated : data.systematic;
+  j["systematic_errors"] = {{"source", estimated ? "estimated" : (o.params_json.empty() ? "none" : "params")},
+                             {"E_b", used.E_b},
+                             {"c_L", used.c_L},
+                             {"c_R", used.c_R},
+                             {"E_d", used.c_R / used.c_L}};
+  j["warnings"] = warnings;
   if (o.json.PrintText()) {
     fmt::print("fit-noise: {} runs in {} group(s){}\n", s.runs, s.groups.size(),
                data.skipped ? fmt::format(" ({} runs without ground truth at both ends skipped)", data.skipped) : "");
-    fmt::print("  k_L = {:.4g} m^1/2   95% interval [{:.4g}, {:.4g}]\n", s.k_L, s.k_L_ci[0], s.k_L_ci[1]);
-    fmt::print("  k_R = {:.4g} m^1/2   95% interval [{:.4g}, {:.4g}]\n", s.k_R, s.k_R_ci[0], s.k_R_ci[1]);
+    for (const auto& [name, k, det, ci] :
+         {std::tuple{"k_L", s.k_L, kL_det, s.k_L_ci}, std::tuple{"k_R", s.k_R, kR_det, s.k_R_ci}}) {
+      if (det) {
+        fmt::print("  {} = {:.4g} m^1/2   95% interval [{:.4g}, {:.4g}]\n", name, k, ci[0], ci[1]);
+      } else {
+        fmt::print("  {} not determined (at the boundary 0); 95% upper bound {:.4g} m^1/2\n", name, ci[1]);
+      }
+    }
+    if (estimated) {
+      fmt::print("  systematic errors estimated jointly: E_b = {:.5f}, E_d = {:.5f} (c_L {:.5f}, c_R {:.5f})\n",
+                 estimated->E_b, estimated->c_R / estimated->c_L, estimated->c_L, estimated->c_R);
+    } else if (!o.params_json.empty()) {
+      fmt::print("  systematic errors from {}\n", o.params_json);
+    }
     fmt::print("  reference noise per pose: {:.3g} m, {:.3g} rad; model: {} order{}\n", data.sigma_xy,
                data.sigma_theta, o.first_order ? "first" : "second", o.reml ? ", REML" : "");
     fmt::print("Systematic mean per group (ex [mm], ey [mm], etheta [mrad]):\n");
@@ -273,6 +365,9 @@ int RunFitNoise(const FitNoiseOptions& o) {
                  g.standard_error, g.z, g.runs, bad ? "  <- not explained by the model" : "");
     }
     if (flagged) fmt::print("  |z| > 3: the wheel noise model cannot explain that element (see docs/noise-model.md)\n");
+    for (const auto& w : warnings) fmt::print("  WARNING: {}\n", w);
+  } else {
+    for (const auto& w : warnings) fmt::print(stderr, "fit-noise: warning: {}\n", w);
   }
   if (!o.plot.empty()) CommandOutputs().Write(o.plot, PlotSvg(s));
   if (cov) {
@@ -326,6 +421,14 @@ Command SetupFitNoise(CLI::App& parent) {
   app->add_option("--speed", opts->covariance.speed_mps, "--ros2: driving speed the covariance is stated for [m/s]")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  app->add_option("--params", opts->params_json,
+                  "The robot's calibration (JSON of `calibrate --json`): the noise is propagated along the path the "
+                  "calibrated robot really drove, so uncorrected systematic errors do not bias k")
+      ->check(CLI::ExistingFile);
+  app->add_option("--systematic", opts->systematic,
+                  "none: the robot is calibrated (the odometry's path); estimate: estimate E_b, E_d jointly with k")
+      ->check(CLI::IsMember({"none", "estimate"}))
+      ->capture_default_str();
   opts->json.Bind(*app);
   return {app, [opts] { return RunFitNoise(*opts); }};
 }

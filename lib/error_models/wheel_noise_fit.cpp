@@ -313,8 +313,13 @@ WheelNoiseFitSummary FitWheelNoise(const std::vector<WheelNoiseFitRun>& runs, co
     }
     return ci;
   };
-  out.k_L_ci = interval(0);
-  out.k_R_ci = interval(1);
+  if (options.intervals) {
+    out.k_L_ci = interval(0);
+    out.k_R_ci = interval(1);
+  } else {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    out.k_L_ci = out.k_R_ci = {nan, nan};
+  }
 
   // 5. Residuals and goodness of fit at the optimum.
   std::vector<Eigen::Vector3d> mu;

@@ -36,6 +36,7 @@
 
 #include <Eigen/Core>
 
+#include "error_models/path_spec.hpp"
 #include "error_models/second_order.hpp"
 #include "error_models/wheel_noise.hpp"
 #include "core/pose2.hpp"
@@ -53,6 +54,12 @@ struct WheelNoiseFitRun {
   /// zero to fit the pure first-order model.
   SecondOrderBasis second_order;
   PoseCovariance measurement = PoseCovariance::Zero();  ///< reference error covariance M_i
+  /// What the odometry measured, per constant-curvature piece (left, right
+  /// wheel travel [m] under the recorded robot) and the recorded wheelbase:
+  /// lets EstimateSystematicErrors predict this run's systematic return
+  /// error. Empty when unknown.
+  std::vector<WheelSegment> odometry_travel;
+  double recorded_wheelbase_m = 0.0;
 };
 
 /// Covariance of the reference's error in a return error whose true
@@ -71,6 +78,9 @@ struct WheelNoiseFitOptions {
   /// S_i^-1) so the noise estimate allows for the degrees of freedom the
   /// group means use (ML underestimates k^2 by about groups / runs).
   bool restricted = false;
+  /// Compute the profile-likelihood intervals (the costly part). false:
+  /// k_L_ci, k_R_ci are left NaN (inner fits of a joint estimate).
+  bool intervals = true;
   /// Empty when valid, else a message naming the bad field.
   std::string Check() const;
 };

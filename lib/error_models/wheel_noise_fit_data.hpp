@@ -7,9 +7,12 @@
 //    return error from ground truth at the first and last sample
 //    (e = GT_end in the GT_start frame - odometry end, contract eq. 3.1).
 // Runs are grouped as `group_prefix + direction`; each group gets its own
-// systematic mean in the fit.
+// systematic mean in the fit. Trajectory runs labelled neither cw nor ccw
+// that turn by more than 1 rad get ":cw" or ":ccw" by the sign of their
+// odometry's total rotation (opposite directions, opposite means).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -20,13 +23,52 @@
 
 namespace umbmark {
 
+/// Systematic errors of the true robot relative to the recorded parameters
+/// (Borenstein & Feng's E_b and the per-wheel diameter factors c = D_true /
+/// D_recorded, which hold E_d = c_R / c_L and the scale).
+struct SystematicErrors {
+  double E_b = 1.0;
+  double c_L = 1.0, c_R = 1.0;
+};
+
 struct NoiseFitInputOptions {
   /// The reference's noise per measured pose (start and end each) [m, rad].
   double sigma_xy_m = 0.0;
   double sigma_theta_rad = 0.0;
   /// Include the second-order heading term (second_order.hpp).
   bool second_order = true;
+  /// The robot's systematic errors: the motion covariance is propagated
+  /// along the path the TRUE robot drove (wheel travel c times what the
+  /// odometry measured, wheelbase E_b b), not the odometry's path. An
+  /// uncorrected E_d or E_b bends the true path away from the odometry's and
+  /// rotates the covariance (on a 10 m back-and-forth, E_b = 1.03 turns the
+  /// way back by 5 deg): ignoring it biases k. Default: none (calibrated).
+  SystematicErrors systematic;
 };
+
+/// Systematic errors from the fitted systematic means of the groups
+/// (summary.group_means, summary.predicted_run_covariance): weighted least
+/// squares of each group's mean return error against the noise-free return
+/// error its runs' odometry travel predicts for a robot with errors
+/// (E_b, c_L, c_R) (exact arc integration), weights the inverse covariance of
+/// the group mean, a weak prior (sigma 0.05) towards 1 keeping directions the
+/// groups do not see (e.g. the scale on a closed path) at 1. Runs without
+/// odometry_travel are ignored; no such run: returns the identity.
+SystematicErrors EstimateSystematicErrors(const std::vector<WheelNoiseFitRun>& runs,
+                                          const WheelNoiseFitSummary& fit);
+
+/// k_L, k_R with the systematic errors estimated jointly: the means give
+/// (E_b, c_L, c_R) (EstimateSystematicErrors), then E_d = c_R / c_L is
+/// refined by maximising the likelihood of the run scatter (profiled over
+/// k_L, k_R and the group means; Brent within +-0.03 of the means' value):
+/// a path that retraces itself (forward and back) hides E_d from the mean
+/// return error, but its curvature still shapes the covariance. `build`
+/// turns systematic errors into fit runs (NoiseRunsFromEndpoints /
+/// NoiseRunsFromTrajectories with NoiseFitInputOptions::systematic).
+/// *estimated receives the errors used for the returned fit.
+WheelNoiseFitSummary FitWheelNoiseWithSystematics(
+    const std::function<std::vector<WheelNoiseFitRun>(const SystematicErrors&)>& build,
+    const WheelNoiseFitOptions& options, SystematicErrors* estimated);
 
 /// One run per endpoint row; `path` is what every run drove (wheelbase_m
 /// resolves turn segments). Rows without etheta use the x-y block.
