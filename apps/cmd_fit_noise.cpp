@@ -243,6 +243,7 @@ std::string PlotSvg(const WheelNoiseFitSummary& s) {
 int RunFitNoise(const FitNoiseOptions& o) {
   io::OutputSet& outs = CommandOutputs();
   RegisterInputs(o.inputs, &o.robot);
+  if (!o.params_json.empty()) outs.AddInput(o.params_json);
   outs.AddOutput("--json", o.json.path);
   outs.AddOutput("--plot", o.plot);
   outs.AddOutput("--ros2", o.ros2);

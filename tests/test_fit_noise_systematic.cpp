@@ -59,7 +59,7 @@ EndpointData Simulate(const std::vector<PathSegment>& spec, double E_d, double E
     const Pose2& t = truth[static_cast<std::size_t>(i)];
     const Pose2 end{t.x + sxy * N01(rng), t.y + sxy * N01(rng), t.theta + sth * N01(rng)};
     const Pose2 rel = RelativeTo(start, end);
-    EndpointRun r;
+    ReturnError r;
     r.run = std::to_string(i + 1);
     r.direction = direction;
     r.ex_m = rel.x - plan.odometry_final.x;
@@ -195,8 +195,13 @@ TEST_CASE("fit-noise CLI: k at the boundary is 'not determined'; --params and --
       sim::SimulateFinalPoses(plan, seed, 0, 60, truth.data());
       EndpointData e;
       for (std::size_t i = 0; i < truth.size(); ++i) {
-        e.runs.push_back({std::to_string(i + 1), "fwd_back", truth[i].x - plan.odometry_final.x,
-                          truth[i].y - plan.odometry_final.y, WrapAngle(truth[i].theta - plan.odometry_final.theta), 0});
+        ReturnError r;
+        r.run = std::to_string(i + 1);
+        r.direction = "fwd_back";
+        r.ex_m = truth[i].x - plan.odometry_final.x;
+        r.ey_m = truth[i].y - plan.odometry_final.y;
+        r.etheta_rad = WrapAngle(truth[i].theta - plan.odometry_final.theta);
+        e.runs.push_back(r);
       }
       const auto s = FitWheelNoise(NoiseRunsFromEndpoints(e, spec, kB, "", NoiseFitInputOptions{}));
       if (s.k_L > 1e-3 * s.k_L_ci[1]) continue;
