@@ -35,23 +35,37 @@ void EnsureOutDir(const std::string& out) {
   if (ec || !fs::is_directory(out)) throw InputError(out, "cannot create output directory: " + ec.message());
 }
 
+// Registers an import's inputs (each path, and every file of a folder) and
+// its two outputs, OUTDIR/runs.csv and OUTDIR/campaign.toml (plus --json),
+// with CommandOutputs(), and checks them before anything is read or written.
+struct CampaignPaths {
+  std::string runs, manifest;
+};
+CampaignPaths CheckImportOutputs(const std::vector<std::string>& inputs, const std::string& out, const JsonFlag& json) {
+  namespace fs = std::filesystem;
+  io::OutputSet& outs = CommandOutputs();
+  for (const auto& in : inputs) {
+    outs.AddInput(in);
+    std::error_code ec;
+    if (fs::is_directory(in, ec))
+      for (const auto& entry : fs::directory_iterator(in, ec)) outs.AddInput(entry.path().string());
+  }
+  CampaignPaths p{(fs::path(out) / "runs.csv").string(), (fs::path(out) / "campaign.toml").string()};
+  outs.AddOutput("--out", p.runs);
+  outs.AddOutput("--out", p.manifest);
+  outs.AddOutput("--json", json.path);
+  outs.Check();
+  return p;
+}
+
 int RunImportOptiOdom(const ImportOptions& o) {
   namespace fs = std::filesystem;
   std::optional<std::string> category;
   if (!o.category.empty()) category = o.category;
   // The output folder must not hold the dataset; the two files it gets must
   // not be other outputs.
+  const auto [runs_path, manifest_path] = CheckImportOutputs({o.dir}, o.out, o.json);
   io::OutputSet& outs = CommandOutputs();
-  outs.AddInput(o.dir);
-  if (fs::exists(o.dir)) {
-    for (const auto& entry : fs::directory_iterator(o.dir)) outs.AddInput(entry.path().string());
-  }
-  const std::string runs_path = (fs::path(o.out) / "runs.csv").string();
-  const std::string manifest_path = (fs::path(o.out) / "campaign.toml").string();
-  outs.AddOutput("--out", runs_path);
-  outs.AddOutput("--out", manifest_path);
-  outs.AddOutput("--json", o.json.path);
-  outs.Check();
   const io::OptiOdomDataset ds = io::ImportOptiOdom(o.dir, category);
 
   EnsureOutDir(o.out);
@@ -160,19 +174,8 @@ int RunRosbag2(Rosbag2Options o) {
   const RobotParams robot = o.robot.Resolve();
   // The recordings (and every file of a bag folder) are inputs; the two
   // files written must not be one of them or another output.
+  const auto [runs_path, manifest_path] = CheckImportOutputs(o.bags, o.out, o.json);
   io::OutputSet& outs = CommandOutputs();
-  for (const auto& bag : o.bags) {
-    outs.AddInput(bag);
-    std::error_code ec;
-    if (fs::is_directory(bag, ec))
-      for (const auto& entry : fs::directory_iterator(bag, ec)) outs.AddInput(entry.path().string());
-  }
-  const std::string runs_path = (fs::path(o.out) / "runs.csv").string();
-  const std::string manifest_path = (fs::path(o.out) / "campaign.toml").string();
-  outs.AddOutput("--out", runs_path);
-  outs.AddOutput("--out", manifest_path);
-  outs.AddOutput("--json", o.json.path);
-  outs.Check();
   const auto result = io::rosbag2::ImportRosbag2(o.bags, robot, opt);
 
   EnsureOutDir(o.out);
