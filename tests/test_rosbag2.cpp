@@ -395,3 +395,18 @@ TEST_CASE("Bad recordings: exit 1 naming the file and the byte offset or topic",
   // Nothing was written by any of these.
   CHECK_FALSE(fs::exists(dir / "out" / "runs.csv"));
 }
+
+TEST_CASE("metadata.yaml: file order, flow lists, rosbag2-compressed bags refused", "[rosbag2][metadata]") {
+  const fs::path dir = TempDir("rosbag2-meta");
+  Write(dir / "metadata.yaml",
+        "rosbag2_bagfile_information:\n  version: 5\n  relative_file_paths:\n  - b_1.mcap\n  - 'a_0.mcap'\n  storage_identifier: mcap\n");
+  CHECK(ReadMetadataFileList((dir / "metadata.yaml").string()) == std::vector<std::string>{"b_1.mcap", "a_0.mcap"});
+  Write(dir / "flow.yaml", "rosbag2_bagfile_information:\n  relative_file_paths: [x_0.db3, x_1.db3]\n");
+  CHECK(ReadMetadataFileList((dir / "flow.yaml").string()) == std::vector<std::string>{"x_0.db3", "x_1.db3"});
+  Write(dir / "zstd.yaml",
+        "rosbag2_bagfile_information:\n  compression_format: zstd\n  compression_mode: FILE\n  relative_file_paths:\n"
+        "  - talker_0.mcap.zstd\n");
+  CHECK_THROWS_WITH(ReadMetadataFileList((dir / "zstd.yaml").string()), Catch::Contains("ros2 bag decompress"));
+  Write(dir / "none.yaml", "rosbag2_bagfile_information:\n  version: 5\n");
+  CHECK_THROWS_AS(ReadMetadataFileList((dir / "none.yaml").string()), InputError);
+}

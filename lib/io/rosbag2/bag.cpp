@@ -83,6 +83,16 @@ std::vector<std::string> ReadMetadataFileList(const std::string& metadata_path) 
     }
   }
   if (!in_list) throw InputError(metadata_path, "no relative_file_paths list (is this a rosbag2 metadata.yaml?)");
+  // A bag recorded with --compression-mode file|message holds compressed
+  // files or messages: refuse it by name rather than misread it.
+  if (const auto at = text.find("compression_format:"); at != std::string::npos) {
+    const std::size_t eol = text.find('\n', at);
+    const std::string format = Trim(std::string_view(text).substr(at + 19, eol == std::string::npos ? std::string::npos : eol - at - 19));
+    if (!format.empty()) {
+      throw InputError(metadata_path, fmt::format("the bag is compressed by rosbag2 (compression_format: {}); run "
+                                                  "`ros2 bag decompress` (or `ros2 bag convert`) first", format));
+    }
+  }
   if (files.empty()) throw InputError(metadata_path, key_line, 0, "relative_file_paths lists no storage files");
   return files;
 }
