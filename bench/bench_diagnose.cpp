@@ -25,6 +25,9 @@
 //              correlated_noise rho +-0.5-0.9; parameter_drift r
 //              +-5e-5-5e-4 per run; gt_offset |(dx, dy)| 0.01-0.05 m in a
 //              random direction; time_offset tau +-0.02-0.1 s;
+//              standstill_motion sigma_xy, sigma_theta 2-10 mm / mrad;
+//              motion_noise_floor sigma 2-10 mm; run_time_offset tau_sd
+//              0.02-0.1 s;
 //   outside    gt_yaw_misalignment delta +-0.005-0.02 rad; floor_slope g
 //              0.002-0.01 m/m towards a random direction
 //
@@ -178,6 +181,12 @@ Case MakeCase(const std::string& truth, std::uint64_t seed, bool extended, doubl
         break;
       }
       case sim::EffectKind::kTimeOffset: fx.time_tau = Sign(g) * U(g, 0.02, 0.1); break;
+      case sim::EffectKind::kStandstillMotion:
+        fx.stand_sigma_xy = U(g, 0.002, 0.01);
+        fx.stand_sigma_theta = U(g, 0.002, 0.01);
+        break;
+      case sim::EffectKind::kMotionNoiseFloor: fx.floor_sigma = U(g, 0.002, 0.01); break;
+      case sim::EffectKind::kRunTimeOffset: fx.run_tau_sd = U(g, 0.02, 0.1); break;
       case sim::EffectKind::kGtYawMisalignment: fx.yaw_delta = Sign(g) * U(g, 0.005, 0.02); break;
       case sim::EffectKind::kFloorSlope:
         fx.slope_g = U(g, 0.002, 0.01);

@@ -454,7 +454,7 @@ TEST_CASE("umbmark diagnose: contract JSON, report, plot", "[diagnose][cli]") {
   CHECK(j["gap"]["where"].is_array());
   REQUIRE_FALSE(j["gap"]["where"].empty());
   for (const char* k : {"experiment", "subset", "statistic", "size_se"}) CHECK(j["gap"]["where"][0].contains(k));
-  REQUIRE(j["candidates"].size() == 9);
+  REQUIRE(j["candidates"].size() == 12);  // every contract effect
   for (const auto& cd : j["candidates"]) {
     CHECK(cd["effect"].is_string());
     CHECK(cd["params"].is_object());
@@ -531,4 +531,42 @@ TEST_CASE("diagnose: a significant but sub-millimetre marker offset is negligibl
   o.negligible = 0.0;
   d = Diagnose(Build(s), o);
   if (d.significant) CHECK(d.verdict == "gt_offset");
+}
+
+TEST_CASE("diagnose: standstill_motion is found, sigmas recovered", "[diagnose][new-effects]") {
+  Small s = MakeSmall(71);
+  s.sim.effects.stand_sigma_xy = 0.004;
+  s.sim.effects.stand_sigma_theta = 0.004;
+  const DiagnoseSummary d = Diagnose(Build(s), Fast());
+  INFO(d.verdict_reason);
+  CHECK(d.verdict == "standstill_motion");
+  const Candidate* c = Find(d, sim::EffectKind::kStandstillMotion);
+  REQUIRE(c);
+  // 20 runs x ~9 standstills: sigma within 25 %.
+  CHECK_THAT(c->params.at("sigma_xy"), WithinRel(0.004, 0.25));
+  CHECK_THAT(c->params.at("sigma_theta"), WithinRel(0.004, 0.25));
+}
+
+TEST_CASE("diagnose: motion_noise_floor is found, sigma recovered", "[diagnose][new-effects]") {
+  Small s = MakeSmall(72);
+  s.sim.effects.floor_sigma = 0.006;
+  const DiagnoseSummary d = Diagnose(Build(s), Fast());
+  INFO(d.verdict_reason);
+  CHECK(d.verdict == "motion_noise_floor");
+  const Candidate* c = Find(d, sim::EffectKind::kMotionNoiseFloor);
+  REQUIRE(c);
+  CHECK_THAT(c->params.at("sigma"), WithinRel(0.006, 0.3));
+}
+
+TEST_CASE("diagnose: run_time_offset is found, tau_sd recovered", "[diagnose][new-effects]") {
+  Small s = MakeSmall(73, 10, 20);
+  s.sim.effects.run_tau_sd = 0.05;
+  const DiagnoseSummary d = Diagnose(Build(s), Fast());
+  INFO(d.verdict_reason);
+  INFO(DiagnoseToJson(d).at("candidates").dump());
+  CHECK(d.verdict == "run_time_offset");
+  const Candidate* c = Find(d, sim::EffectKind::kRunTimeOffset);
+  REQUIRE(c);
+  // 40 runs: the sd of 40 draws is within ~25 % of tau_sd (3 sigma).
+  CHECK_THAT(c->params.at("tau_sd"), WithinRel(0.05, 0.35));
 }

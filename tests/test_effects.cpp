@@ -105,7 +105,7 @@ TEST_CASE("effects: spec parsing round-trips and rejects bad specs", "[effects]"
   Effects bad;
   bad.noise_rho = 1.5;
   CHECK_THAT(bad.Check(), Catch::Contains("correlated_noise.rho"));
-  CHECK(ContractEffects().size() == 9);
+  CHECK(ContractEffects().size() == 12);  // the contract's nine plus standstill_motion, motion_noise_floor, run_time_offset
 }
 
 TEST_CASE("simulate: nominal robot, no noise: ground truth follows the commanded path", "[effects]") {
@@ -434,4 +434,64 @@ TEST_CASE("castor_kick: no kick between motions back to back (no standstill), on
     const double sign = run.direction == "cw" ? -1.0 : 1.0;
     CHECK_THAT(Last(run).theta, WithinAbs(sign * 2.0 * kPi + kappa, 1e-9));
   }
+}
+
+TEST_CASE("standstill_motion: the pose moves only between a motion's end and the next start", "[effects]") {
+  // Noise-free robot: every ground-truth change while the encoders are still
+  // is the settling, drawn once per standstill (constant over it), with the
+  // stated spread over many standstills.
+  CampaignSimOptions o = Quiet(20);
+  o.effects.stand_sigma_xy = 0.004;
+  o.effects.stand_sigma_theta = 0.003;
+  const SimulatedCampaign c = SimulateCampaign(Campaign(true), o);
+  std::vector<double> dxy, dth;
+  for (const auto& run : Traj(c, 1).runs) {
+    for (std::size_t j = 1; j + 1 < run.size(); ++j) {
+      const bool still_before = run.ticks_left[j] == run.ticks_left[j - 1] && run.ticks_right[j] == run.ticks_right[j - 1];
+      const bool still_after = run.ticks_left[j + 1] == run.ticks_left[j] && run.ticks_right[j + 1] == run.ticks_right[j];
+      if (still_before && still_after) {
+        // Inside a standstill the pose does not move.
+        CHECK_THAT(run.gt_x_m[j + 1] - run.gt_x_m[j], WithinAbs(0.0, 1e-12));
+        CHECK_THAT(run.gt_theta_rad[j + 1] - run.gt_theta_rad[j], WithinAbs(0.0, 1e-12));
+      }
+    }
+    // The back-and-forth's far standstill: the robot-frame displacement
+    // beyond the commanded leg is the settling.
+    const Pose2 far = At(run, FarPauseTime(o));
+    dxy.push_back(far.y);
+    dth.push_back(far.theta);
+  }
+  auto sd = [](const std::vector<double>& v) {
+    double s = 0.0;
+    for (double x : v) s += x * x;
+    return std::sqrt(s / static_cast<double>(v.size()));
+  };
+  // 20 draws: the sample sd within 40 % of sigma.
+  CHECK_THAT(sd(dxy), WithinRel(0.004, 0.4));
+  CHECK_THAT(sd(dth), WithinRel(0.003, 0.4));
+}
+
+TEST_CASE("run_time_offset: each run's ground truth lags by its own tau_i", "[effects]") {
+  CampaignSimOptions o = Quiet(10);
+  o.effects.run_tau_sd = 0.05;
+  CampaignSimOptions plain = o;
+  plain.effects.run_tau_sd = 0.0;
+  const SimulatedCampaign c = SimulateCampaign(Campaign(false), o), c0 = SimulateCampaign(Campaign(false), plain);
+  std::vector<double> taus;
+  const auto& runs = Traj(c, 1).runs;
+  const auto& runs0 = Traj(c0, 1).runs;
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    // In the forward leg at constant speed v the lag shows as x(t) = x0(t - tau_i).
+    const double v = o.speed_m_s, t_mid = o.pause_s + 0.5 * kDist / v;
+    const double lag = (At(runs0[r], t_mid).x - At(runs[r], t_mid).x) / v;
+    taus.push_back(lag);
+  }
+  double m = 0.0, s = 0.0;
+  for (double t : taus) m += t;
+  m /= static_cast<double>(taus.size());
+  for (double t : taus) s += (t - m) * (t - m);
+  s = std::sqrt(s / static_cast<double>(taus.size() - 1));
+  CHECK(std::abs(m) < 3.0 * 0.05 / std::sqrt(10.0));
+  CHECK_THAT(s, WithinRel(0.05, 0.5));
+  CHECK(s > 0.0);
 }

@@ -45,6 +45,37 @@ double TypicalMagnitude(int param) {
   }
 }
 
+bool IsNoiseEffect(sim::EffectKind k) {
+  return k == sim::EffectKind::kCorrelatedNoise || k == sim::EffectKind::kBumpOutliers ||
+         k == sim::EffectKind::kStandstillMotion || k == sim::EffectKind::kMotionNoiseFloor ||
+         k == sim::EffectKind::kRunTimeOffset;
+}
+
+void EnableNoiseEffect(sim::EffectKind k, PieceNoiseFitOptions& o) {
+  if (k == sim::EffectKind::kCorrelatedNoise) o.correlated = true;
+  if (k == sim::EffectKind::kStandstillMotion) o.standstill = true;
+  if (k == sim::EffectKind::kMotionNoiseFloor) o.motion_floor = true;
+  if (k == sim::EffectKind::kRunTimeOffset) o.run_time = true;
+}
+
+std::map<std::string, double> NoiseEffectParams(sim::EffectKind k, const NoiseParams& n) {
+  switch (k) {
+    case sim::EffectKind::kCorrelatedNoise: return {{"rho", n.rho()}};
+    case sim::EffectKind::kBumpOutliers: return {{"rate", n.bump_rate}, {"sigma", std::sqrt(n.bump_s2)}};
+    case sim::EffectKind::kStandstillMotion:
+      return {{"sigma_xy", std::sqrt(n.stand_xy2)}, {"sigma_theta", std::sqrt(n.stand_th2)}};
+    case sim::EffectKind::kMotionNoiseFloor: return {{"sigma", std::sqrt(n.floor_s2)}};
+    case sim::EffectKind::kRunTimeOffset: return {{"tau_sd", std::sqrt(n.run_tau2)}};
+    default: return {};
+  }
+}
+
+int EffectParameterCount(sim::EffectKind k) {
+  if (k == sim::EffectKind::kBumpOutliers || k == sim::EffectKind::kStandstillMotion) return 2;
+  if (IsNoiseEffect(k)) return 1;
+  return static_cast<int>(EffectParams(k).size());
+}
+
 double Gap(double score, double null_median) { return std::max(0.0, score - null_median); }
 
 double Shrink(double after, double before) { return before > 0.0 ? std::max(-1.0, 1.0 - after / before) : 0.0; }
@@ -189,23 +220,23 @@ void FitMeanEffect(const Shared& x, sim::EffectKind kind, const std::vector<int>
 /// correlated_noise or bump_outliers on the baseline's residuals.
 void FitNoiseEffect(const Shared& x, sim::EffectKind kind, Candidate& cd) {
   const CampaignData& c = x.c;
-  const bool corr = kind == sim::EffectKind::kCorrelatedNoise;
-  cd.parameters = corr ? 1 : 2;
+  // Gaussian noise effects (a variance component each); bump_outliers is
+  // a mixture with its own fit.
+  const bool corr = kind != sim::EffectKind::kBumpOutliers;
+  cd.parameters = EffectParameterCount(kind);
   cd.E_d = x.b.p[kParamEd];
   cd.E_b = x.b.p[kParamEb];
   PieceNoiseFitOptions cf = x.b.noise_fit;
-  cf.correlated = true;
+  EnableNoiseEffect(kind, cf);
   PieceNoiseFitOptions cf_fold = x.fold_fit;
-  cf_fold.correlated = true;
+  EnableNoiseEffect(kind, cf_fold);
   const NoiseParams ne = corr ? FitPieceNoise(x.b.eps, x.b.bases, c.pieces, {}, x.b.noise, cf)
                               : FitBumps(x.b.eps, x.b.bases, c.pieces, {}, x.b.noise);
-  if (corr) {
-    cd.params["rho"] = ne.rho();
-    LikelihoodRatioTest(cd, TotalLogLik(c, x.b.bases, x.b.eps, ne), x.ll_base);
-  } else {
-    cd.params["rate"] = ne.bump_rate;
-    cd.params["sigma"] = std::sqrt(ne.bump_s2);
-  }
+  cd.params = NoiseEffectParams(kind, ne);
+  // A variance at its boundary 0 under the baseline: Wilks' chi^2 is
+  // conservative there (the true null is a 50:50 mixture), so the test
+  // keeps its level.
+  if (corr) LikelihoodRatioTest(cd, TotalLogLik(c, x.b.bases, x.b.eps, ne), x.ll_base);
   const GapSummary ga = ComputeGap(c, PieceScores(x.b.eps, x.b.bases, c.pieces, ne), x.options.gap);
   cd.gap_after = ga.score;
   cd.gap_by_kind = ga.by_kind;
@@ -256,7 +287,7 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
       cd.parameters = static_cast<int>(eparams.size());
       if (!Identify(x, eparams, cd, out.projected[ei])) return;
       FitMeanEffect(x, kind, eparams, cd);
-    } else if (kind == sim::EffectKind::kCorrelatedNoise || kind == sim::EffectKind::kBumpOutliers) {
+    } else if (IsNoiseEffect(kind)) {
       FitNoiseEffect(x, kind, cd);
     } else {
       cd.identifiable = false;

@@ -16,6 +16,7 @@
 #include "diagnosis/baseline.hpp"
 #include "diagnosis/cross_validation.hpp"
 #include "diagnosis/gap_stats.hpp"
+#include "diagnosis/piece_noise.hpp"
 #include "simulation/effects.hpp"
 
 namespace umbmark::diag {
@@ -49,6 +50,18 @@ struct Candidate {
 
 /// Mean-model parameters of an effect (empty for the noise effects).
 std::vector<int> EffectParams(sim::EffectKind k);
+
+/// The effects the piece noise model carries (piece_noise.hpp):
+/// correlated_noise, bump_outliers, standstill_motion, motion_noise_floor,
+/// run_time_offset.
+bool IsNoiseEffect(sim::EffectKind k);
+/// Switches on the variance component(s) of a Gaussian noise effect (not
+/// bump_outliers, which has its own mixture fit).
+void EnableNoiseEffect(sim::EffectKind k, PieceNoiseFitOptions& o);
+/// Contract parameters of a noise effect from fitted noise parameters.
+std::map<std::string, double> NoiseEffectParams(sim::EffectKind k, const NoiseParams& n);
+/// Parameters an effect adds.
+int EffectParameterCount(sim::EffectKind k);
 
 /// gap = max(0, G - G0): what the model's own noise does not produce.
 double Gap(double score, double null_median);

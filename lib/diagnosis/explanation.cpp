@@ -31,14 +31,13 @@ SetFit FitSet(const CampaignData& c, const MeanModel& model, const BaselineFit& 
   std::vector<int> params = BaselineParams();
   for (sim::EffectKind e : set)
     for (int k : EffectParams(e)) params.push_back(k);
-  const bool corr = Contains(set, sim::EffectKind::kCorrelatedNoise);
   const bool bumps = Contains(set, sim::EffectKind::kBumpOutliers);
   const bool scrub = Contains(set, sim::EffectKind::kTurnScrub);
   const MeanFit mf = FitMean(model, b.p, params, b.W, MeanFitOptions{12});
   // turn_scrub changes the spot turns' noise bases too (candidates.cpp).
   const std::vector<PieceBases> bases = scrub ? ComputeBases(c, model, mf.p) : b.bases;
   PieceNoiseFitOptions nf = b.noise_fit;
-  nf.correlated = corr;
+  for (sim::EffectKind e : set) EnableNoiseEffect(e, nf);
   SetFit out;
   out.p = mf.p;
   // Bumps and rho together: the bump mixture (its fit has no rho).
@@ -59,22 +58,10 @@ SetFit FitSet(const CampaignData& c, const MeanModel& model, const BaselineFit& 
   return out;
 }
 
-int Parameters(sim::EffectKind e) {
-  if (e == sim::EffectKind::kCorrelatedNoise) return 1;
-  if (e == sim::EffectKind::kBumpOutliers) return 2;
-  return static_cast<int>(EffectParams(e).size());
-}
-
 std::map<std::string, double> ParamsOf(sim::EffectKind e, const SetFit& f) {
+  if (IsNoiseEffect(e)) return NoiseEffectParams(e, f.noise);
   std::map<std::string, double> out;
-  if (e == sim::EffectKind::kCorrelatedNoise) {
-    out["rho"] = f.noise.rho();
-  } else if (e == sim::EffectKind::kBumpOutliers) {
-    out["rate"] = f.noise.bump_rate;
-    out["sigma"] = std::sqrt(f.noise.bump_s2);
-  } else {
-    for (int k : EffectParams(e)) out[ParamName(k)] = f.p[k];
-  }
+  for (int k : EffectParams(e)) out[ParamName(k)] = f.p[k];
   return out;
 }
 
@@ -106,8 +93,8 @@ PieceScatter Scatter(const CampaignData& c, const BaselineFit& b) {
 }
 
 /// Practical size of effect e within the joint fit f (see explanation.hpp).
-void Size(const CampaignData& c, const MeanModel& model, const PieceScatter& noise, const SetFit& f,
-          sim::EffectKind e, ExplanationStep& s) {
+void Size(const CampaignData& c, const MeanModel& model, const std::vector<PieceBases>& bases,
+          const PieceScatter& noise, const SetFit& f, sim::EffectKind e, ExplanationStep& s) {
   const double kL2 = f.noise.kL2, kR2 = f.noise.kR2, kbar2 = 0.5 * (kL2 + kR2);
   if (e == sim::EffectKind::kCorrelatedNoise) {
     const double ratio = kbar2 > 0.0 ? f.noise.c_LR / kbar2 : 0.0;
@@ -116,6 +103,31 @@ void Size(const CampaignData& c, const MeanModel& model, const PieceScatter& noi
   }
   if (e == sim::EffectKind::kBumpOutliers) {
     s.relative_size = kbar2 > 0.0 ? std::sqrt(1.0 + f.noise.bump_rate * f.noise.bump_s2 / kbar2) - 1.0 : 1.0;
+    return;
+  }
+  if (IsNoiseEffect(e)) {
+    // Variance components: how much they widen the noise of the pieces
+    // they act on (median over those pieces of the relative growth of the
+    // position and heading standard deviations, the larger counts), and
+    // their own standard deviation there [mm, mrad].
+    NoiseParams without = f.noise;
+    if (e == sim::EffectKind::kStandstillMotion) without.stand_xy2 = without.stand_th2 = 0.0;
+    if (e == sim::EffectKind::kMotionNoiseFloor) without.floor_s2 = 0.0;
+    if (e == sim::EffectKind::kRunTimeOffset) without.run_tau2 = 0.0;
+    std::vector<double> rel, pos, head;
+    for (std::size_t j = 0; j < bases.size(); ++j) {
+      const Eigen::Matrix3d A = PieceCovariance(bases[j], f.noise), B0 = PieceCovariance(bases[j], without);
+      const double dp = A(0, 0) + A(1, 1) - B0(0, 0) - B0(1, 1), dh = A(2, 2) - B0(2, 2);
+      if (!(dp > 0.0 || dh > 0.0)) continue;
+      const double rp = std::sqrt((A(0, 0) + A(1, 1)) / std::max(B0(0, 0) + B0(1, 1), 1e-300)) - 1.0;
+      const double rh = std::sqrt(A(2, 2) / std::max(B0(2, 2), 1e-300)) - 1.0;
+      rel.push_back(std::max(rp, rh));
+      pos.push_back(std::sqrt(std::max(dp, 0.0)));
+      head.push_back(std::sqrt(std::max(dh, 0.0)));
+    }
+    s.relative_size = Median(rel);
+    s.size_mm = 1e3 * Median(pos);
+    s.size_mrad = 1e3 * Median(head);
     return;
   }
   ParamVector without = f.p;
@@ -207,7 +219,7 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
     std::size_t best = 0;
     double best_evidence = -1e300;
     for (std::size_t i = 0; i < remaining.size(); ++i) {
-      const double ev = trial[i].cv_loglik - current.cv_loglik - options.complexity_penalty_nats * Parameters(remaining[i]);
+      const double ev = trial[i].cv_loglik - current.cv_loglik - options.complexity_penalty_nats * EffectParameterCount(remaining[i]);
       if (ev > best_evidence) {
         best_evidence = ev;
         best = i;
@@ -222,7 +234,7 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
   ex.gap_left = current.gap_after > null_quantile;
   const PieceScatter scatter = Scatter(c, b);
   for (ExplanationStep& s : ex.steps) {
-    Size(c, model, scatter, current, s.effect, s);
+    Size(c, model, b.bases, scatter, current, s.effect, s);
     s.negligible = s.relative_size < options.negligible;
   }
   return ex;

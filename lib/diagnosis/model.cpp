@@ -223,6 +223,18 @@ std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanMod
   const double b_turn = b_plain / (1.0 - p[kParamScrub]);
   const double E_d = p[kParamEd];
   const double c_L = 2.0 / (E_d + 1.0), c_R = 2.0 * E_d / (E_d + 1.0);
+  // run_time_offset's levers: d eps / d tau on either side of p's tau. The
+  // pose is not smooth in time where a motion starts or stops (a lag shows
+  // the motion, a lead the standstill), so with tau_i symmetric about 0 the
+  // second moment is tau_sd^2 (J+ J+^T + J- J-^T) / 2.
+  constexpr double kTauStep = 1e-3;  // s
+  std::vector<double> eps0, eps_plus, eps_minus;
+  model.Residuals(p, eps0);
+  ParamVector pt = p;
+  pt[kParamTau] = p[kParamTau] + kTauStep;
+  model.Residuals(pt, eps_plus);
+  pt[kParamTau] = p[kParamTau] - kTauStep;
+  model.Residuals(pt, eps_minus);
   for (std::size_t j = 0; j < campaign.pieces.size(); ++j) {
     const Piece& pc = campaign.pieces[j];
     const DiagRun& r = campaign.runs[pc.run];
@@ -288,6 +300,20 @@ std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanMod
     B.A_R = P_R;
     B.A_LR = P_LR;
     B.Q = P_Q;
+    if (!first_moving && !r.endpoint) {
+      if (pc.starts_from_standstill) B.F += 0.5 * M_start * M_start.transpose();
+      if (pc.ends_at_standstill) B.F += 0.5 * G_last * G_last.transpose();
+    }
+    if (pc.ends_at_standstill) {
+      B.S_xy = Eigen::Vector3d(1.0, 1.0, 0.0).asDiagonal();
+      B.S_theta(2, 2) = 1.0;
+    }
+    Eigen::Vector3d jp, jm;
+    for (int k = 0; k < 3; ++k) {
+      jp[k] = (eps_plus[3 * j + k] - eps0[3 * j + k]) / kTauStep;
+      jm[k] = (eps0[3 * j + k] - eps_minus[3 * j + k]) / kTauStep;
+    }
+    if (jp.allFinite() && jm.allFinite()) B.T = 0.5 * (jp * jp.transpose() + jm * jm.transpose());
     // Ground-truth noise at both ends, each averaged over its samples.
     const double wa = pc.a_weight, wb = pc.b_weight;
     B.G_xy = Eigen::Vector3d(wa + wb, wa + wb, 0.0).asDiagonal();

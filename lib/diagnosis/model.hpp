@@ -100,6 +100,16 @@ struct PieceBases {
   Eigen::Matrix<double, 3, 2> quant_start = Eigen::Matrix<double, 3, 2>::Zero();
   Eigen::Matrix<double, 3, 2> quant_end = Eigen::Matrix<double, 3, 2>::Zero();
   double travel_left_m = 0.0, travel_right_m = 0.0;  ///< sum of |wheel travel| (bumps)
+  /// motion_noise_floor: sigma^2 F is the covariance of a motion's start /
+  /// stop slip (half the variance at each end) on this piece.
+  Eigen::Matrix3d F = Eigen::Matrix3d::Zero();
+  /// standstill_motion: sigma_xy^2 S_xy + sigma_theta^2 S_theta when the
+  /// piece ends where the robot settles (isotropic in position, any frame).
+  Eigen::Matrix3d S_xy = Eigen::Matrix3d::Zero(), S_theta = Eigen::Matrix3d::Zero();
+  /// run_time_offset: tau_sd^2 T, T = (J+ J+^T + J- J-^T) / 2 with J+-
+  /// = d eps / d tau on either side (the pieces of a run share tau_i;
+  /// their correlation is left out).
+  Eigen::Matrix3d T = Eigen::Matrix3d::Zero();
 };
 
 /// Bases of every piece, along the path predicted for `p` (the shape of a

@@ -19,7 +19,8 @@ double NoiseParams::rho() const {
 }
 
 Eigen::Matrix3d PieceCovariance(const PieceBases& B, const NoiseParams& n) {
-  return n.kL2 * B.A_L + n.kR2 * B.A_R + n.c_LR * B.A_LR + n.sxy2 * B.G_xy + n.sth2 * B.G_theta + B.Q;
+  return n.kL2 * B.A_L + n.kR2 * B.A_R + n.c_LR * B.A_LR + n.sxy2 * B.G_xy + n.sth2 * B.G_theta + B.Q +
+         n.floor_s2 * B.F + n.stand_xy2 * B.S_xy + n.stand_th2 * B.S_theta + n.run_tau2 * B.T;
 }
 
 BumpMixture PieceMixture(const PieceBases& B, const NoiseParams& n) {
@@ -79,9 +80,11 @@ double GaussLogPdf(const double* eps, int d, const Eigen::Matrix3d& C) {
 bool Used(const std::vector<char>& use, std::size_t j) { return use.empty() || use[j] != 0; }
 
 
-struct Component {
-  int param;  // 0 kL2, 1 kR2, 2 c, 3 sxy2, 4 sth2
-};
+/// Variance components: 0 kL2, 1 kR2, 2 c, 3 sxy2, 4 sth2, 5 floor_s2,
+/// 6 stand_xy2, 7 stand_th2, 8 run_tau2.
+constexpr int kComponents = 9;
+using ScoreVec = Eigen::Matrix<double, kComponents, 1>;
+using InfoMat = Eigen::Matrix<double, kComponents, kComponents>;
 
 double& Slot(NoiseParams& n, int m) {
   switch (m) {
@@ -89,7 +92,11 @@ double& Slot(NoiseParams& n, int m) {
     case 1: return n.kR2;
     case 2: return n.c_LR;
     case 3: return n.sxy2;
-    default: return n.sth2;
+    case 4: return n.sth2;
+    case 5: return n.floor_s2;
+    case 6: return n.stand_xy2;
+    case 7: return n.stand_th2;
+    default: return n.run_tau2;
   }
 }
 
@@ -99,7 +106,11 @@ const Eigen::Matrix3d& Basis(const PieceBases& B, int m) {
     case 1: return B.A_R;
     case 2: return B.A_LR;
     case 3: return B.G_xy;
-    default: return B.G_theta;
+    case 4: return B.G_theta;
+    case 5: return B.F;
+    case 6: return B.S_xy;
+    case 7: return B.S_theta;
+    default: return B.T;
   }
 }
 
@@ -149,7 +160,7 @@ double Objective(const std::vector<double>& eps, const std::vector<PieceBases>& 
 /// residual components) for the active variance components.
 template <int D>
 void AccumulateFisher(const double* eps, const PieceBases& B, const NoiseParams& n, const std::vector<int>& active,
-                      Eigen::Matrix<double, 5, 1>& score, Eigen::Matrix<double, 5, 5>& info) {
+                      ScoreVec& score, InfoMat& info) {
   using Mat = Eigen::Matrix<double, D, D>;
   using Vec = Eigen::Matrix<double, D, 1>;
   const Mat C = PieceCovariance(B, n).template topLeftCorner<D, D>();
@@ -158,7 +169,7 @@ void AccumulateFisher(const double* eps, const PieceBases& B, const NoiseParams&
   for (int c = 0; c < D; ++c) e[c] = eps[c];
   const Vec u = Ci * e;
   const int p = static_cast<int>(active.size());
-  Mat M[5];
+  Mat M[kComponents];
   for (int a = 0; a < p; ++a) {
     const Mat Bm = Basis(B, active[a]).template topLeftCorner<D, D>();
     M[a] = Ci * Bm;
@@ -177,6 +188,10 @@ void Clamp(NoiseParams& n, const PieceNoiseFitOptions& o) {
   n.kR2 = std::max(n.kR2, o.min_k2);
   n.sxy2 = std::max(n.sxy2, o.min_sigma_xy2);
   n.sth2 = std::max(n.sth2, o.min_sigma_theta2);
+  n.floor_s2 = std::max(n.floor_s2, 0.0);
+  n.stand_xy2 = std::max(n.stand_xy2, 0.0);
+  n.stand_th2 = std::max(n.stand_th2, 0.0);
+  n.run_tau2 = std::max(n.run_tau2, 0.0);
   const double lim = 0.995 * std::sqrt(n.kL2 * n.kR2);
   n.c_LR = std::clamp(n.c_LR, -lim, lim);
 }
@@ -208,10 +223,28 @@ NoiseParams FitPieceNoiseOnce(const std::vector<double>& eps, const std::vector<
     active.push_back(3);
     active.push_back(4);
   }
-  const int p = static_cast<int>(active.size());
+  if (options.motion_floor) active.push_back(5);
+  if (options.standstill) {
+    active.push_back(6);
+    active.push_back(7);
+  }
+  if (options.run_time) active.push_back(8);
   NoiseParams n = start;
   n.bump_rate = n.bump_s2 = 0.0;
   if (!options.correlated) n.c_LR = 0.0;
+  if (!options.motion_floor) n.floor_s2 = 0.0;
+  if (!options.standstill) n.stand_xy2 = n.stand_th2 = 0.0;
+  if (!options.run_time) n.run_tau2 = 0.0;
+  // A component no used piece shows (no standstill in these runs, say)
+  // cannot be estimated: it stays at 0.
+  std::erase_if(active, [&](int m) {
+    if (m < 5) return false;
+    for (std::size_t j = 0; j < pieces.size(); ++j)
+      if (Used(use, j) && Basis(bases[j], m).trace() > 0.0) return false;
+    Slot(n, m) = 0.0;
+    return true;
+  });
+  const int p = static_cast<int>(active.size());
   Clamp(n, options);
 
   // Rough start: scale the fitted variances so the median chi^2 per piece
@@ -243,8 +276,8 @@ NoiseParams FitPieceNoiseOnce(const std::vector<double>& eps, const std::vector<
 
   double ll = options.line_search ? Objective(eps, bases, pieces, use, n) : 0.0;
   for (int it = 0; it < options.max_iterations; ++it) {
-    Eigen::Matrix<double, 5, 1> score = Eigen::Matrix<double, 5, 1>::Zero();
-    Eigen::Matrix<double, 5, 5> info = Eigen::Matrix<double, 5, 5>::Zero();
+    ScoreVec score = ScoreVec::Zero();
+    InfoMat info = InfoMat::Zero();
     for (std::size_t j = 0; j < pieces.size(); ++j) {
       if (!Used(use, j)) continue;
       if (pieces[j].components == 3)

@@ -37,6 +37,10 @@ struct NoiseParams {
   double sth2 = 1e-6;             ///< sigma_theta^2 [rad^2]
   double bump_rate = 0.0;         ///< per metre of wheel travel
   double bump_s2 = 0.0;           ///< sigma_b^2 [m^2]
+  double floor_s2 = 0.0;          ///< motion_noise_floor sigma^2 [m^2]
+  double stand_xy2 = 0.0;         ///< standstill_motion sigma_xy^2 [m^2]
+  double stand_th2 = 0.0;         ///< standstill_motion sigma_theta^2 [rad^2]
+  double run_tau2 = 0.0;          ///< run_time_offset tau_sd^2 [s^2]
 
   double rho() const;
 };
@@ -62,6 +66,9 @@ struct PieceNoiseFitOptions {
   bool fit_ground_truth = false;
   /// Estimate c = rho k_L k_R (correlated_noise).
   bool correlated = false;
+  /// Estimate motion_noise_floor's sigma^2, standstill_motion's sigma_xy^2
+  /// and sigma_theta^2, run_time_offset's tau_sd^2 (else held at 0).
+  bool motion_floor = false, standstill = false, run_time = false;
   int max_iterations = 60;
   /// Step halving on the likelihood (robust from a poor start); without it
   /// plain Fisher steps until the relative change is below `tolerance`

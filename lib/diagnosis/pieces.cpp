@@ -332,6 +332,14 @@ void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, co
     cur = joined_after ? std::max(*end, std::min(s1 + 2, g1)) : *end;
   }
   if (g1 > cur) add(cur, g1, PieceType::kStand, 0, false);
+  for (std::size_t j = first_piece; j < c.pieces.size(); ++j) {
+    Piece& p = c.pieces[j];
+    if (p.type == PieceType::kStand) continue;
+    const bool stand_before = j == first_piece || (c.pieces[j - 1].type == PieceType::kStand && c.pieces[j - 1].b == p.a);
+    p.starts_from_standstill = p.motion_first && stand_before;
+    p.ends_at_standstill =
+        j + 1 < c.pieces.size() && c.pieces[j + 1].type == PieceType::kStand && c.pieces[j + 1].a == p.b;
+  }
   if (!o.average_standstills) return;
   // Motions next to a true standstill (no wheel travel) are measured from /
   // to its mean ground-truth pose.

@@ -50,6 +50,11 @@ struct Piece {
   /// straight / arc: +1 forward, -1 backward; turn: +1 ccw, -1 cw; else 0.
   int sign = 0;
   bool motion_first = false;  ///< first piece of its motion
+  /// First piece of a motion that starts from standstill (or the run's
+  /// start), and last piece of a motion that ends at a standstill: where
+  /// motion_noise_floor's start / stop slip and standstill_motion's
+  /// settling show.
+  bool starts_from_standstill = false, ends_at_standstill = false;
   int components = 3;         ///< 2 for return errors without heading
   double travel_m = 0.0;      ///< nominal (|dL| + |dR|) / 2 over the piece
   /// Subsets the piece belongs to (CampaignData::subsets): its own, e.g.

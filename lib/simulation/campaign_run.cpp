@@ -147,10 +147,11 @@ Pose2 PoseAt(const std::vector<StepRecord>& steps, double time, double wheelbase
 
 /// What the logger writes at the sample times: encoder counts (or nominal
 /// travel) and ground truth with gt_offset, time_offset, gt_yaw_misalignment
-/// and measurement noise (from gt_rng).
+/// and measurement noise (from gt_rng); run_tau: this run's
+/// run_time_offset tau_i, added to time_offset's tau.
 void WriteLog(const std::vector<double>& ts, const std::vector<Pose2>& sample_pose,
               const std::vector<double> (&sample_p)[2], const std::vector<StepRecord>& steps, const RunTruth& truth,
-              NormalSource& gt_rng, TrajectoryRun& run) {
+              double run_tau, NormalSource& gt_rng, TrajectoryRun& run) {
   const Effects& fx = truth.effects;
   const std::size_t n = ts.size();
   run.t_s = ts;
@@ -173,7 +174,8 @@ void WriteLog(const std::vector<double>& ts, const std::vector<Pose2>& sample_po
       run.dist_left_m[j] = sample_p[0][j];
       run.dist_right_m[j] = sample_p[1][j];
     }
-    const Pose2 q = fx.time_tau != 0.0 ? PoseAt(steps, ts[j] - fx.time_tau, truth.true_wheelbase_m) : sample_pose[j];
+    const double shift = fx.time_tau + run_tau;
+    const Pose2 q = shift != 0.0 ? PoseAt(steps, ts[j] - shift, truth.true_wheelbase_m) : sample_pose[j];
     const double c = std::cos(q.theta), s = std::sin(q.theta);
     const double nx = gt_rng.Next(), ny = gt_rng.Next(), nt = gt_rng.Next();
     run.gt_x_m[j] = q.x + c * fx.gt_dx - s * fx.gt_dy + truth.gt_sigma_xy_m * nx;
@@ -196,6 +198,37 @@ SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::
 
   NormalSource gt_rng(StreamSeed(seed, run_index, kCampaignStreamGroundTruth));
   NormalSource phase_rng(StreamSeed(seed, run_index, kCampaignStreamPhase));
+  NormalSource stand_rng(StreamSeed(seed, run_index, kCampaignStreamStandstill));
+  NormalSource floor_rng(StreamSeed(seed, run_index, kCampaignStreamMotionFloor));
+  NormalSource run_time_rng(StreamSeed(seed, run_index, kCampaignStreamRunTime));
+  // run_time_offset: this run's tau_i.
+  const double run_tau = fx.run_tau_sd > 0.0 ? fx.run_tau_sd * run_time_rng.Next() : 0.0;
+  // A motion between two standstills: starts at the run's first move or
+  // after a pause that lasts; stops before such a pause (or the run's end).
+  std::vector<char> motion_starts(plan.motions.size(), 0), motion_stops(plan.motions.size(), 0);
+  {
+    bool still = true;
+    for (std::size_t k = 0; k < plan.motions.size(); ++k) {
+      const PlannedMotion& m = plan.motions[k];
+      if (m.pause) {
+        if (m.duration_s > 0.0) still = true;
+        continue;
+      }
+      motion_starts[k] = still;
+      still = false;
+      std::size_t q = k + 1;
+      while (q < plan.motions.size() && plan.motions[q].pause && !(plan.motions[q].duration_s > 0.0)) ++q;
+      motion_stops[k] = q == plan.motions.size() || plan.motions[q].pause;
+    }
+  }
+  // standstill_motion applies only when a standstill follows.
+  auto standstill_follows = [&](std::size_t k) {
+    for (std::size_t q = k + 1; q < plan.motions.size(); ++q) {
+      if (!plan.motions[q].pause) return false;
+      if (plan.motions[q].duration_s > 0.0) return true;
+    }
+    return false;
+  };
 
   SimulatedRun out;
   TrajectoryRun& run = out.run;
@@ -238,7 +271,8 @@ SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::
   record_samples_upto(0.0);
 
   double t = 0.0;
-  for (const PlannedMotion& m : plan.motions) {
+  for (std::size_t mk = 0; mk < plan.motions.size(); ++mk) {
+    const PlannedMotion& m = plan.motions[mk];
     const double t0 = t, t1 = t + m.duration_s;
     if (m.pause) {
       record_samples_upto(t1);
@@ -279,6 +313,15 @@ SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::
         travel[w] = dp[w] * true_per_tick[w] * asym;
       }
       disturbance.Apply(travel, out);
+      // motion_noise_floor: half its variance in the motion's first step,
+      // half in its last (start and stop slip).
+      if (fx.floor_sigma > 0.0) {
+        const bool first_step = motion_starts[mk] && ta == t0, last_step = motion_stops[mk] && last;
+        for (int w = 0; w < 2; ++w) {
+          if (first_step) travel[w] += fx.floor_sigma * std::sqrt(0.5) * floor_rng.Next();
+          if (last_step) travel[w] += fx.floor_sigma * std::sqrt(0.5) * floor_rng.Next();
+        }
+      }
       StepRecord s;
       s.ta = ta;
       s.tb = tb;
@@ -299,6 +342,19 @@ SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::
       if (last) {
         p[0] = p_end[0];
         p[1] = p_end[1];
+        // standstill_motion: the robot settles as the standstill begins (an
+        // instantaneous step, so every still sample shows it).
+        if ((fx.stand_sigma_xy > 0.0 || fx.stand_sigma_theta > 0.0) && motion_stops[mk] && standstill_follows(mk)) {
+          StepRecord nudge;
+          nudge.ta = nudge.tb = tb;
+          nudge.start = pose;
+          const double nx = fx.stand_sigma_xy * stand_rng.Next(), ny = fx.stand_sigma_xy * stand_rng.Next();
+          const double nt = fx.stand_sigma_theta * stand_rng.Next();
+          const double c = std::cos(pose.theta), sn = std::sin(pose.theta);
+          pose = {pose.x + c * nx - sn * ny, pose.y + sn * nx + c * ny, pose.theta + nt};
+          nudge.end = pose;
+          steps.push_back(nudge);
+        }
       }
       record_samples_upto(tb);
       if (last) break;
@@ -309,7 +365,7 @@ SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::
   record_samples_upto(ts.back());
 
   out.true_pose = sample_pose;
-  WriteLog(ts, sample_pose, sample_p, steps, truth, gt_rng, run);
+  WriteLog(ts, sample_pose, sample_p, steps, truth, run_tau, gt_rng, run);
   return out;
 }
 

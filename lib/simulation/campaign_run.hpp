@@ -62,6 +62,9 @@ enum CampaignStream : std::uint64_t {
   kCampaignStreamBumps = 102,
   kCampaignStreamGroundTruth = 103,
   kCampaignStreamPhase = 104,
+  kCampaignStreamStandstill = 105,
+  kCampaignStreamMotionFloor = 106,
+  kCampaignStreamRunTime = 107,
 };
 
 /// One commanded motion, or a pause.

@@ -38,6 +38,17 @@ const std::vector<EffectDescriptor>& EffectCatalogue() {
        "ground truth reports the point (dx, dy) of the robot frame instead of the axle midpoint"},
       {EffectKind::kTimeOffset, "time_offset", {{"tau", &Effects::time_tau, "s"}}, true,
        "a ground-truth sample stamped t shows the true pose at t - tau"},
+      {EffectKind::kStandstillMotion,
+       "standstill_motion",
+       {{"sigma_xy", &Effects::stand_sigma_xy, "m"}, {"sigma_theta", &Effects::stand_sigma_theta, "rad"}},
+       true,
+       "after every motion, while the encoders read still, the true pose moves by N(0, sigma_xy^2) m along each "
+       "robot axis and N(0, sigma_theta^2) rad in heading, independently per standstill"},
+      {EffectKind::kMotionNoiseFloor, "motion_noise_floor", {{"sigma", &Effects::floor_sigma, "m"}}, true,
+       "every motion between two standstills adds N(0, sigma^2) m to each wheel's true travel, independently of "
+       "its length"},
+      {EffectKind::kRunTimeOffset, "run_time_offset", {{"tau_sd", &Effects::run_tau_sd, "s"}}, true,
+       "in run i the ground truth stamped t shows the true pose at t - tau_i, tau_i ~ N(0, tau_sd^2) per run"},
       {EffectKind::kGtYawMisalignment, "gt_yaw_misalignment", {{"delta", &Effects::yaw_delta, "rad"}}, false,
        "(outside the contract) ground-truth heading = true heading + delta; position right"},
       {EffectKind::kFloorSlope,
@@ -95,6 +106,14 @@ std::string Effects::Check() const {
   if (!(std::abs(gt_dx) < 10.0 && std::abs(gt_dy) < 10.0))
     return fmt::format("gt_offset (dx, dy) = ({}, {}) must be within 10 m", gt_dx, gt_dy);
   if (!(std::abs(time_tau) < 10.0)) return fmt::format("time_offset.tau = {} must be in (-10, 10) s", time_tau);
+  if (!(stand_sigma_xy >= 0.0 && stand_sigma_xy < 1.0))
+    return fmt::format("standstill_motion.sigma_xy = {} must be in [0, 1) m", stand_sigma_xy);
+  if (!(stand_sigma_theta >= 0.0 && stand_sigma_theta < 0.5))
+    return fmt::format("standstill_motion.sigma_theta = {} must be in [0, 0.5) rad", stand_sigma_theta);
+  if (!(floor_sigma >= 0.0 && floor_sigma < 1.0))
+    return fmt::format("motion_noise_floor.sigma = {} must be in [0, 1) m", floor_sigma);
+  if (!(run_tau_sd >= 0.0 && run_tau_sd < 10.0))
+    return fmt::format("run_time_offset.tau_sd = {} must be in [0, 10) s", run_tau_sd);
   if (!(std::abs(yaw_delta) < 1.0))
     return fmt::format("gt_yaw_misalignment.delta = {} must be in (-1, 1) rad", yaw_delta);
   if (!(slope_g >= 0.0 && slope_g < 0.5)) return fmt::format("floor_slope.g = {} must be in [0, 0.5)", slope_g);

@@ -19,6 +19,17 @@
 //                                   robot frame instead of the axle midpoint
 //   time_offset         tau         a ground-truth sample stamped t shows the true
 //                                   pose at t - tau
+//   standstill_motion   sigma_xy,   after every motion, while the encoders read still,
+//                       sigma_theta the true pose moves by N(0, sigma_xy^2) m along each
+//                                   robot axis and N(0, sigma_theta^2) rad in heading
+//                                   (once per standstill; the simulator applies it as
+//                                   the standstill begins)
+//   motion_noise_floor  sigma       every motion between two standstills adds N(0,
+//                                   sigma^2) m to each wheel's true travel, whatever its
+//                                   length (the simulator: half the variance as the
+//                                   motion starts, half as it stops)
+//   run_time_offset     tau_sd      run i's ground truth stamped t shows the true pose
+//                                   at t - tau_i, tau_i ~ N(0, tau_sd^2) per run
 //
 // Two further effects are NOT in the contract; the blind validation benchmark
 // uses them as "outside" effects that no listed effect mimics, to check that
@@ -49,6 +60,9 @@ enum class EffectKind {
   kParameterDrift,
   kGtOffset,
   kTimeOffset,
+  kStandstillMotion,
+  kMotionNoiseFloor,
+  kRunTimeOffset,
   // Outside the contract (blind benchmark only).
   kGtYawMisalignment,
   kFloorSlope,
@@ -68,6 +82,10 @@ struct Effects {
   double gt_dx = 0.0;          ///< gt_offset.dx [m]
   double gt_dy = 0.0;          ///< gt_offset.dy [m]
   double time_tau = 0.0;       ///< time_offset.tau [s]
+  double stand_sigma_xy = 0.0;     ///< standstill_motion.sigma_xy [m]
+  double stand_sigma_theta = 0.0;  ///< standstill_motion.sigma_theta [rad]
+  double floor_sigma = 0.0;        ///< motion_noise_floor.sigma [m]
+  double run_tau_sd = 0.0;         ///< run_time_offset.tau_sd [s]
   double yaw_delta = 0.0;      ///< gt_yaw_misalignment.delta [rad] (outside)
   double slope_g = 0.0;        ///< floor_slope.g [m/m] (outside)
   double slope_dir = 0.0;      ///< floor_slope.dir [rad] (outside)
@@ -99,7 +117,7 @@ struct EffectDescriptor {
 
 /// All effects, contract ones first (in the contract's table order).
 const std::vector<EffectDescriptor>& EffectCatalogue();
-/// The contract's nine effects.
+/// The contract's twelve effects.
 std::vector<EffectKind> ContractEffects();
 const EffectDescriptor& Describe(EffectKind kind);
 const char* EffectToString(EffectKind kind);
