@@ -13,6 +13,7 @@
 #include "calibrate_plot.hpp"
 #include "calibration/calibrate_job.hpp"
 #include "calibration/heldout.hpp"
+#include "calibration/plausibility.hpp"
 #include "commands.hpp"
 #include "common.hpp"
 #include "core/angles.hpp"
@@ -263,9 +264,11 @@ void PrintResult(const CalibrateJobResult& r) {
              s.cw.x_cg_m * 1e3, s.cw.y_cg_m * 1e3, s.cw.r_cg_m * 1e3, s.cw.sigma_m * 1e3, s.cw.sem_m * 1e3);
   fmt::print("  centre of gravity ccw ({:+8.2f}, {:+8.2f}) mm  r = {:7.2f} mm  sigma {:6.2f} mm  SEM {:6.2f} mm\n",
              s.ccw.x_cg_m * 1e3, s.ccw.y_cg_m * 1e3, s.ccw.r_cg_m * 1e3, s.ccw.sigma_m * 1e3, s.ccw.sem_m * 1e3);
+  const bool scatter_known = s.cw.n >= 2 && s.ccw.n >= 2 && s.sem_m > 0.0;
   fmt::print("  E_max,syst = {:.2f} mm   (3*SEM = {:.2f} mm: {})\n", s.E_max_syst_m * 1e3, 3e3 * s.sem_m,
-             s.compensation_worthwhile ? "systematic error stands out of the scatter, compensation worthwhile"
-                                       : "systematic error within the scatter, compensation unlikely to help");
+             !scatter_known             ? "scatter unknown, so the 3*SEM test cannot decide (see the warnings)"
+             : s.compensation_worthwhile ? "systematic error stands out of the scatter, compensation worthwhile"
+                                         : "systematic error within the scatter, compensation unlikely to help");
   fmt::print("  alpha = {:+.5f} deg, beta = {:+.5f} deg, R = {:.3f} m\n", Rad2Deg(s.selected.alpha_rad),
              Rad2Deg(s.selected.beta_rad), s.selected.R_m);
   fmt::print("  E_d = {:.6f}   E_b = {:.6f}   c_L = {:.6f}   c_R = {:.6f}\n", s.selected.E_d, s.selected.E_b, s.c_L, s.c_R);
@@ -355,6 +358,7 @@ int RunCalibrate(const CalibrateOptions& o) {
     std::string error;
   };
   std::vector<Row> rows;
+  std::vector<std::string> all_warnings;
   int status = 0;
   for (const auto& path : o.inputs) {
     std::vector<CalibrateInput> inputs;
@@ -370,13 +374,38 @@ int RunCalibrate(const CalibrateOptions& o) {
     }
     for (const auto& in : inputs) {
       CalibrateJobResult r;
+      PlausibilityReport gate;
       try {
+        // Swapped encoder channels show in the data themselves: the odometry
+        // turns against the ground truth. Said plainly, before any fit.
+        if (in.trajectories) {
+          const int mirrored = CountMirroredRuns(*in.trajectories, in.recorded);
+          if (2 * mirrored > static_cast<int>(in.errors.size())) {
+            throw QualityGateError(fmt::format(
+                "{}: in {} of {} runs the odometry turns the other way than the ground truth and the cw/ccw label: "
+                "the left and right encoder channels (or the sign of the ticks) are swapped; swap the columns "
+                "ticks_left/ticks_right (or dist_left_m/dist_right_m) and run again",
+                in.label, mirrored, in.errors.size()));
+          }
+        }
         r = RunCalibrateJob(in, jo);
+        // Plausibility gates: never print or write an impossible result.
+        gate = CheckUmbmarkPlausibility(r.umbmark);
+        if (r.refined) CheckRefinedPlausibility(r.umbmark.recorded, r.refined->refined, gate);
+        if (!gate.ok()) throw QualityGateError(fmt::format("{}: implausible result: {}", in.label, gate.Message()));
+
       } catch (const RefineError& e) {
         // Print what is known (solver report, identifiability), then fail
         // the quality gate: exit 3, never numbers from a failed fit.
         fmt::print(stderr, "{}: refined calibration failed: {}\n{}", in.label, e.what(), RefineReport(e.summary()));
         if (!batch) throw;
+        rows.push_back({in.label, std::nullopt, e.what()});
+        results.push_back({{"input", in.label}, {"error", e.what()}});
+        status = std::max(status, 3);
+        continue;
+      } catch (const QualityGateError& e) {
+        if (!batch) throw;
+        fmt::print(stderr, "umbmark: quality gate failed: {}\n", e.what());
         rows.push_back({in.label, std::nullopt, e.what()});
         results.push_back({{"input", in.label}, {"error", e.what()}});
         status = std::max(status, 3);
@@ -393,7 +422,8 @@ int RunCalibrate(const CalibrateOptions& o) {
       const Chosen chosen = ChooseParameters(r, heldout, o.use);
       const ModelCheck check = CheckCentresAgainstModel(in, r.umbmark.runs, r.refined ? r.refined->refined : r.umbmark.corrected,
                                                         jo.refine ? jo.refine->final_turn : true);
-      const std::vector<std::string> warnings = TrustWarnings(r, heldout, check);
+      std::vector<std::string> warnings = gate.warnings;
+      for (auto& w : TrustWarnings(r, heldout, check)) warnings.push_back(std::move(w));
       const std::string tag = std::filesystem::path(in.path).stem().string() + "-" + std::to_string(rows.size() + 1);
       if (!o.ros2.empty()) outs.Write(batch ? TaggedPath(o.ros2, tag) : o.ros2, Ros2Parameters(r, chosen, o.controller));
       if (!o.plot.empty()) {
@@ -407,6 +437,7 @@ int RunCalibrate(const CalibrateOptions& o) {
       } else {
         for (const auto& w : warnings) fmt::print(stderr, "{}: warning: {}\n", in.label, w);
       }
+      for (const auto& w : warnings) all_warnings.push_back(batch ? in.label + ": " + w : w);
       // The JSON document only when asked for: with a million runs it is
       // the largest thing the command builds.
       if (!o.json.path.empty()) results.push_back(JsonResult(in, r, o, heldout, check, chosen, warnings));
@@ -435,7 +466,7 @@ int RunCalibrate(const CalibrateOptions& o) {
   } else if (rows.size() == 1 && rows.front().result) {
     o.json.Emit(results.front());
   } else {
-    o.json.Emit({{"results", results}, {"failed", status != 0}});
+    o.json.Emit({{"results", results}, {"failed", status != 0}, {"warnings", all_warnings}});
   }
   return status;
 }
@@ -449,7 +480,7 @@ Command SetupCalibrate(CLI::App& parent) {
       ->required()
       ->check(CLI::ExistingFile);
   opts->robot.Bind(*app);
-  app->add_option("--side", opts->side_m, "Square side L [m] (required for CSV input)")->check(CLI::PositiveNumber);
+  app->add_option("--side", opts->side_m, "Square side L [m] (required for CSV input)")->check(Positive());
   app->add_option("--estimator", opts->estimator, "alpha/beta from x (4.20a, 4.24a), y (4.20b, 4.24b) or their mean")
       ->check(CLI::IsMember({"x", "y", "mean"}))
       ->capture_default_str();
@@ -463,7 +494,7 @@ Command SetupCalibrate(CLI::App& parent) {
   app->add_option("--exclude-runs", opts->exclude_runs, "Run ids to leave out (listed in the output)")->delimiter(',');
   app->add_flag("--reject-outliers", opts->reject_outliers, "Drop runs flagged as outliers (listed in the output)");
   app->add_option("--outlier-threshold", opts->outlier_threshold, "Robust score above which a run is flagged")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   opts->json.Bind(*app);
   app->add_option("--ros2", opts->ros2,
@@ -489,9 +520,9 @@ Command SetupCalibrate(CLI::App& parent) {
   app->add_option("--loss", opts->loss, "With --refine on trajectories: robust loss per sampled pose")
       ->check(CLI::IsMember({"huber", "cauchy", "none"}))
       ->capture_default_str();
-  app->add_option("--loss-scale", opts->loss_scale_m, "Robust loss scale [m]")->check(CLI::PositiveNumber)->capture_default_str();
+  app->add_option("--loss-scale", opts->loss_scale_m, "Robust loss scale [m]")->check(Positive())->capture_default_str();
   app->add_option("--samples-per-run", opts->samples_per_run, "Poses sampled per trajectory run (evenly in travel)")
-      ->check(CLI::Range(2, 100000))
+      ->check(NumberIn(2, 100000))
       ->capture_default_str();
   app->add_option("--sampling", opts->sampling,
                   "With --refine on trajectories: poses per run (--samples-per-run) or every sample with ground truth")
@@ -504,7 +535,7 @@ Command SetupCalibrate(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--heading-weight", opts->heading_weight,
                   "With --refine on trajectories: heading residual weight, in wheelbases per radian (0 = position only)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   return {app, [opts] { return RunCalibrate(*opts); }};
 }

@@ -63,17 +63,17 @@ Command SetupDiagnose(CLI::App& parent) {
   app->add_option("MANIFEST", opts->manifest, "Campaign manifest (TOML)")->required()->check(CLI::ExistingFile);
   auto& d = opts->diag;
   app->add_option("--null-sims", d.null_simulations, "Simulated baseline campaigns for the p-value (default 500)")
-      ->check(CLI::Range(20, 1000000));
-  app->add_option("--alpha", d.alpha, "False-alarm rate of the gap test (default 0.01)")->check(CLI::Range(1e-6, 0.5));
+      ->check(NumberIn(20, 1000000));
+  app->add_option("--alpha", d.alpha, "False-alarm rate of the gap test (default 0.01)")->check(NumberIn(1e-6, 0.5));
   app->add_option("--min-heldout-shrink", d.min_heldout_shrink,
                   "Held-out shrink a winning effect needs (default 0.5)")
-      ->check(CLI::Range(0.01, 1.0));
+      ->check(NumberIn(0.01, 1.0));
   app->add_option("--penalty", d.complexity_penalty_nats, "Held-out nats an effect must gain per parameter (default 2)")
-      ->check(CLI::NonNegativeNumber);
-  app->add_option("--folds", d.pieces.folds, "Cross-validation folds over runs (default 5)")->check(CLI::Range(2, 100));
+      ->check(NonNegative());
+  app->add_option("--folds", d.pieces.folds, "Cross-validation folds over runs (default 5)")->check(NumberIn(2, 100));
   app->add_option("--piece-length", d.pieces.max_piece_length_m,
-                  "Longest piece of a leg or arc compared with the model [m] (default 1)")
-      ->check(CLI::PositiveNumber);
+                  "Longest piece of a leg or arc compared with the model [m] (default 1; 0.01 to 1000)")
+      ->check(NumberIn(0.01, 1000.0));
   app->add_flag("!--no-likelihood-tests", d.likelihood_tests,
                "Judge the gap by the gap score alone (default: combined with the candidates' likelihood-ratio tests)");
   app->add_flag("!--no-standstill-averaging", d.pieces.average_standstills,
@@ -86,8 +86,8 @@ Command SetupDiagnose(CLI::App& parent) {
   app->add_option("--max-effects", d.max_explanation_effects, "Most effects in the stepwise explanation (default 4)")
       ->check(CLI::Range(1, 12));
   app->add_option("--seed", d.seed, "Seed of the null simulations (default 1)")->check(SeedValidator());
-  app->add_option("--threads", d.threads, "Threads (default 2)")->check(CLI::Range(1, 256));
-  app->add_option("--where", d.where_top, "Discrepancies listed under 'where' (default 12)")->check(CLI::NonNegativeNumber);
+  app->add_option("--threads", d.threads, "Threads (default 2)")->check(NumberIn(1, 256));
+  app->add_option("--where", d.where_top, "Discrepancies listed under 'where' (default 12)")->check(NonNegative());
   app->add_option("--effects", opts->effects, "Effects to try (default: the contract's nine)")->delimiter(',');
   app->add_option("--plot", opts->plot, "SVG bars of the gap per statistic before/after the winning effect");
   app->add_flag("--fail-unexplained", opts->quality_gate, "Exit 3 when the verdict is 'unexplained'");

@@ -73,6 +73,8 @@ RobotParams ReadParams(const std::string& path, const RobotParams& recorded) {
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::out_of_range& e) {
+    throw InputError(path, "a number is out of range for double precision (e.g. 1e400)");
   } catch (const nlohmann::json::parse_error& e) {
     std::size_t line = 1, col = 1;
     for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {

@@ -405,7 +405,7 @@ Command SetupFitNoise(CLI::App& parent) {
       ->check(CLI::ExistingFile);
   opts->robot.Bind(*app);
   app->add_option("--distance", opts->distance_m, "Endpoint data: each run drove D forward, then D back [m]")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   app->add_option("--meas-sigma", opts->meas_sigma,
                   "Noise of the external reference per measured pose: SXY[,STHETA] [m, rad] (default: the "
                   "manifest's [ground_truth], else 0)")

@@ -279,11 +279,11 @@ Command SetupImport(CLI::App& parent) {
       ->check(CLI::IsMember({"arc", "midpoint"}));
   rb->add_option("--pause", ro->import.pause_s, "Split runs where both wheels stand still this long [s]; 0 = one run per recording")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative());
   rb->add_option("--max-gt-gap", ro->import.max_gt_gap_s,
                  "Interpolate ground truth only between poses at most this far from the sample [s]")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   ro->robot.Bind(*rb);
   ro->json.Bind(*rb);
   return {imp, [opts, ro, rb] {

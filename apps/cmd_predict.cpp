@@ -3,10 +3,14 @@
 // closed-form mean pose and covariance after a path (Chong & Kleeman eqs.
 // 23-28), optionally next to a Monte Carlo estimate of the same quantities
 // (each segment split into P partitions with white wheel noise).
+#include <unistd.h>
+
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <optional>
 
+#include <Eigen/Eigenvalues>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -50,6 +54,14 @@ PoseCovariance ParseP0(const std::vector<double>& v) {
     throw InvalidOptions(fmt::format("--P0 takes 3, 6 or 9 comma-separated values, got {}", v.size()));
   }
   if (!P.allFinite()) throw InvalidOptions("--P0: values must be finite");
+  // A covariance has no negative variance along any direction.
+  const Eigen::SelfAdjointEigenSolver<PoseCovariance> eig(P);
+  const double lowest = eig.eigenvalues().minCoeff(), highest = eig.eigenvalues().cwiseAbs().maxCoeff();
+  if (lowest < -1e-12 * std::max(1e-300, highest)) {
+    throw InvalidOptions(fmt::format("--P0 is not positive semi-definite (smallest eigenvalue {:.3g}): a covariance "
+                                     "needs |cov(a,b)| <= sqrt(var(a) var(b)) and no negative variance",
+                                     lowest));
+  }
   return P;
 }
 
@@ -71,6 +83,31 @@ void PrintCovariance(const char* title, const Pose2& mean, const PoseCovariance&
   for (int i = 0; i < 3; ++i) fmt::print("    {:>14.6e} {:>14.6e} {:>14.6e}\n", P(i, 0), P(i, 1), P(i, 2));
 }
 
+/// Longest wheel travel of one path segment [m]: 10,000 km, far beyond any
+/// robot, far below where squared lengths overflow.
+constexpr double kMaxWheelTravel_m = 1e7;
+
+/// Memory and work of a Monte Carlo run, estimated before anything is
+/// allocated: RunMonteCarlo keeps one 96-byte block of sums per 64 runs (so
+/// the result does not depend on the thread count). Refused when it needs
+/// more than half of this machine's memory.
+void CheckMonteCarloSize(std::int64_t runs, int partitions, std::size_t segments) {
+  const double bytes = std::ceil(static_cast<double>(runs) / 64.0) * 96.0;
+  const double physical = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGESIZE));
+  const double budget = physical > 0 ? 0.5 * physical : 4e9;
+  if (bytes > budget) {
+    throw InvalidOptions(fmt::format("--monte-carlo {}: needs about {:.3g} GB of memory, more than half of this "
+                                     "machine's {:.3g} GB; use at most {:.3g} runs",
+                                     runs, bytes / 1e9, physical / 1e9, std::floor(budget / 96.0) * 64.0));
+  }
+  const double steps = static_cast<double>(runs) * partitions * static_cast<double>(std::max<std::size_t>(segments, 1));
+  if (steps > 1e13) {
+    throw InvalidOptions(fmt::format("--monte-carlo {} x --partitions {} x {} segments = {:.3g} wheel steps: days of "
+                                     "computing at about 1e8 steps per second; lower the runs or partitions",
+                                     runs, partitions, segments, steps));
+  }
+}
+
 int RunPredict(const PredictOptions& o) {
   RegisterInputs({}, &o.robot);
   CommandOutputs().AddOutput("--json", o.json.path);
@@ -79,7 +116,16 @@ int RunPredict(const PredictOptions& o) {
   const WheelNoise noise{o.k_L, o.k_R};
   const std::vector<PathSegment> spec = ParsePathSpec(o.path);
   const std::vector<WheelSegment> path = ToWheelSegments(spec, robot.wheelbase_m);
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    const double longest = std::max(std::abs(path[i].left_m), std::abs(path[i].right_m));
+    if (!(longest <= kMaxWheelTravel_m)) {
+      throw InvalidOptions(fmt::format("--path segment {} makes a wheel travel {:.3g} m; the limit is {:.0e} m "
+                                       "(longer paths overflow the covariance)",
+                                       i + 1, longest, kMaxWheelTravel_m));
+    }
+  }
   const PoseCovariance P0 = ParseP0(o.p0);
+  if (o.mc_runs) CheckMonteCarloSize(*o.mc_runs, o.partitions, path.size());
   const PathCovarianceSummary pred = PredictPathCovariance(path, robot.wheelbase_m, noise, P0);
   // Mean heading wrapped to (-pi, pi]; the continuous value is reported too.
   const double theta_shift = WrapAngle(pred.mean.theta) - pred.mean.theta;
@@ -145,6 +191,13 @@ int RunPredict(const PredictOptions& o) {
                  mc.threads, mc.kernel, mc.seconds);
     }
   }
+  // Gate: never print or write a number that is not one.
+  const bool finite = std::isfinite(mean.x) && std::isfinite(mean.y) && std::isfinite(mean.theta) &&
+                      pred.covariance.allFinite() && cov2.allFinite();
+  if (!finite) {
+    throw QualityGateError("the predicted mean or covariance is not finite (a path or noise constant too large for "
+                           "double precision); shorten the path or check --kl/--kr");
+  }
   o.json.Emit(j);
   return 0;
 }
@@ -155,23 +208,23 @@ Command SetupPredict(CLI::App& parent) {
   auto opts = std::make_shared<PredictOptions>();
   auto* app = parent.add_subcommand("predict", "Closed-form pose mean and covariance after a path (Chong & Kleeman)");
   opts->robot.Bind(*app);
-  app->add_option("--kl", opts->k_L, "Left wheel noise constant k_L [m^1/2]")->required()->check(CLI::NonNegativeNumber);
-  app->add_option("--kr", opts->k_R, "Right wheel noise constant k_R [m^1/2]")->required()->check(CLI::NonNegativeNumber);
+  app->add_option("--kl", opts->k_L, "Left wheel noise constant k_L [m^1/2]")->required()->check(NonNegative());
+  app->add_option("--kr", opts->k_R, "Right wheel noise constant k_R [m^1/2]")->required()->check(NonNegative());
   app->add_option("--path", opts->path, "Segments: line:D, turn:ANGLE_RAD, arc:L_LEFT:L_RIGHT (comma-separated)")
       ->required();
   app->add_option("--P0", opts->p0,
                   "Initial pose covariance: 3 values (variances xx,yy,thth), 6 (xx,xy,xth,yy,yth,thth) or 9 (row-major)")
       ->delimiter(',');
   app->add_option("--monte-carlo", opts->mc_runs, "Also estimate mean and covariance from RUNS simulated runs")
-      ->check(CLI::Range(static_cast<std::int64_t>(2), static_cast<std::int64_t>(1) << 40));
+      ->check(NumberIn(2.0, 1099511627776.0));
   app->add_option("--partitions", opts->partitions, "Monte Carlo: partitions per segment")
-      ->check(CLI::Range(1, 1 << 30))
+      ->check(NumberIn(1.0, 1073741824.0))
       ->capture_default_str();
   app->add_option("--seed", opts->seed, "Monte Carlo: seed (run i uses streams derived from (seed, i))")
       ->check(SeedValidator())
       ->capture_default_str();
   app->add_option("--threads", opts->threads, "Monte Carlo: worker threads (0 = all cores)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   opts->json.Bind(*app);
   return {app, [opts] { return RunPredict(*opts); }};

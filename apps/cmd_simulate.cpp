@@ -155,27 +155,27 @@ Command SetupSimulate(CLI::App& parent) {
                   "Effect NAME:k=v,... (repeatable), e.g. turn_scrub:k=0.05 or gt_offset:dx=0.02,dy=0");
   app->add_option("--seed", opts->seed, "Seed of every random process (default 1)")->check(SeedValidator());
   auto& s = opts->sim;
-  app->add_option("--E-d", s.truth.E_d, "True wheel diameter ratio error E_d (default 1)")->check(CLI::PositiveNumber);
-  app->add_option("--E-b", s.truth.E_b, "True wheelbase error E_b (default 1)")->check(CLI::PositiveNumber);
-  app->add_option("--kl", s.truth.k_L, "True left wheel noise k_L [m^1/2] (default 0.001)")->check(CLI::NonNegativeNumber);
-  app->add_option("--kr", s.truth.k_R, "True right wheel noise k_R [m^1/2] (default 0.001)")->check(CLI::NonNegativeNumber);
+  app->add_option("--E-d", s.truth.E_d, "True wheel diameter ratio error E_d (default 1)")->check(Positive());
+  app->add_option("--E-b", s.truth.E_b, "True wheelbase error E_b (default 1)")->check(Positive());
+  app->add_option("--kl", s.truth.k_L, "True left wheel noise k_L [m^1/2] (default 0.001)")->check(NonNegative());
+  app->add_option("--kr", s.truth.k_R, "True right wheel noise k_R [m^1/2] (default 0.001)")->check(NonNegative());
   app->add_option("--square-runs", s.square_runs_per_direction, "Square runs per direction (default 10)")
-      ->check(CLI::Range(1, 1000000));
+      ->check(NumberIn(1, 1000000));
   app->add_option("--back-and-forth-runs", s.back_and_forth_runs, "Back-and-forth runs (default 20)")
-      ->check(CLI::Range(1, 1000000));
+      ->check(NumberIn(1, 1000000));
   app->add_option("--free-runs", s.free_runs, "Figure-eight runs per free experiment without a template (default 4)")
-      ->check(CLI::Range(1, 1000000));
-  app->add_option("--sample-rate", s.sample_rate_hz, "Logging rate [Hz] (default 20)")->check(CLI::PositiveNumber);
-  app->add_option("--speed", s.speed_m_s, "Leg speed [m/s] (default 0.3)")->check(CLI::PositiveNumber);
-  app->add_option("--turn-rate", s.turn_rate_rad_s, "Spot-turn rate [rad/s] (default 1)")->check(CLI::PositiveNumber);
-  app->add_option("--pause", s.pause_s, "Standstill between motions [s] (default 1)")->check(CLI::NonNegativeNumber);
+      ->check(NumberIn(1, 1000000));
+  app->add_option("--sample-rate", s.sample_rate_hz, "Logging rate [Hz] (default 20)")->check(Positive());
+  app->add_option("--speed", s.speed_m_s, "Leg speed [m/s] (default 0.3)")->check(Positive());
+  app->add_option("--turn-rate", s.turn_rate_rad_s, "Spot-turn rate [rad/s] (default 1)")->check(Positive());
+  app->add_option("--pause", s.pause_s, "Standstill between motions [s] (default 1)")->check(NonNegative());
   app->add_option("--free-radius", s.free_radius_m, "Radius of the figure-eight circles [m] (default 1)")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   app->add_option("--gt-sigma-xy", opts->gt_sigma_xy, "Ground-truth position noise [m] (default: the manifest's, else 0.0003)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative());
   app->add_option("--gt-sigma-theta", opts->gt_sigma_theta,
                   "Ground-truth heading noise [rad] (default: the manifest's, else 0.0017)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative());
   app->add_flag("--hide-gt-sigma", opts->hide_gt_sigma,
                 "Do not state [ground_truth] in the written manifest (diagnose then estimates it)");
   app->add_flag("--endpoint-squares", s.endpoint_squares, "Write squares as endpoint CSV (return errors only)");

@@ -18,13 +18,13 @@ namespace umbmark::cli {
 void RobotFlags::Bind(CLI::App& app) {
   app.add_option("--robot", robot_file, "Robot file (TOML): the parameters the odometry USED")
       ->check(CLI::ExistingFile);
-  app.add_option("--wheelbase", wheelbase_m, "Override wheelbase_m [m]")->check(CLI::PositiveNumber);
+  app.add_option("--wheelbase", wheelbase_m, "Override wheelbase_m [m]")->check(Positive());
   app.add_option("--diameter-left", diameter_left_m, "Override wheel_diameter_left_m [m]")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   app.add_option("--diameter-right", diameter_right_m, "Override wheel_diameter_right_m [m]")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   app.add_option("--ticks-per-rev", ticks_per_rev, "Override ticks_per_rev (ticks per wheel revolution)")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
 }
 
 bool RobotFlags::Given() const {
@@ -63,6 +63,49 @@ void JsonFlag::Emit(const nlohmann::json& j) const {
   nlohmann::json out = j;
   if (out.is_object() && !out.contains("warnings")) out["warnings"] = nlohmann::json::array();
   CommandOutputs().Write(path, DumpJson(out) + "\n");
+}
+
+namespace {
+/// The number in `v` when all of it is one (finite), else nullopt.
+std::optional<double> WholeNumber(const std::string& v) {
+  try {
+    std::size_t used = 0;
+    const double x = std::stod(v, &used);
+    if (used == v.size() && std::isfinite(x)) return x;
+  } catch (const std::exception&) {
+  }
+  return std::nullopt;
+}
+}  // namespace
+
+CLI::Validator NumberIn(double lo, double hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& v) -> std::string {
+        const auto x = WholeNumber(v);
+        if (!x || !(*x >= lo && *x <= hi)) return fmt::format("must be a number from {:g} to {:g} (got '{}')", lo, hi, v);
+        return {};
+      },
+      fmt::format("NUMBER in [{:g}, {:g}]", lo, hi));
+}
+
+CLI::Validator Positive() {
+  return CLI::Validator(
+      [](std::string& v) -> std::string {
+        const auto x = WholeNumber(v);
+        if (!x || !(*x > 0.0)) return fmt::format("must be a finite number > 0 (got '{}')", v);
+        return {};
+      },
+      "POSITIVE");
+}
+
+CLI::Validator NonNegative() {
+  return CLI::Validator(
+      [](std::string& v) -> std::string {
+        const auto x = WholeNumber(v);
+        if (!x || !(*x >= 0.0)) return fmt::format("must be a finite number >= 0 (got '{}')", v);
+        return {};
+      },
+      "NON-NEGATIVE");
 }
 
 CLI::Validator SeedValidator() {

@@ -46,6 +46,17 @@ struct JsonFlag {
   void Emit(const nlohmann::json& j) const;
 };
 
+/// Validator for a number in [lo, hi]; the message quotes the value as the
+/// user typed it and the bounds with sensible precision (CLI::Range prints
+/// them with six decimals, or 300 digits for the largest double).
+CLI::Validator NumberIn(double lo, double hi);
+
+/// Validators for a finite number > 0, resp. >= 0, with short messages that
+/// quote the user's value (replacing CLI::PositiveNumber/NonNegativeNumber,
+/// whose messages print the largest double in 300 digits).
+CLI::Validator Positive();
+CLI::Validator NonNegative();
+
 /// Validator for --seed: a whole number in [0, 2^64), quoted back as given
 /// (CLI11 would turn "-1" silently into 2^64-1).
 CLI::Validator SeedValidator();
