@@ -422,8 +422,8 @@ int RunCalibrate(const CalibrateOptions& o) {
       const Chosen chosen = ChooseParameters(r, heldout, o.use);
       const ModelCheck check = CheckCentresAgainstModel(in, r.umbmark.runs, r.refined ? r.refined->refined : r.umbmark.corrected,
                                                         jo.refine ? jo.refine->final_turn : true);
-      std::vector<std::string> warnings = gate.warnings;
-      for (auto& w : TrustWarnings(r, heldout, check)) warnings.push_back(std::move(w));
+      std::vector<std::string> warnings = TrustWarnings(r, heldout, check);
+      warnings.insert(warnings.end(), gate.warnings.begin(), gate.warnings.end());
       const std::string tag = std::filesystem::path(in.path).stem().string() + "-" + std::to_string(rows.size() + 1);
       if (!o.ros2.empty()) outs.Write(batch ? TaggedPath(o.ros2, tag) : o.ros2, Ros2Parameters(r, chosen, o.controller));
       if (!o.plot.empty()) {

@@ -88,9 +88,6 @@ PlausibilityReport CheckUmbmarkPlausibility(const UmbmarkSummary& s) {
       r.warnings.push_back(fmt::format("the {} {} runs have identical return errors (zero scatter): real runs "
                                        "scatter, so check the data are not copies; intervals have no meaning",
                                        c->n, dir));
-    } else if (c->n < 5) {
-      r.warnings.push_back(fmt::format("only {} {} runs: UMBmark asks for 5 per direction; the result is uncertain",
-                                       c->n, dir));
     }
   }
   if (s.cw.r_cg_m == 0.0 && s.ccw.r_cg_m == 0.0 && s.cw.sigma_m == 0.0 && s.ccw.sigma_m == 0.0) {
