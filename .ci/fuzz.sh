@@ -5,7 +5,7 @@
 # of tests/data/rosbag2 for fuzz_mcap and fuzz_cdr). Fails on any crash, sanitizer
 # report, timeout or out-of-memory; the reproducer is left in
 # $FUZZ_BUILD_DIR/artifacts/.
-#   env: FUZZ_SECONDS (60), FUZZ_BUILD_DIR (build-fuzz), FUZZ_CXX (clang++)
+#   env: FUZZ_SECONDS (60), FUZZ_NEW_SECONDS (30: fuzz_params_json), FUZZ_BUILD_DIR (build-fuzz), FUZZ_CXX (clang++)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -75,6 +75,21 @@ cat > "$build/toml.dict" <<'DICT'
 "inf"
 DICT
 
+cat > "$build/json.dict" <<'DICT'
+"parameters"
+"refined"
+"results"
+"wheelbase_m"
+"wheel_diameter_left_m"
+"wheel_diameter_right_m"
+"ticks_per_rev"
+"1e400"
+"-0"
+"null"
+"\\u0000"
+"\xff"
+DICT
+
 status=0
 for target in "${targets[@]}"; do
   seeds="$build/seeds/$target"
@@ -94,10 +109,23 @@ for target in "${targets[@]}"; do
     fuzz_cdr)
       dict=""
       cp tests/data/rosbag2/cdr/*.bin "$seeds/" ;;
+    fuzz_params_json)
+      dict=json.dict
+      cat > "$seeds/cal.json" <<'JSON'
+{"E_d": 1.0, "parameters": {"wheelbase_m": 0.34, "wheel_diameter_left_m": 0.1524, "wheel_diameter_right_m": 0.1525, "ticks_per_rev": 2048}, "warnings": []}
+JSON
+      cat > "$seeds/refined.json" <<'JSON'
+{"results": [{"parameters": {"wheelbase_m": 0.34, "wheel_diameter_left_m": 0.15, "wheel_diameter_right_m": 0.15},
+ "refined": {"parameters": {"wheelbase_m": 0.341, "wheel_diameter_left_m": 0.1523, "wheel_diameter_right_m": 0.1526}}}]}
+JSON
+      ;;
     *) dict="" ;;
   esac
-  echo "== $target: $(ls "$seeds" | wc -l) seed files, $(ls "$corpus" | wc -l) corpus files, ${seconds} s"
-  args=(-max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=16384 -print_final_stats=1
+  # Targets added by issue 9 run FUZZ_NEW_SECONDS (default 30) to keep CI short.
+  t_seconds=$seconds
+  case $target in fuzz_params_json) t_seconds=${FUZZ_NEW_SECONDS:-30} ;; esac
+  echo "== $target: $(ls "$seeds" | wc -l) seed files, $(ls "$corpus" | wc -l) corpus files, ${t_seconds} s"
+  args=(-max_total_time="$t_seconds" -timeout=10 -rss_limit_mb=2048 -max_len=16384 -print_final_stats=1
         -artifact_prefix="$build/artifacts/$target-")
   if [[ -n $dict ]]; then args+=(-dict="$build/$dict"); fi
   # Keep the log short: progress lines and libFuzzer's dictionary advice out.

@@ -424,6 +424,10 @@ int RunCalibrate(const CalibrateOptions& o) {
                                                         jo.refine ? jo.refine->final_turn : true);
       std::vector<std::string> warnings = TrustWarnings(r, heldout, check);
       warnings.insert(warnings.end(), gate.warnings.begin(), gate.warnings.end());
+      if (r.refined && in.trajectories && !HasInteriorGroundTruth(*in.trajectories)) {
+        warnings.push_back("ground truth only at the first and last sample of each run: the refined fit used the "
+                           "return errors (commanded-square model), as for endpoint data, not the path geometry");
+      }
       const std::string tag = std::filesystem::path(in.path).stem().string() + "-" + std::to_string(rows.size() + 1);
       if (!o.ros2.empty()) outs.Write(batch ? TaggedPath(o.ros2, tag) : o.ros2, Ros2Parameters(r, chosen, o.controller));
       if (!o.plot.empty()) {

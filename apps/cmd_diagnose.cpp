@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "diagnosis/design_check.hpp"
+#include "io/manifest.hpp"
 #include "common.hpp"
 #include "core/errors.hpp"
 #include "diagnosis/pieces.hpp"
@@ -39,6 +41,10 @@ int RunDiagnose(DiagnoseCliOptions o) {
   outs.AddOutput("--json", o.json.path);
   outs.AddOutput("--plot", o.plot);
   outs.Check();
+  // A design that cannot determine the baseline is refused before fitting.
+  if (const std::string why = diag::CampaignDesignProblem(io::ReadManifest(o.manifest)); !why.empty()) {
+    throw InputError(o.manifest, why);
+  }
   const diag::CampaignData campaign = diag::LoadCampaign(o.manifest, o.diag.pieces);
   const diag::DiagnoseSummary s = diag::Diagnose(campaign, o.diag);
   if (o.json.PrintText()) fmt::print("{}", diag::DiagnoseReport(s));

@@ -16,6 +16,7 @@
 #include "evaluation/run_track.hpp"
 #include "io/atomic_write.hpp"
 #include "io/data_file.hpp"
+#include "io/params_json.hpp"
 #include "io/manifest.hpp"
 #include "io/svg_plot.hpp"
 
@@ -65,51 +66,6 @@ struct PlotRun {
   const Source* source;
   TrajectoryRun run;
 };
-
-// Reads calibrated parameters from a `calibrate` JSON: refined.parameters
-// when present, else parameters (contract).
-RobotParams ReadParams(const std::string& path, const RobotParams& recorded) {
-  const std::string text = io::ReadWholeFile(path);
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::out_of_range& e) {
-    throw InputError(path, "a number is out of range for double precision (e.g. 1e400)");
-  } catch (const nlohmann::json::parse_error& e) {
-    std::size_t line = 1, col = 1;
-    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
-      if (text[i] == '\n') {
-        ++line;
-        col = 1;
-      } else {
-        ++col;
-      }
-    }
-    throw InputError(path, line, col, "invalid JSON");
-  }
-  if (j.contains("results")) {
-    if (!j["results"].is_array() || j["results"].size() != 1)
-      throw InputError(path, "a batch calibration result holds several calibrations; pass a single one");
-    j = j["results"][0];
-  }
-  const nlohmann::json* p = nullptr;
-  if (j.contains("refined") && j["refined"].is_object() && j["refined"].contains("parameters"))
-    p = &j["refined"]["parameters"];
-  else if (j.contains("parameters"))
-    p = &j["parameters"];
-  if (!p || !p->is_object()) throw InputError(path, "no 'parameters' (or 'refined.parameters') object");
-  RobotParams out = recorded;
-  auto get = [&](const char* key, double& field) {
-    if (!p->contains(key) || !(*p)[key].is_number()) throw InputError(path, fmt::format("parameters.{} is missing or not a number", key));
-    field = (*p)[key].get<double>();
-  };
-  get("wheelbase_m", out.wheelbase_m);
-  get("wheel_diameter_left_m", out.wheel_diameter_left_m);
-  get("wheel_diameter_right_m", out.wheel_diameter_right_m);
-  if (p->contains("ticks_per_rev") && (*p)["ticks_per_rev"].is_number()) out.ticks_per_rev = (*p)["ticks_per_rev"].get<double>();
-  if (auto err = out.Check(); !err.empty()) throw InputError(path, "parameters: " + err);
-  return out;
-}
 
 void PrintSummary(const char* title, const EvaluationSummary& s) {
   fmt::print("{} ({} runs)\n", title, s.runs.size());
@@ -184,7 +140,7 @@ int RunEvaluate(const EvaluateOptions& o) {
   outs.Check();
   const std::vector<Source> sources = ListSources(o);
   std::optional<RobotParams> params;
-  if (!o.params_file.empty()) params = ReadParams(o.params_file, sources.front().recorded);
+  if (!o.params_file.empty()) params = io::ReadParamsJson(o.params_file, sources.front().recorded);
 
   // Stream each file run by run: only the run in hand is in memory (and the
   // first few, for --plot).

@@ -56,7 +56,10 @@ RefineSummary RefineInput(const CalibrateInput& input, const std::vector<bool>& 
   ro.integrator = integrator;
   ro.start.E_b = start.E_b;
   ro.start.E_d = start.E_d;
-  if (input.trajectories) {
+  // Path geometry needs ground truth along the path; with ground truth at
+  // the first and last sample only (the contract's minimum) the return
+  // errors are all the data say, so the commanded-square model fits them.
+  if (input.trajectories && HasInteriorGroundTruth(*input.trajectories)) {
     TrajectoryData kept;
     kept.path = input.trajectories->path;
     for (std::size_t i = 0; i < input.trajectories->runs.size(); ++i)
@@ -70,6 +73,13 @@ RefineSummary RefineInput(const CalibrateInput& input, const std::vector<bool>& 
   for (std::size_t i = 0; i < input.errors.size(); ++i)
     if (keep[i]) set.errors.push_back(input.errors[i]);
   return RefineFromReturnErrors({set}, input.recorded, ro);
+}
+
+bool HasInteriorGroundTruth(const TrajectoryData& data) {
+  for (const auto& run : data.runs)
+    for (std::size_t i = 1; i + 1 < run.size(); ++i)
+      if (run.HasGroundTruth(i)) return true;
+  return false;
 }
 
 CalibrateJobResult RunCalibrateJob(const CalibrateInput& input, const CalibrateJobOptions& options) {

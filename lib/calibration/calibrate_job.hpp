@@ -76,6 +76,12 @@ ClusterStats ClusterOfUsed(const std::vector<ReturnError>& errors, const std::ve
 RefineSummary RefineInput(const CalibrateInput& input, const std::vector<bool>& keep, RefineOptions options,
                           const UmbmarkEstimate& start, Integrator integrator);
 
+/// True when some run has ground truth between its first and last sample.
+/// Without it, the refined fit of trajectory input uses the return errors
+/// (commanded-square model, as for endpoint input): the path carries no
+/// further information.
+bool HasInteriorGroundTruth(const TrajectoryData& data);
+
 /// Runs UMBmark (and the after-correction evaluation when trajectories are
 /// present, and the refined fit when asked). Throws RefineError (exit 3)
 /// when the refined fit fails its quality gates.

@@ -1,0 +1,283 @@
+// Hostile-input corpus for the whole executable: every case of issue 9 (and
+// more) with its expected exit status and a substring of its message. Every
+// case also checks that the inputs are unchanged (hash of every file in the
+// case's folder before and after, minus the outputs it is meant to write),
+// that it ends within a time bound (coreutils `timeout`), that no temporary
+// file remains, and, over the whole corpus, that no child process grew
+// beyond a memory bound (getrusage of the children's peak RSS).
+#include <catch2/catch.hpp>
+
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "support/run_cli.hpp"
+
+namespace fs = std::filesystem;
+using umbmark::testing::Slurp;
+
+namespace {
+
+const fs::path kSource = fs::path(UMBMARK_SOURCE_DIR);
+constexpr int kTimeoutSeconds = 120;  // generous: the machine is shared; a hang is caught, not a slow run
+constexpr long kMaxRssKb = 2L * 1024 * 1024;
+
+void Put(const fs::path& p, const std::string& s) {
+  fs::create_directories(p.parent_path());
+  std::ofstream(p, std::ios::binary) << s;
+}
+
+std::map<std::string, std::size_t> Hashes(const fs::path& dir) {
+  std::map<std::string, std::size_t> out;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (fs::is_symlink(e.path()) || !e.is_regular_file()) continue;
+    out[fs::relative(e.path(), dir).string()] = std::hash<std::string>{}(Slurp(e.path().string()));
+  }
+  return out;
+}
+
+struct Run {
+  int status = -1;
+  std::string out, err;
+};
+
+Run Exec(const fs::path& dir, const std::string& args) {
+  const std::string cmd = "cd '" + dir.string() + "' && timeout " + std::to_string(kTimeoutSeconds) + " '" +
+                          UMBMARK_EXE + "' " + args + " </dev/null >.stdout 2>.stderr";
+  const int raw = std::system(cmd.c_str());
+  Run r;
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + (WIFSIGNALED(raw) ? WTERMSIG(raw) : 0);
+  r.out = Slurp((dir / ".stdout").string());
+  r.err = Slurp((dir / ".stderr").string());
+  fs::remove(dir / ".stdout");
+  fs::remove(dir / ".stderr");
+  return r;
+}
+
+const std::string kRobot =
+    "wheelbase_m = 0.340\nwheel_diameter_left_m = 0.1524\nwheel_diameter_right_m = 0.1524\nticks_per_rev = 2048\n";
+const std::string kEndpoints = Slurp((kSource / "data/examples/endpoints.csv").string());
+const std::string kExampleRobot = Slurp((kSource / "data/examples/robot.toml").string());
+const std::string kManifest =
+    "[robot]\nwheelbase_m = 0.3\nwheel_diameter_left_m = 0.08\nwheel_diameter_right_m = 0.08\nticks_per_rev = 2000\n\n"
+    "[[experiment]]\nkind = \"square\"\nside_m = 1.0\nfile = \"sq.csv\"\n";
+
+/// Endpoint rows scaled by `k` (k = 1000: millimetres written as metres).
+std::string ScaledEndpoints(double k) {
+  std::string out = "run,direction,ex_m,ey_m,etheta_rad\n";
+  std::istringstream in(kEndpoints);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#' || line.rfind("run", 0) == 0) continue;
+    std::vector<std::string> c;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) c.push_back(cell);
+    out += c[0] + "," + c[1] + "," + std::to_string(std::stod(c[2]) * k) + "," + std::to_string(std::stod(c[3]) * k) +
+           "," + (c.size() > 4 ? c[4] : "") + "\n";
+  }
+  return out;
+}
+
+std::string Repeated(const std::string& cw, const std::string& ccw, int n) {
+  std::string out = "run,direction,ex_m,ey_m,etheta_rad\n";
+  for (int i = 0; i < n; ++i) out += std::to_string(2 * i + 1) + ",cw," + cw + "\n" + std::to_string(2 * i + 2) + ",ccw," + ccw + "\n";
+  return out;
+}
+
+struct Case {
+  std::string name;
+  std::function<void(const fs::path&)> setup;
+  std::string args;
+  int status;
+  std::string message;                 ///< substring of stderr (or of stdout for status 0)
+  std::set<std::string> outputs = {};  ///< files the case may create or change
+  std::function<void(const Run&, const fs::path&)> extra = nullptr;
+};
+
+void Examples(const fs::path& d) {
+  Put(d / "ep.csv", kEndpoints);
+  Put(d / "robot.toml", kExampleRobot);
+}
+
+std::vector<Case> Corpus() {
+  const std::string cal = "calibrate ep.csv --robot robot.toml --side 4 ";
+  std::vector<Case> c;
+  // 1. Files destroyed.
+  c.push_back({"--json equal to the input CSV", Examples, cal + "--json ep.csv", 2, "is the input file"});
+  c.push_back({"--plot equal to the robot file", Examples, cal + "--plot robot.toml", 2, "is the input file"});
+  c.push_back({"--ros2 and --json the same file", Examples, cal + "--ros2 o.json --json o.json", 2, "name the same file"});
+  c.push_back({"--json through a symlink to the input",
+               [](const fs::path& d) {
+                 Examples(d);
+                 fs::create_symlink("ep.csv", d / "l.json");
+               },
+               cal + "--json l.json", 2, "is the input file"});
+  c.push_back({"--json /dev/stdout", Examples, cal + "--json /dev/stdout", 1, "use '-' for standard output"});
+  c.push_back({"--json a FIFO",
+               [](const fs::path& d) {
+                 Examples(d);
+                 REQUIRE(::mkfifo((d / "fifo").c_str(), 0600) == 0);
+               },
+               cal + "--json fifo", 1, "not a regular file"});
+  c.push_back({"--json a directory",
+               [](const fs::path& d) {
+                 Examples(d);
+                 fs::create_directory(d / "dir");
+               },
+               cal + "--json dir", 1, "directory"});
+  c.push_back({"--json in a folder that does not exist", Examples, cal + "--json no/such/o.json", 1,
+               "cannot create temporary file"});
+  c.push_back({"simulate --out into its manifest's folder", [](const fs::path& d) { Put(d / "m.toml", kManifest); },
+               "simulate m.toml --out . --force", 2, "contains the input"});
+  c.push_back({"simulate --out non-empty without --force",
+               [](const fs::path& d) {
+                 Put(d / "m.toml", kManifest);
+                 Put(d / "out/keep.txt", "user file\n");
+               },
+               "simulate m.toml --out out", 2, "not empty"});
+  c.push_back({"fit-noise --plot equal to the input",
+               [](const fs::path& d) {
+                 Put(d / "m.toml", kManifest);
+                 Put(d / "sq.csv", "x");
+               },
+               "fit-noise m.toml --plot sq.csv", 2, "is the input file"});
+  c.push_back({"evaluate --plot equal to --json", Examples,
+               "evaluate ep.csv --robot robot.toml --plot o.x --json o.x", 2, "name the same file"});
+  // 2. Impossible results.
+  c.push_back({"return errors in mm given as m",
+               [](const fs::path& d) {
+                 Examples(d);
+                 Put(d / "ep.csv", ScaledEndpoints(1000.0));
+               },
+               cal, 3, "millimetres given as metres"});
+  c.push_back({"--side 0.002", Examples, "calibrate ep.csv --robot robot.toml --side 0.002", 3, "square side"});
+  c.push_back({"1e308 in a CSV",
+               [](const fs::path& d) {
+                 Examples(d);
+                 Put(d / "ep.csv", "run,direction,ex_m,ey_m\n1,cw,1e308,0\n2,ccw,-1e308,0\n3,cw,1e308,1\n4,ccw,1,1\n");
+               },
+               cal, 3, "not a finite number"});
+  c.push_back({"predict --path line:1e308", Examples,
+               "predict --robot robot.toml --kl 0.001 --kr 0.001 --path line:1e308", 2, "limit"});
+  c.push_back({"predict: P0 not positive semi-definite", Examples,
+               "predict --robot robot.toml --kl 0.001 --kr 0.001 --path line:1 --P0 1,2,0,1,0,1", 2,
+               "positive semi-definite"});
+  c.push_back({"one run per direction", [](const fs::path& d) {
+                 Examples(d);
+                 Put(d / "ep.csv", "run,direction,ex_m,ey_m\n1,cw,0.01,0.02\n2,ccw,-0.01,0.03\n");
+               },
+               cal + "--json -", 0, "only 1 cw run"});
+  c.push_back({"identical runs", [](const fs::path& d) {
+                 Examples(d);
+                 Put(d / "ep.csv", Repeated("0.01,0.02,0.001", "-0.01,0.03,0.002", 5));
+               },
+               cal + "--json -", 0, "zero scatter"});
+  c.push_back({"runs that never move (all errors zero)", [](const fs::path& d) {
+                 Examples(d);
+                 Put(d / "ep.csv", Repeated("0,0,0", "0,0,0", 5));
+               },
+               cal + "--json -", 0, "exactly zero"});
+  // 3. Crashes.
+  c.push_back({"non-UTF-8 byte in run id and direction", [](const fs::path& d) {
+                 Examples(d);
+                 std::string text = kEndpoints;
+                 const auto at = text.find("\n1,cw,");
+                 REQUIRE(at != std::string::npos);
+                 text.replace(at, 6, "\n1\xff\xfe,cw,");
+                 Put(d / "ep.csv", text);
+               },
+               cal + "--json -", 0, "\\\\xFF\\\\xFE",  {},
+               [](const Run& r, const fs::path&) { CHECK_NOTHROW(nlohmann::json::parse(r.out)); }});
+  c.push_back({"non-UTF-8 direction", [](const fs::path& d) {
+                 Examples(d);
+                 Put(d / "ep.csv", "run,direction,ex_m,ey_m\n1,c\xe9w,0.01,0.02\n");
+               },
+               cal, 1, "\\xE9"});
+  c.push_back({"1e400 in --params JSON", [](const fs::path& d) {
+                 Examples(d);
+                 Put(d / "cal.json", "{\"parameters\": {\"wheelbase_m\": 1e400, \"wheel_diameter_left_m\": 0.15, "
+                                     "\"wheel_diameter_right_m\": 0.15}}");
+                 Put(d / "tr.csv", Slurp((kSource / "tests/data/good/trajectory_ticks.csv").string()));
+               },
+               "evaluate tr.csv --robot robot.toml --params cal.json", 1, "out of range"});
+  c.push_back({"predict --monte-carlo 1e12", Examples,
+               "predict --robot robot.toml --kl 0.001 --kr 0.001 --path line:1 --monte-carlo 1000000000000", 2,
+               "GB of memory"});
+  c.push_back({"simulate --speed 1e-9", [](const fs::path& d) { Put(d / "m.toml", kManifest); },
+               "simulate m.toml --out o --speed 1e-9", 2, "samples"});
+  // 4. Unbounded sizes.
+  c.push_back({"simulate --square-runs 1e8", [](const fs::path& d) { Put(d / "m.toml", kManifest); },
+               "simulate m.toml --out o --square-runs 100000000", 2, "got '100000000'"});
+  c.push_back({"diagnose --piece-length 1e-9", [](const fs::path& d) { Put(d / "m.toml", kManifest); },
+               "diagnose m.toml --piece-length 1e-9", 2, "from 0.01 to 1000"});
+  // 7. Messages.
+  c.push_back({"import foo DIR", [](const fs::path&) {}, "import foo .", 2, "unknown import format 'foo'"});
+  c.push_back({"--seed -1", [](const fs::path& d) { Put(d / "m.toml", kManifest); },
+               "simulate m.toml --out o --seed -1", 2, "got '-1'"});
+  c.push_back({"repeated --effect", [](const fs::path& d) { Put(d / "m.toml", kManifest); },
+               "simulate m.toml --out o --effect turn_scrub:k=0.01 --effect turn_scrub:k=0.02", 2, "given twice"});
+  c.push_back({"negative --side quotes the value", Examples, "calibrate ep.csv --robot robot.toml --side -412.3", 2,
+               "got '-412.3'"});
+  // More: garbage, empty, unwritable stdout.
+  c.push_back({"binary garbage as CSV", [](const fs::path& d) {
+                 Examples(d);
+                 Put(d / "ep.csv", std::string("\x00\x01\xff\xfe garbage\n\x7f", 14));
+               },
+               cal, 1, "ep.csv"});
+  c.push_back({"empty CSV", [](const fs::path& d) {
+                 Examples(d);
+                 Put(d / "ep.csv", "");
+               },
+               cal, 1, "ep.csv"});
+  c.push_back({"stdout is /dev/full", Examples, cal + "--json - >/dev/full 2>/dev/null; exit $?",
+               1, ""});  // the message itself: test_output_safety
+  c.push_back({"a manifest whose experiment file is the manifest", [](const fs::path& d) {
+                 std::string m = kManifest;
+                 m.replace(m.find("sq.csv"), 6, "m.toml");
+                 Put(d / "m.toml", m);
+               },
+               "calibrate m.toml --json -", 1, "m.toml"});
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("hostile corpus: exit status, message, inputs unchanged, bounded time and memory", "[safety][corpus][cli]") {
+  const auto cases = Corpus();
+  REQUIRE(cases.size() >= 30);
+  for (const auto& c : cases) {
+    INFO("case: " << c.name << "\n  umbmark " << c.args);
+    const fs::path dir = umbmark::testing::TempDir("hostile");
+    c.setup(dir);
+    const auto before = Hashes(dir);
+    const Run r = Exec(dir, c.args);
+    INFO("stderr: " << r.err);
+    CHECK(r.status != 124);  // timeout: a hang
+    CHECK(r.status == c.status);
+    if (!c.message.empty()) CHECK_THAT(c.status == 0 ? r.out : r.err, Catch::Contains(c.message));
+    if (c.status != 0) CHECK_THAT(r.err, !Catch::Contains("internal error"));
+    auto after = Hashes(dir);
+    for (const auto& o : c.outputs) after.erase(o);
+    auto expected = before;
+    for (const auto& o : c.outputs) expected.erase(o);
+    CHECK(after == expected);  // inputs unchanged, nothing else written
+    for (const auto& e : fs::recursive_directory_iterator(dir)) CHECK(e.path().filename().string().find(".tmp.") == std::string::npos);
+    if (c.extra) c.extra(r, dir);
+  }
+  struct rusage ru {};
+  REQUIRE(::getrusage(RUSAGE_CHILDREN, &ru) == 0);
+  CHECK(ru.ru_maxrss < kMaxRssKb);
+}
