@@ -226,7 +226,8 @@ void PrintEvaluation(const char* title, const EvaluationSummary& e) {
 
 void PrintHeldout(const HeldoutComparison& h, const Chosen& chosen, const std::vector<std::string>& warnings,
                   const CalibrateOptions& o) {
-  fmt::print("Which calibration to trust: leave-one-run-out prediction error ({} folds, {})\n",
+  fmt::print("Which calibration to trust: {} prediction error ({} folds, {})\n",
+             h.scheme == "leave_one_run_out" ? "leave-one-run-out" : "10-fold (over runs)",
              h.methods.empty() ? 0 : h.methods.front().folds,
              h.measure == "max_position_error_m" ? "largest position error along the left-out run"
                                                    : "left-out return error vs the model's prediction");

@@ -29,12 +29,25 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-CalibrateInput Subset(const CalibrateInput& in, const std::vector<std::size_t>& keep) {
-  CalibrateInput out = in;
-  out.errors.clear();
+/// Leave-one-run-out costs one calibration per run, time quadratic in the
+/// runs; above this many runs the folds are kFolds interleaved groups of
+/// runs instead (k-fold cross-validation over runs).
+constexpr std::size_t kMaxLeaveOneOutRuns = 200;
+constexpr std::size_t kFolds = 10;
+
+/// The runs `keep` of `in`; their trajectories only when a method needs them.
+CalibrateInput Subset(const CalibrateInput& in, const std::vector<std::size_t>& keep, bool with_trajectories) {
+  CalibrateInput out;
+  out.label = in.label;
+  out.path = in.path;
+  out.recorded = in.recorded;
+  out.side_m = in.side_m;
+  out.errors.reserve(keep.size());
   for (std::size_t i : keep) out.errors.push_back(in.errors[i]);
-  if (in.trajectories) {
-    out.trajectories->runs.clear();
+  if (in.trajectories && with_trajectories) {
+    out.trajectories.emplace();
+    out.trajectories->path = in.trajectories->path;
+    out.trajectories->runs.reserve(keep.size());
     for (std::size_t i : keep) out.trajectories->runs.push_back(in.trajectories->runs[i]);
   }
   return out;
@@ -44,10 +57,8 @@ CalibrateInput Subset(const CalibrateInput& in, const std::vector<std::size_t>& 
 double PredictionError(const CalibrateInput& in, std::size_t i, const RobotParams& p, Integrator integrator,
                        bool final_turn) {
   if (in.trajectories) {
-    TrajectoryData one;
-    one.path = in.trajectories->path;
-    one.runs.push_back(in.trajectories->runs[i]);
-    return EvaluateRuns(one, in.label, p, in.recorded, integrator).front().max_position_error_m;
+    return EvaluateRun(in.trajectories->runs[i], in.trajectories->path, in.label, p, in.recorded, integrator)
+        .max_position_error_m;
   }
   const ReturnError& e = in.errors[i];
   const auto direction = SquareDirectionFromString(e.direction);
@@ -80,7 +91,8 @@ HeldoutComparison CompareMethodsHeldout(const CalibrateInput& input, const Calib
   for (std::size_t i = 0; i < full.umbmark.runs.size(); ++i) {
     if (full.umbmark.runs[i].used()) used.push_back(i);
   }
-  const CalibrateInput all_used = Subset(input, used);
+  const bool with_trajectories = options.refine.has_value();  // only the refined fits read them
+  const CalibrateInput all_used = Subset(input, used, with_trajectories);
   const std::vector<bool> keep_all(used.size(), true);
 
   // A method: its parameters from a set of runs (throws when it cannot fit).
@@ -127,20 +139,40 @@ HeldoutComparison CompareMethodsHeldout(const CalibrateInput& input, const Calib
     }
   }
 
-  // Folds.
+  // Folds: each run alone, or kFolds interleaved groups (both directions in
+  // each) for many runs; a fold's error is the mean over its runs.
+  std::vector<std::vector<std::size_t>> folds;
+  if (used.size() <= kMaxLeaveOneOutRuns) {
+    for (std::size_t k = 0; k < used.size(); ++k) folds.push_back({k});
+  } else {
+    out.scheme = "k_fold_over_runs";
+    folds.resize(kFolds);
+    for (std::size_t k = 0; k < used.size(); ++k) folds[k % kFolds].push_back(k);
+    out.notes.push_back(fmt::format("{} runs: {}-fold cross-validation over runs instead of leave-one-run-out",
+                                    used.size(), kFolds));
+  }
   std::vector<bool> complete;  // every method predicted this fold
-  for (std::size_t k = 0; k < used.size(); ++k) {
+  std::vector<bool> in_fold(used.size(), false);
+  for (std::size_t f = 0; f < folds.size(); ++f) {
+    for (std::size_t k : folds[f]) in_fold[k] = true;
     std::vector<std::size_t> rest;
+    rest.reserve(used.size());
     for (std::size_t j = 0; j < used.size(); ++j) {
-      if (j != k) rest.push_back(used[j]);
+      if (!in_fold[j]) rest.push_back(used[j]);
     }
-    const CalibrateInput train = Subset(input, rest);
-    out.left_out.push_back(input.errors[used[k]].run);
+    for (std::size_t k : folds[f]) in_fold[k] = false;
+    const CalibrateInput train = Subset(input, rest, with_trajectories);
+    out.left_out.push_back(folds[f].size() == 1
+                               ? input.errors[used[folds[f].front()]].run
+                               : fmt::format("fold {} of {} ({} runs)", f + 1, folds.size(), folds[f].size()));
     bool all = true;
     for (std::size_t m = 0; m < methods.size(); ++m) {
       double err = kNaN;
       try {
-        err = PredictionError(input, used[k], methods[m].fit(train), options.integrator, final_turn);
+        const RobotParams p = methods[m].fit(train);
+        double sum = 0.0;
+        for (std::size_t k : folds[f]) sum += PredictionError(input, used[k], p, options.integrator, final_turn);
+        err = sum / static_cast<double>(folds[f].size());
       } catch (const std::runtime_error& e) {  // InputError, QualityGateError
         if (out.methods[m].failure.empty()) out.methods[m].failure = e.what();
       }

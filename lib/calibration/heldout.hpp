@@ -13,6 +13,9 @@
 //  - return errors only (endpoint input): the distance between the measured
 //    return error (x, y) and the exact commanded-square return error of a
 //    robot with those parameters (model/commanded_square.hpp).
+// Above 200 used runs (where one calibration per run would cost time
+// quadratic in the runs) the folds are 10 interleaved groups of runs
+// instead (scheme "k_fold_over_runs"; a fold's error is its runs' mean).
 // Outlier rejection and --exclude-runs are decided once on all runs and kept
 // across folds. Methods: recorded (no calibration, the baseline),
 // umbmark_x, umbmark_y, umbmark_mean (classic estimators), refined and, for
@@ -41,7 +44,7 @@ struct MethodHeldout {
 };
 
 struct HeldoutComparison {
-  std::string scheme = "leave_one_run_out";
+  std::string scheme = "leave_one_run_out";  ///< or "k_fold_over_runs" (above 200 runs)
   /// max_position_error_m (trajectories) | return_error_prediction_m (endpoints)
   std::string measure;
   std::vector<std::string> left_out;  ///< run ids, fold order
