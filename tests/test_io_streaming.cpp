@@ -291,3 +291,17 @@ TEST_CASE("CLI: evaluate streams a file and names it in reader messages", "[io][
   CHECK(r.err.find(csv + ":1:68: carriage return (\\r) inside the line: the file uses CR-only line ends") !=
         std::string::npos);
 }
+
+TEST_CASE("CLI: a robot fault found while reading a file names the file, not <input>", "[io][stream][cli]") {
+  const auto dir = umbmark::testing::TempDir("inputname");
+  const std::string csv = (dir / "ticks.csv").string();
+  std::FILE* f = std::fopen(csv.c_str(), "wb");
+  REQUIRE(f != nullptr);
+  std::fputs((kHeader + "\n1,cw,0,0,0,0,0,0\n1,cw,1,10,10,0,0,0\n").c_str(), f);
+  std::fclose(f);
+  // Ticks in the file but no ticks_per_rev given.
+  const auto r = RunCli("evaluate " + Q(csv) + " --wheelbase 0.2 --diameter-left 0.084 --diameter-right 0.084");
+  CHECK(r.status == 1);
+  CHECK(r.err.find(csv + ":2: run 1: ticks_per_rev is required") != std::string::npos);
+  CHECK(r.err.find("<input>") == std::string::npos);
+}

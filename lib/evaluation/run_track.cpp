@@ -18,8 +18,13 @@ RunTrack TrackRun(const TrajectoryRun& run, const std::string& file, const Robot
                      "run " + run.run + " has no ground truth at its first sample");
   }
   RunTrack track;
-  track.odometry = IntegrateOdometry(ComputeWheelTravel(run, params, recorded), params.wheelbase_m, Pose2{},
-                                     integrator);
+  WheelTravel travel;
+  try {
+    travel = ComputeWheelTravel(run, params, recorded);
+  } catch (const InputError& e) {  // a fault of the robot for this file: name the file, not "<input>"
+    throw InputError(file, run.lines.empty() ? 0 : run.lines.front(), 0, e.message());
+  }
+  track.odometry = IntegrateOdometry(travel, params.wheelbase_m, Pose2{}, integrator);
   track.ground_truth.resize(n);
   track.has_ground_truth.resize(n);
   const Pose2 world_T_start = run.GroundTruth(0);
