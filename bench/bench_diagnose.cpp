@@ -31,6 +31,13 @@
 //   outside    gt_yaw_misalignment delta +-0.005-0.02 rad; floor_slope g
 //              0.002-0.01 m/m towards a random direction
 //
+// Classes beyond the catalogue's (--classes): `negligible` (500 ticks/rev,
+// k_L = k_R 2-5e-3 m^1/2, ground truth 0.8 mm / 0.15 deg, plus one of a
+// 0.1-0.8 mm marker offset, a 1-2 ms time offset, a 0.5-2e-4 scale error;
+// --clean campaigns; target verdict `none`), `pair_castor_bumps` and
+// `pair_time_gt` (both effects at the single ranges; both must be in
+// verdict.effects).
+//
 // Usage: bench_diagnose [--per-class N] [--clean N] [--seed S] [--threads T]
 //                       [--null-sims B] [--extended] [--classes a,b,...]
 //                       [--json FILE] [--write-dir DIR] [--only-case I]
@@ -49,6 +56,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "core/angles.hpp"
@@ -137,7 +145,14 @@ Case MakeCase(const std::string& truth, std::uint64_t seed, bool extended, doubl
   const double d = U(g, 0.06, 0.2);
   robot.wheel_diameter_left_m = robot.wheel_diameter_right_m = d;
   robot.ticks_per_rev = std::round(U(g, 500.0, 20000.0));
-  const GroundTruthNoise gt{U(g, 1e-4, 5e-4), U(g, 0.5e-3, 3e-3)};
+  GroundTruthNoise gt{U(g, 1e-4, 5e-4), U(g, 0.5e-3, 3e-3)};
+  const bool negligible = truth == "negligible";
+  if (negligible) {
+    // A clean robot with coarse encoders, large wheel noise and a noisy
+    // motion capture (0.8 mm, 0.15 deg), plus one mismatch too small to matter.
+    robot.ticks_per_rev = 500.0;
+    gt = GroundTruthNoise{8e-4, 0.15 * kPi / 180.0};
+  }
   c.manifest = sim::StandardCampaignManifest(robot, U(g, 2.0, 4.0), U(g, 2.0, 5.0), gt);
   if (extended) {
     Experiment fr;
@@ -151,6 +166,7 @@ Case MakeCase(const std::string& truth, std::uint64_t seed, bool extended, doubl
   o.truth.E_b = 1.0 + Sign(g) * U(g, 0.0, 0.03);
   o.truth.k_L = LogU(g, 3e-4, 3e-3);
   o.truth.k_R = LogU(g, 3e-4, 3e-3);
+  if (negligible) o.truth.k_L = o.truth.k_R = LogU(g, 2e-3, 5e-3);
   o.square_runs_per_direction = 10;
   o.back_and_forth_runs = 20;
   o.free_runs = 4;
@@ -160,6 +176,29 @@ Case MakeCase(const std::string& truth, std::uint64_t seed, bool extended, doubl
   o.pause_s = pause_s;
   o.free_radius_m = U(g, 0.8, 1.5);
   sim::Effects& fx = o.effects;
+  if (negligible) {
+    switch (static_cast<int>(U(g, 0.0, 3.0))) {
+      case 0: {
+        const double r = U(g, 1e-4, 8e-4), a = U(g, 0.0, 2.0 * kPi);
+        fx.gt_dx = r * std::cos(a);
+        fx.gt_dy = r * std::sin(a);
+        break;
+      }
+      case 1: fx.time_tau = Sign(g) * U(g, 0.001, 0.002); break;
+      default: fx.scale_s = Sign(g) * U(g, 5e-5, 2e-4); break;
+    }
+  }
+  if (truth == "pair_castor_bumps") {
+    fx.castor_kappa = Sign(g) * U(g, 0.005, 0.02);
+    fx.bump_rate = U(g, 0.2, 1.0);
+    fx.bump_sigma = U(g, 0.003, 0.01);
+  }
+  if (truth == "pair_time_gt") {
+    fx.time_tau = Sign(g) * U(g, 0.02, 0.1);
+    const double r = U(g, 0.01, 0.05), a = U(g, 0.0, 2.0 * kPi);
+    fx.gt_dx = r * std::cos(a);
+    fx.gt_dy = r * std::sin(a);
+  }
   const auto kind = sim::EffectFromString(truth);
   if (kind) {
     c.outside = !sim::Describe(*kind).in_contract;
@@ -215,7 +254,7 @@ int main(int argc, char** argv) {
   }
   std::vector<Case> cases;
   for (std::size_t ci = 0; ci < classes.size(); ++ci) {
-    const int count = classes[ci] == "none" ? args.clean : args.per_class;
+    const int count = classes[ci] == "none" || classes[ci] == "negligible" ? args.clean : args.per_class;
     for (int i = 0; i < count; ++i)
       cases.push_back(MakeCase(classes[ci], args.seed * 1000003ull + ci * 10007ull + static_cast<std::uint64_t>(i),
                                args.extended, args.pause_s));
@@ -233,6 +272,7 @@ int main(int argc, char** argv) {
   std::map<std::string, std::vector<double>> stage_times;
   int listed = 0, listed_right = 0, listed_no_scrub = 0, listed_no_scrub_right = 0;
   int clean = 0, false_alarms = 0, outside = 0, outside_unexplained = 0;
+  int negligible = 0, negligible_none = 0, pairs = 0, pairs_both = 0;
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const Case& c = cases[i];
     if (args.only_case >= 0 && static_cast<int>(i) != args.only_case) continue;
@@ -253,7 +293,17 @@ int main(int argc, char** argv) {
     for (const auto& [stage, v] : s.timings) stage_times[stage].push_back(v);
     confusion[c.truth][s.verdict] += 1;
     const bool right = s.verdict == c.truth;
-    if (c.truth == "none") {
+    auto named = [&](const char* e) {
+      return std::find(s.verdict_effects.begin(), s.verdict_effects.end(), e) != s.verdict_effects.end();
+    };
+    if (c.truth == "negligible") {
+      ++negligible;
+      negligible_none += s.verdict == "none";
+    } else if (c.truth.rfind("pair_", 0) == 0) {
+      ++pairs;
+      pairs_both += c.truth == "pair_castor_bumps" ? named("castor_kick") && named("bump_outliers")
+                                                   : named("time_offset") && named("gt_offset");
+    } else if (c.truth == "none") {
       ++clean;
       if (s.verdict != "none") ++false_alarms;
     } else if (c.outside) {
@@ -275,6 +325,7 @@ int main(int argc, char** argv) {
     records.push_back({{"case", i},
                        {"truth", c.truth},
                        {"verdict", s.verdict},
+                       {"verdict_effects", s.verdict_effects},
                        {"p_value", s.p_value},
                        {"score_p_value", s.score_p_value},
                        {"tests_p_value", s.tests_p_value},
@@ -290,8 +341,8 @@ int main(int argc, char** argv) {
                                              : nlohmann::json{{"effect", sim::EffectToString(s.candidates[0].effect)},
                                                               {"heldout_shrink", s.candidates[0].heldout_shrink},
                                                               {"evidence", s.candidates[0].evidence}}}});
-    fmt::print("{:4d} {:<20} -> {:<20} p={:<7.4f} G={:<10.1f} {:.2f}s\n", i, c.truth, s.verdict, s.p_value,
-               s.gap_score, dt);
+    fmt::print("{:4d} {:<20} -> {:<20} p={:<7.4f} G={:<10.1f} {:.2f}s  effects: {}\n", i, c.truth, s.verdict,
+               s.p_value, s.gap_score, dt, fmt::join(s.verdict_effects, " + "));
     std::fflush(stdout);
   }
 
@@ -311,6 +362,9 @@ int main(int argc, char** argv) {
   fmt::print("false alarms on clean campaigns:           {:5.1f}% ({}/{})\n", pct(false_alarms, clean), false_alarms, clean);
   fmt::print("'unexplained' on outside effects:          {:5.1f}% ({}/{})\n", pct(outside_unexplained, outside),
              outside_unexplained, outside);
+  fmt::print("'none' on negligible-mismatch campaigns:   {:5.1f}% ({}/{})\n", pct(negligible_none, negligible),
+             negligible_none, negligible);
+  fmt::print("both effects named on pair campaigns:      {:5.1f}% ({}/{})\n", pct(pairs_both, pairs), pairs_both, pairs);
   fmt::print("median heldout_shrink (true effect):       {:.3f}\n", Median(heldout_true));
   fmt::print("median heldout_shrink (verdict's effect):  {:.3f}\n", Median(heldout_verdict));
   fmt::print("time per diagnosis: median {:.2f} s, max {:.2f} s\n", Median(times),
@@ -323,6 +377,8 @@ int main(int argc, char** argv) {
                               {"top1_listed_without_turn_scrub", pct(listed_no_scrub_right, listed_no_scrub) / 100.0},
                               {"false_alarm_rate", pct(false_alarms, clean) / 100.0},
                               {"outside_unexplained_rate", pct(outside_unexplained, outside) / 100.0},
+                              {"negligible_none_rate", pct(negligible_none, negligible) / 100.0},
+                              {"pairs_both_named_rate", pct(pairs_both, pairs) / 100.0},
                               {"median_heldout_shrink_true", Median(heldout_true)},
                               {"median_heldout_shrink_verdict", Median(heldout_verdict)},
                               {"median_seconds", Median(times)},
