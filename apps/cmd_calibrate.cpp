@@ -361,6 +361,12 @@ int RunCalibrate(const CalibrateOptions& o) {
   std::vector<Row> rows;
   std::vector<std::string> all_warnings;
   int status = 0;
+  // A failed unit of a batch: a row, a JSON entry and the worst exit status.
+  const auto record_failure = [&](const std::string& label, const std::string& what, int code) {
+    rows.push_back({label, std::nullopt, what});
+    results.push_back({{"input", label}, {"error", what}});
+    status = std::max(status, code);
+  };
   for (const auto& path : o.inputs) {
     std::vector<CalibrateInput> inputs;
     try {
@@ -368,9 +374,7 @@ int RunCalibrate(const CalibrateOptions& o) {
     } catch (const InputError& e) {
       if (!batch) throw;
       fmt::print(stderr, "{}\n", e.what());
-      rows.push_back({path, std::nullopt, e.what()});
-      results.push_back({{"input", path}, {"error", e.what()}});
-      status = std::max(status, 1);
+      record_failure(path, e.what(), 1);
       continue;
     }
     for (const auto& in : inputs) {
@@ -394,29 +398,22 @@ int RunCalibrate(const CalibrateOptions& o) {
         gate = CheckUmbmarkPlausibility(r.umbmark);
         if (r.refined) CheckRefinedPlausibility(r.umbmark.recorded, r.refined->refined, gate);
         if (!gate.ok()) throw QualityGateError(fmt::format("{}: implausible result: {}", in.label, gate.Message()));
-
       } catch (const RefineError& e) {
         // Print what is known (solver report, identifiability), then fail
         // the quality gate: exit 3, never numbers from a failed fit.
         fmt::print(stderr, "{}: refined calibration failed: {}\n{}", in.label, e.what(), RefineReport(e.summary()));
         if (!batch) throw;
-        rows.push_back({in.label, std::nullopt, e.what()});
-        results.push_back({{"input", in.label}, {"error", e.what()}});
-        status = std::max(status, 3);
+        record_failure(in.label, e.what(), 3);
         continue;
       } catch (const QualityGateError& e) {
         if (!batch) throw;
         fmt::print(stderr, "umbmark: quality gate failed: {}\n", e.what());
-        rows.push_back({in.label, std::nullopt, e.what()});
-        results.push_back({{"input", in.label}, {"error", e.what()}});
-        status = std::max(status, 3);
+        record_failure(in.label, e.what(), 3);
         continue;
       } catch (const InputError& e) {
         if (!batch) throw;
         fmt::print(stderr, "{}\n", e.what());
-        rows.push_back({in.label, std::nullopt, e.what()});
-        results.push_back({{"input", in.label}, {"error", e.what()}});
-        status = std::max(status, 1);
+        record_failure(in.label, e.what(), 1);
         continue;
       }
       const HeldoutComparison heldout = CompareMethodsHeldout(in, jo, r);
