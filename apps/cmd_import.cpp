@@ -158,6 +158,8 @@ int RunRosbag2List(const Rosbag2Options& o) {
   return 0;
 }
 
+// Options to the library's, output checks, import, write, then the text and
+// JSON summaries of what was read (long only because of the printing).
 int RunRosbag2(Rosbag2Options o) {
   namespace fs = std::filesystem;
   if (o.list) return RunRosbag2List(o);

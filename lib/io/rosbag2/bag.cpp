@@ -103,6 +103,9 @@ std::optional<std::size_t> Bag::FindTopic(std::string_view name) const {
   return std::nullopt;
 }
 
+// Long because it is the one place that knows the three bag layouts (folder
+// with metadata.yaml, bare folder, single file) and both storages' topic
+// sources (SQLite counts, MCAP summary or one counting pass).
 Bag Bag::Open(const std::string& path, std::vector<std::string>& warnings) {
   Bag bag;
   bag.path_ = path;

@@ -238,7 +238,8 @@ struct RecordingData {
 };
 
 // One streaming pass over the recording: decodes the wheel and ground-truth
-// topics into time-stamped samples (the only per-message state kept).
+// topics into time-stamped samples (the only per-message state kept). One
+// callback handles every message type so the bag is read once.
 RecordingData ReadRecording(const Bag& bag, const TopicChoice& c, const RobotParams& robot,
                             const Rosbag2ImportOptions& o) {
   RecordingData d;
@@ -356,6 +357,9 @@ std::string DescribeTopics(const Bag& bag) {
   return out;
 }
 
+// Per recording: read, split, then build each run (relative travel, ground
+// truth re-expressed, direction); kept in one function so the contract's
+// run rules read in one place.
 Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotParams& robot,
                             const Rosbag2ImportOptions& o) {
   if (const std::string err = o.Validate(); !err.empty()) throw InvalidOptions(err);
