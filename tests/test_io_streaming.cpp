@@ -44,6 +44,13 @@ std::string Dump(const TrajectoryData& d) {
   return out;
 }
 
+void WriteText(const std::string& path, const std::string& text) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  REQUIRE(f != nullptr);
+  std::fwrite(text.data(), 1, text.size(), f);
+  std::fclose(f);
+}
+
 /// Result (or error message) of reading `text` with the given chunking.
 std::string ReadWith(const std::string& text, std::size_t chunk, std::size_t buffer) {
   try {
@@ -145,11 +152,7 @@ TEST_CASE("streaming: NextRun hands out one run at a time and reuses the caller'
 TEST_CASE("ReadRunFile and OpenRunFile read a file once, by its header", "[io][stream]") {
   const auto dir = umbmark::testing::TempDir("open");
   const std::string path = (dir / "t.csv").string();
-  std::FILE* f = std::fopen(path.c_str(), "wb");
-  REQUIRE(f != nullptr);
-  const std::string text = kHeader + "\n1,cw,0,0,0,0,0,0\n1,cw,1,1,1,0,0,0\n2,ccw,0,0,0,0,0,0\n2,ccw,1,1,1,0,0,0\n";
-  std::fwrite(text.data(), 1, text.size(), f);
-  std::fclose(f);
+  WriteText(path, kHeader + "\n1,cw,0,0,0,0,0,0\n1,cw,1,1,1,0,0,0\n2,ccw,0,0,0,0,0,0\n2,ccw,1,1,1,0,0,0\n");
   io::OpenedRunFile opened = io::OpenRunFile(path);
   auto* reader = std::get_if<io::TrajectoryReader>(&opened);
   REQUIRE(reader != nullptr);
@@ -256,15 +259,9 @@ TEST_CASE("size limits: non-regular inputs stop early with a clear message", "[i
 
 TEST_CASE("CLI: a manifest whose file is /dev/zero fails at once with exit 1", "[io][stream][cli]") {
   const auto dir = umbmark::testing::TempDir("devzero");
-  {
-    std::FILE* f = std::fopen((dir / "m.toml").string().c_str(), "wb");
-    REQUIRE(f != nullptr);
-    std::fputs(
-        "[robot]\nwheelbase_m = 0.2\nwheel_diameter_left_m = 0.084\nwheel_diameter_right_m = 0.084\n"
-        "ticks_per_rev = 2796.8\n\n[[experiment]]\nkind = \"free\"\nfile = \"/dev/zero\"\n",
-        f);
-    std::fclose(f);
-  }
+  WriteText((dir / "m.toml").string(),
+            "[robot]\nwheelbase_m = 0.2\nwheel_diameter_left_m = 0.084\nwheel_diameter_right_m = 0.084\n"
+            "ticks_per_rev = 2796.8\n\n[[experiment]]\nkind = \"free\"\nfile = \"/dev/zero\"\n");
   for (const char* command : {"evaluate", "calibrate", "fit-noise"}) {
     INFO(command);
     const auto r = RunCli(std::string(command) + " " + Q(dir / "m.toml"));
@@ -282,10 +279,7 @@ TEST_CASE("CLI: a manifest whose file is /dev/zero fails at once with exit 1", "
 TEST_CASE("CLI: evaluate streams a file and names it in reader messages", "[io][stream][cli]") {
   const auto dir = umbmark::testing::TempDir("evalstream");
   const std::string csv = (dir / "cr.csv").string();
-  std::FILE* f = std::fopen(csv.c_str(), "wb");
-  REQUIRE(f != nullptr);
-  std::fputs((kHeader + "\r1,cw,0,0,0,0,0,0\r1,cw,1,10,10,0,0,0\r").c_str(), f);
-  std::fclose(f);
+  WriteText(csv, kHeader + "\r1,cw,0,0,0,0,0,0\r1,cw,1,10,10,0,0,0\r");
   const auto r = RunCli("evaluate " + Q(csv) + " --wheelbase 0.2 --diameter-left 0.084 --diameter-right 0.084");
   CHECK(r.status == 1);
   CHECK(r.err.find(csv + ":1:68: carriage return (\\r) inside the line: the file uses CR-only line ends") !=
@@ -295,10 +289,7 @@ TEST_CASE("CLI: evaluate streams a file and names it in reader messages", "[io][
 TEST_CASE("CLI: a robot fault found while reading a file names the file, not <input>", "[io][stream][cli]") {
   const auto dir = umbmark::testing::TempDir("inputname");
   const std::string csv = (dir / "ticks.csv").string();
-  std::FILE* f = std::fopen(csv.c_str(), "wb");
-  REQUIRE(f != nullptr);
-  std::fputs((kHeader + "\n1,cw,0,0,0,0,0,0\n1,cw,1,10,10,0,0,0\n").c_str(), f);
-  std::fclose(f);
+  WriteText(csv, kHeader + "\n1,cw,0,0,0,0,0,0\n1,cw,1,10,10,0,0,0\n");
   // Ticks in the file but no ticks_per_rev given.
   const auto r = RunCli("evaluate " + Q(csv) + " --wheelbase 0.2 --diameter-left 0.084 --diameter-right 0.084");
   CHECK(r.status == 1);
