@@ -6,9 +6,11 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <set>
 #include <variant>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "calibrate_plot.hpp"
 #include "calibration/calibrate_job.hpp"
@@ -16,6 +18,7 @@
 #include "calibration/plausibility.hpp"
 #include "commands.hpp"
 #include "common.hpp"
+#include "progress.hpp"
 #include "core/angles.hpp"
 #include "core/errors.hpp"
 #include "io/atomic_write.hpp"
@@ -50,6 +53,7 @@ struct CalibrateOptions {
   std::string start_pose = "fitted";
   double heading_weight = 4.0;
   std::string use = "recommended";
+  bool per_experiment = false;
 };
 
 // The parameters --ros2 and --plot use: --use classic | refined |
@@ -92,8 +96,9 @@ Chosen ChooseParameters(const CalibrateJobResult& r, const HeldoutComparison& h,
   return classic("no recommendation could be formed (too few runs): the classic result");
 }
 
-// Turns one command-line input into calibration inputs (a manifest may hold
-// several square experiments; each is calibrated on its own).
+// Turns one command-line input into calibration inputs. A manifest's square
+// experiments pool into one calibration (one side length), or give one each
+// with --per-experiment.
 std::vector<CalibrateInput> LoadInputs(const std::string& path, const CalibrateOptions& o, Integrator integrator) {
   std::vector<CalibrateInput> out;
   auto from_file = [&](const std::string& file, const RobotParams& robot, double side, const std::string& label) {
@@ -106,19 +111,37 @@ std::vector<CalibrateInput> LoadInputs(const std::string& path, const CalibrateO
   if (io::IsManifestPath(path)) {
     const Manifest m = io::ReadManifest(path);
     const RobotParams robot = o.robot.Resolve(m.robot);
+    std::vector<std::string> tags;
     int index = 0;
     for (const auto& e : m.experiments) {
       ++index;
       if (e.kind != ExperimentKind::kSquare) continue;
       const double side = o.side_m.value_or(e.side_m);
       out.push_back(from_file(e.resolved_file, robot, side, fmt::format("{}#{}", path, index)));
+      tags.push_back(std::to_string(index));
     }
     if (out.empty()) throw InputError(path, "the manifest has no square experiment to calibrate from");
+    if (!o.per_experiment && out.size() > 1) {
+      return {PoolInputs(out, tags, fmt::format("{} (experiments {} pooled)", path, fmt::join(tags, ", ")))};
+    }
   } else {
     if (!o.side_m) throw InvalidOptions("--side S (square side in metres) is required for CSV input");
     out.push_back(from_file(path, o.robot.Resolve(), *o.side_m, path));
   }
   return out;
+}
+
+// The name a batch output is tagged with: the dataset, i.e. the input file's
+// stem, or its folder when the file has a generic name (an import's
+// campaign.toml / runs.csv), plus the experiment for --per-experiment.
+std::string DatasetTag(const std::string& input_path, const CalibrateInput& in) {
+  const std::filesystem::path p(input_path);
+  std::string stem = p.stem().string();
+  if ((stem == "campaign" || stem == "runs") && p.has_parent_path() && !p.parent_path().filename().empty())
+    stem = p.parent_path().filename().string();
+  if (const auto hash = in.label.rfind('#'); hash != std::string::npos && in.label.find(' ', hash) == std::string::npos)
+    stem += "-exp" + in.label.substr(hash + 1);
+  return stem;
 }
 
 nlohmann::json JsonCluster(const ClusterStats& c) {
@@ -177,6 +200,8 @@ nlohmann::json JsonResult(const CalibrateInput& in, const CalibrateJobResult& r,
     runs.push_back(jr);
   }
   j["runs"] = runs;
+  j["experiments"] = in.files;
+  if (r.refine_failure) j["refine_error"] = r.refine_failure->what();
   if (r.refined) {
     j["refined"] = RefinedToJson(*r.refined);
     if (r.refined_evaluation) {
@@ -322,6 +347,7 @@ int RunCalibrate(const CalibrateOptions& o) {
   jo.umbmark.reject_outliers = o.reject_outliers;
   jo.umbmark.outlier_threshold = o.outlier_threshold;
   jo.integrator = *IntegratorFromString(o.integrator);
+  jo.keep_classic_on_refine_failure = true;
   if (o.refine) {
     RefineOptions ro;
     auto has = [](const std::vector<std::string>& v, const char* name) {
@@ -360,6 +386,8 @@ int RunCalibrate(const CalibrateOptions& o) {
   };
   std::vector<Row> rows;
   std::vector<std::string> all_warnings;
+  std::vector<std::string> written;  // "path (what)"
+  std::set<std::string> tags_used;
   int status = 0;
   // A failed unit of a batch: a row, a JSON entry and the worst exit status.
   const auto record_failure = [&](const std::string& label, const std::string& what, int code) {
@@ -367,7 +395,10 @@ int RunCalibrate(const CalibrateOptions& o) {
     results.push_back({{"input", label}, {"error", what}});
     status = std::max(status, code);
   };
+  Progress progress(fmt::format("calibrating {} inputs", o.inputs.size()), static_cast<double>(o.inputs.size()));
+  double done = 0.0;
   for (const auto& path : o.inputs) {
+    progress.Update(done++);
     std::vector<CalibrateInput> inputs;
     try {
       inputs = LoadInputs(path, o, jo.integrator);
@@ -426,11 +457,18 @@ int RunCalibrate(const CalibrateOptions& o) {
         warnings.push_back("ground truth only at the first and last sample of each run: the refined fit used the "
                            "return errors (commanded-square model), as for endpoint data, not the path geometry");
       }
-      const std::string tag = std::filesystem::path(in.path).stem().string() + "-" + std::to_string(rows.size() + 1);
-      if (!o.ros2.empty()) outs.Write(batch ? TaggedPath(o.ros2, tag) : o.ros2, Ros2Parameters(r, chosen, o.controller));
+      std::string tag = DatasetTag(path, in);
+      for (int k = 2; !tags_used.insert(tag).second; ++k) tag = fmt::format("{}-{}", DatasetTag(path, in), k);
+      const bool several = batch || inputs.size() > 1;
+      if (!o.ros2.empty()) {
+        const std::string file = several ? TaggedPath(o.ros2, tag) : o.ros2;
+        outs.Write(file, Ros2Parameters(r, chosen, o.controller));
+        written.push_back(file + " (ros2_control parameters)");
+      }
       if (!o.plot.empty()) {
-        outs.Write(batch ? TaggedPath(o.plot, tag) : o.plot,
-                   CalibrationPlotSvg(in, r, jo.integrator, chosen.parameters, chosen.method));
+        const std::string file = several ? TaggedPath(o.plot, tag) : o.plot;
+        outs.Write(file, CalibrationPlotSvg(in, r, jo.integrator, chosen.parameters, chosen.method));
+        written.push_back(file + " (plot)");
       }
       if (o.json.PrintText()) {
         PrintResult(r);
@@ -438,6 +476,13 @@ int RunCalibrate(const CalibrateOptions& o) {
         fmt::print("\n");
       } else {
         for (const auto& w : warnings) fmt::print(stderr, "{}: warning: {}\n", in.label, w);
+      }
+      if (r.refine_failure) {
+        // The classic result stands (printed and written); the refined fit
+        // failed its quality gate: say so once, with the solver's report.
+        fmt::print(stderr, "umbmark: quality gate failed: {}: refined calibration failed: {}\n  solver: {}\n", in.label,
+                   r.refine_failure->what(), r.refine_failure->summary().solver.brief_report);
+        status = std::max(status, 3);
       }
       for (const auto& w : warnings) all_warnings.push_back(batch ? in.label + ": " + w : w);
       // The JSON document only when asked for: with a million runs it is
@@ -470,6 +515,8 @@ int RunCalibrate(const CalibrateOptions& o) {
   } else {
     o.json.Emit({{"results", results}, {"failed", status != 0}, {"warnings", all_warnings}});
   }
+  if (!o.json.path.empty() && !o.json.ToStdout()) written.push_back(o.json.path + " (JSON)");
+  PrintWritten(written, o.json.PrintText());
   return status;
 }
 
@@ -479,8 +526,7 @@ Command SetupCalibrate(CLI::App& parent) {
   auto opts = std::make_shared<CalibrateOptions>();
   auto* app = parent.add_subcommand("calibrate", "UMBmark calibration from CW/CCW square runs");
   app->add_option("DATA", opts->inputs, "Endpoint or trajectory CSV, or campaign manifest (.toml); several = batch")
-      ->required()
-      ->check(CLI::ExistingFile);
+      ->required();
   opts->robot.Bind(*app);
   app->add_option("--side", opts->side_m, "Square side L [m] (required for CSV input)")->check(Positive());
   app->add_option("--estimator", opts->estimator, "alpha/beta from x (4.20a, 4.24a), y (4.20b, 4.24b) or their mean")
@@ -523,6 +569,8 @@ Command SetupCalibrate(CLI::App& parent) {
       ->check(CLI::IsMember({"huber", "cauchy", "none"}))
       ->capture_default_str();
   app->add_option("--loss-scale", opts->loss_scale_m, "Robust loss scale [m]")->check(Positive())->capture_default_str();
+  app->add_flag("--per-experiment", opts->per_experiment,
+                "A manifest with several square experiments: one calibration per experiment (default: pooled into one)");
   app->add_option("--samples-per-run", opts->samples_per_run, "Poses sampled per trajectory run (evenly in travel)")
       ->check(NumberIn(2, 100000))
       ->capture_default_str();

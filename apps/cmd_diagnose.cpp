@@ -66,7 +66,7 @@ int RunDiagnose(DiagnoseCliOptions o) {
 Command SetupDiagnose(CLI::App& parent) {
   auto opts = std::make_shared<DiagnoseCliOptions>();
   auto* app = parent.add_subcommand("diagnose", "Sim-to-real gap: where it lies, which effect causes it, how far it shrinks");
-  app->add_option("MANIFEST", opts->manifest, "Campaign manifest (TOML)")->required()->check(CLI::ExistingFile);
+  app->add_option("MANIFEST", opts->manifest, "Campaign manifest (TOML)")->required();
   auto& d = opts->diag;
   app->add_option("--null-sims", d.null_simulations, "Simulated baseline campaigns for the p-value (default 500)")
       ->check(NumberIn(20, 1000000));

@@ -197,10 +197,9 @@ int RunEvaluate(const EvaluateOptions& o) {
 Command SetupEvaluate(CLI::App& parent) {
   auto opts = std::make_shared<EvaluateOptions>();
   auto* app = parent.add_subcommand("evaluate", "Odometry vs ground truth along trajectories, for any parameters");
-  app->add_option("DATA", opts->inputs, "Trajectory CSV(s) or campaign manifest(s)")->required()->check(CLI::ExistingFile);
+  app->add_option("DATA", opts->inputs, "Trajectory CSV(s) or campaign manifest(s)")->required();
   opts->robot.Bind(*app);
-  app->add_option("--params", opts->params_file, "Calibration JSON from `umbmark calibrate` (refined.parameters if present)")
-      ->check(CLI::ExistingFile);
+  app->add_option("--params", opts->params_file, "Calibration JSON from `umbmark calibrate` (refined.parameters if present)");
   app->add_option("--integrator", opts->integrator, "Odometry from ticks: arc (exact) or midpoint")
       ->check(CLI::IsMember({"arc", "midpoint"}))
       ->capture_default_str();

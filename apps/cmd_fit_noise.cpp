@@ -401,8 +401,7 @@ Command SetupFitNoise(CLI::App& parent) {
   auto opts = std::make_shared<FitNoiseOptions>();
   auto* app = parent.add_subcommand("fit-noise", "k_L, k_R (Chong & Kleeman) from back-and-forth or any trajectory runs");
   app->add_option("DATA", opts->inputs, "Endpoint or trajectory CSV(s), or campaign manifest(s)")
-      ->required()
-      ->check(CLI::ExistingFile);
+      ->required();
   opts->robot.Bind(*app);
   app->add_option("--distance", opts->distance_m, "Endpoint data: each run drove D forward, then D back [m]")
       ->check(Positive());

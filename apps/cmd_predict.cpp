@@ -16,6 +16,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "progress.hpp"
 #include "core/angles.hpp"
 #include "core/errors.hpp"
 #include "error_models/path_covariance.hpp"
@@ -108,6 +109,23 @@ void CheckMonteCarloSize(std::int64_t runs, int partitions, std::size_t segments
   }
 }
 
+/// Standard errors of a Monte Carlo mean and covariance from n runs: the
+/// mean's sqrt(C_ii / n); the sample covariance's, for Gaussian poses,
+/// sqrt((C_ii C_jj + C_ij^2) / (n - 1)) (Wishart variance).
+struct MonteCarloErrors {
+  Eigen::Vector3d mean;
+  PoseCovariance covariance;
+};
+MonteCarloErrors StandardErrors(const PoseCovariance& C, std::int64_t n) {
+  MonteCarloErrors e;
+  const double runs = static_cast<double>(n);
+  for (int i = 0; i < 3; ++i) {
+    e.mean(i) = std::sqrt(std::max(C(i, i), 0.0) / runs);
+    for (int k = 0; k < 3; ++k) e.covariance(i, k) = std::sqrt((C(i, i) * C(k, k) + C(i, k) * C(i, k)) / (runs - 1.0));
+  }
+  return e;
+}
+
 int RunPredict(const PredictOptions& o) {
   RegisterInputs({}, &o.robot);
   CommandOutputs().AddOutput("--json", o.json.path);
@@ -169,10 +187,16 @@ int RunPredict(const PredictOptions& o) {
     mo.runs = *o.mc_runs;
     mo.seed = o.seed;
     mo.threads = o.threads;
-    const sim::MonteCarloSummary mc = sim::RunMonteCarlo(plan, mo);
+    const sim::MonteCarloSummary mc = [&] {
+      Progress progress(fmt::format("Monte Carlo, {} runs", mo.runs));
+      return sim::RunMonteCarlo(plan, mo);
+    }();
     const Pose2 mc_mean{mc.mean.x, mc.mean.y, mc.mean.theta + theta_shift};
+    const MonteCarloErrors se = StandardErrors(mc.covariance, mc.runs);
     j["monte_carlo"] = {{"mean", {mc_mean.x, mc_mean.y, mc_mean.theta}},
                         {"covariance", JsonMatrix(mc.covariance)},
+                        {"mean_se", {se.mean(0), se.mean(1), se.mean(2)}},
+                        {"covariance_se", JsonMatrix(se.covariance)},
                         {"runs", mc.runs},
                         {"partitions", o.partitions},
                         {"seed", mc.seed},
@@ -187,6 +211,11 @@ int RunPredict(const PredictOptions& o) {
                                   o.partitions, mc.seed)
                           .c_str(),
                       mc_mean, mc.covariance);
+      fmt::print("  standard error of the mean  x {:.3g} m, y {:.3g} m, theta {:.3g} rad\n", se.mean(0), se.mean(1),
+                 se.mean(2));
+      fmt::print("  standard error of the covariance (Gaussian approximation) [m, m, rad]:\n");
+      for (int i = 0; i < 3; ++i)
+        fmt::print("    {:>14.6e} {:>14.6e} {:>14.6e}\n", se.covariance(i, 0), se.covariance(i, 1), se.covariance(i, 2));
       fmt::print("  {:.3e} wheel steps per second ({} threads, {} kernel, {:.3f} s)\n", mc.steps_per_second,
                  mc.threads, mc.kernel, mc.seconds);
     }

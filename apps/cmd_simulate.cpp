@@ -148,8 +148,7 @@ Command SetupSimulate(CLI::App& parent) {
   auto opts = std::make_shared<SimulateOptions>();
   auto* app = parent.add_subcommand("simulate", "Write a synthetic campaign (manifest + CSVs) with chosen effects");
   app->add_option("MANIFEST", opts->manifest, "Campaign manifest (TOML): robot and experiments to simulate")
-      ->required()
-      ->check(CLI::ExistingFile);
+      ->required();
   app->add_option("--out", opts->out, "Output directory (campaign.toml + experiment files)")->required();
   app->add_option("--effect", opts->effects,
                   "Effect NAME:k=v,... (repeatable), e.g. turn_scrub:k=0.05 or gt_offset:dx=0.02,dy=0");

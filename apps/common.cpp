@@ -16,8 +16,7 @@
 namespace umbmark::cli {
 
 void RobotFlags::Bind(CLI::App& app) {
-  app.add_option("--robot", robot_file, "Robot file (TOML): the parameters the odometry USED")
-      ->check(CLI::ExistingFile);
+  app.add_option("--robot", robot_file, "Robot file (TOML): the parameters the odometry USED");
   app.add_option("--wheelbase", wheelbase_m, "Override wheelbase_m [m]")->check(Positive());
   app.add_option("--diameter-left", diameter_left_m, "Override wheel_diameter_left_m [m]")
       ->check(Positive());
@@ -211,6 +210,10 @@ std::string TaggedPath(const std::string& path, const std::string& tag) {
   std::filesystem::path p(path);
   const std::string stem = p.stem().string(), ext = p.extension().string();
   return (p.parent_path() / (stem + "-" + tag + ext)).string();
+}
+
+void PrintWritten(const std::vector<std::string>& files, bool to_stdout) {
+  for (const auto& f : files) fmt::print(to_stdout ? stdout : stderr, "wrote {}\n", f);
 }
 
 }  // namespace umbmark::cli

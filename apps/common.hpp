@@ -89,4 +89,8 @@ nlohmann::json JsonEvaluationSummary(const EvaluationSummary& s);
 /// Used when one flag names an output and several inputs are processed.
 std::string TaggedPath(const std::string& path, const std::string& tag);
 
+/// "wrote FILE (what)" for every output file, on stdout when the readable
+/// text goes there, else on stderr (so `--json -` keeps stdout pure JSON).
+void PrintWritten(const std::vector<std::string>& files, bool to_stdout);
+
 }  // namespace umbmark::cli

@@ -25,6 +25,7 @@
 #include "core/utf8.hpp"
 #include "io/atomic_write.hpp"
 #include "umbmark/version.hpp"
+#include "progress.hpp"
 
 namespace {
 
@@ -83,6 +84,9 @@ int main(int argc, char** argv) {
   CLI::App app{"umbmark: odometry calibration and sim-to-real diagnosis for differential-drive robots"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("umbmark ") + kVersion);
+  bool quiet = false;
+  app.add_flag("-q,--quiet", quiet, "No progress lines on stderr (they appear only on a terminal, after 2 s)");
+  app.fallthrough();  // --quiet may follow the subcommand
 
   std::vector<cli::Command> commands;
   // Registered subcommands (one cmd_*.cpp each).
@@ -113,11 +117,32 @@ int main(int argc, char** argv) {
       }
     }
   }
+
+  // `umbmark help [COMMAND [SUBCOMMAND]]`: the options of a command.
+  std::vector<std::string> help_topic;
+  auto* help = app.add_subcommand("help", "Show the options of a command: umbmark help [COMMAND]");
+  help->add_option("COMMAND", help_topic, "Command (and subcommand, e.g. `import optiodom`)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);  // prints help or the error message
     return code == 0 ? 0 : 2;
+  }
+  cli::SetQuiet(quiet);
+  if (help->parsed()) {
+    CLI::App* topic = &app;
+    for (const auto& name : help_topic) {
+      try {
+        topic = topic->get_subcommand(name);
+      } catch (const CLI::OptionNotFound&) {
+        fmt::print(stderr, "umbmark help: no command '{}' (see `umbmark help`)\n", name);
+        return 2;
+      }
+    }
+    // The formatter directly: App::help() would show the `help` command's own page.
+    fmt::print("{}", topic->get_formatter()->make_help(topic, topic->get_name(), CLI::AppFormatMode::Normal));
+    return 0;
   }
   int status = RunCommand(commands);
   // Output that could not be written (a full disk, `> /dev/full`, a closed

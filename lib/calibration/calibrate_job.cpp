@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -28,6 +29,7 @@ CalibrateInput InputFromTrajectories(TrajectoryData data, const RobotParams& rec
                                    e.direction, Rad2Deg(*e.gt_total_rotation_rad), gt_dir));
     }
   }
+  in.files = {data.path};
   in.trajectories = std::move(data);
   return in;
 }
@@ -40,8 +42,54 @@ CalibrateInput InputFromEndpoints(const EndpointData& data, const RobotParams& r
   in.recorded = recorded;
   in.side_m = side_m;
   in.errors = ReturnErrorsFromEndpoints(data);
+  in.files = {data.path};
   return in;
 }
+
+CalibrateInput PoolInputs(const std::vector<CalibrateInput>& parts, const std::vector<std::string>& tags,
+                          const std::string& label) {
+  if (parts.empty()) throw std::invalid_argument("PoolInputs: no parts");
+  if (parts.size() == 1) {
+    CalibrateInput one = parts.front();
+    one.label = label;
+    return one;
+  }
+  CalibrateInput pooled;
+  pooled.label = label;
+  pooled.path = parts.front().path;
+  pooled.recorded = parts.front().recorded;
+  pooled.side_m = parts.front().side_m;
+  const bool all_trajectories =
+      std::all_of(parts.begin(), parts.end(), [](const CalibrateInput& p) { return p.trajectories.has_value(); });
+  if (all_trajectories) pooled.trajectories.emplace().path = pooled.path;
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const CalibrateInput& p = parts[k];
+    if (p.side_m != pooled.side_m) {
+      throw InputError(label, fmt::format("square experiments {} and {} have different sides ({} m, {} m): one UMBmark "
+                                          "calibration needs one side; calibrate them separately (--per-experiment)",
+                                          tags.front(), tags[k], pooled.side_m, p.side_m));
+    }
+    if (p.recorded.wheelbase_m != pooled.recorded.wheelbase_m ||
+        p.recorded.wheel_diameter_left_m != pooled.recorded.wheel_diameter_left_m ||
+        p.recorded.wheel_diameter_right_m != pooled.recorded.wheel_diameter_right_m) {
+      throw InputError(label, "the square experiments were recorded with different robot parameters; calibrate them "
+                              "separately (--per-experiment)");
+    }
+    for (ReturnError e : p.errors) {
+      e.run = tags[k] + ":" + e.run;
+      pooled.errors.push_back(std::move(e));
+    }
+    if (all_trajectories) {
+      for (TrajectoryRun r : p.trajectories->runs) {
+        r.run = tags[k] + ":" + r.run;
+        pooled.trajectories->runs.push_back(std::move(r));
+      }
+    }
+    pooled.files.insert(pooled.files.end(), p.files.begin(), p.files.end());
+  }
+  return pooled;
+}
+
 
 ClusterStats ClusterOfUsed(const std::vector<ReturnError>& errors, const std::vector<RunFlag>& flags,
                            const std::string& direction) {
@@ -105,7 +153,13 @@ CalibrateJobResult RunCalibrateJob(const CalibrateInput& input, const CalibrateJ
   if (options.refine) {
     std::vector<bool> keep;
     for (const auto& f : r.umbmark.runs) keep.push_back(f.used());
-    r.refined = RefineInput(input, keep, *options.refine, r.umbmark.selected, options.integrator);
+    try {
+      r.refined = RefineInput(input, keep, *options.refine, r.umbmark.selected, options.integrator);
+    } catch (const RefineError& e) {
+      if (!options.keep_classic_on_refine_failure) throw;
+      r.refine_failure = e;
+      return r;
+    }
     if (input.trajectories) {
       TrajectoryData kept;
       kept.path = input.trajectories->path;

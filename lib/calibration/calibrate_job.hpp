@@ -23,6 +23,7 @@ struct CalibrateInput {
   double side_m = 0.0;
   std::vector<ReturnError> errors;           ///< from endpoints, or computed from trajectories
   std::optional<TrajectoryData> trajectories;  ///< trajectory input only
+  std::vector<std::string> files;              ///< the data files behind it (several when pooled)
 };
 
 struct CalibrateJobOptions {
@@ -34,6 +35,9 @@ struct CalibrateJobOptions {
   /// used, started from the classic solution; its integrator and start are
   /// overwritten from the fields above and the UMBmark result.
   std::optional<RefineOptions> refine;
+  /// A failed refined fit: false (default) throws RefineError; true keeps
+  /// the classic result and records the failure in `refine_failure`.
+  bool keep_classic_on_refine_failure = false;
 };
 
 /// What the corrected parameters do on the same runs (trajectory input).
@@ -53,6 +57,8 @@ struct CalibrateJobResult {
   std::optional<RefineSummary> refined;
   /// Evaluation measures with the refined parameters (trajectory input).
   std::optional<EvaluationSummary> refined_evaluation;
+  /// Set when the refined fit failed and keep_classic_on_refine_failure.
+  std::optional<RefineError> refine_failure;
 };
 
 /// Builds the input from trajectories: return errors with the recorded
@@ -81,6 +87,15 @@ RefineSummary RefineInput(const CalibrateInput& input, const std::vector<bool>& 
 /// (commanded-square model, as for endpoint input): the path carries no
 /// further information.
 bool HasInteriorGroundTruth(const TrajectoryData& data);
+
+/// Pools the square experiments of one campaign into one calibration: the
+/// return errors (and trajectories, when every part has them) of all parts.
+/// UMBmark's eqs. 4.20-4.24 take one side length, so the parts must share
+/// side_m and the recorded robot (InputError otherwise). Run ids become
+/// "<tag>:<run>" (tags[i] names part i, e.g. its experiment number) so runs
+/// of different files stay apart.
+CalibrateInput PoolInputs(const std::vector<CalibrateInput>& parts, const std::vector<std::string>& tags,
+                          const std::string& label);
 
 /// Runs UMBmark (and the after-correction evaluation when trajectories are
 /// present, and the refined fit when asked). Throws RefineError (exit 3)

@@ -1,4 +1,4 @@
-// In-memory form of the contract's data files (see shared/spec/interface.md):
+// In-memory form of the data files (docs/formats.md):
 // endpoint runs (return errors only) and trajectory runs (encoder samples with
 // optional ground truth). Readers live in io/; this header only holds data.
 #pragma once
@@ -9,6 +9,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -16,6 +17,22 @@
 #include "core/pose2.hpp"
 
 namespace umbmark {
+
+/// A square's direction as written in a file: `cw`/`ccw` in any case become
+/// "cw"/"ccw"; any other text (free experiments) is kept as written.
+inline std::string CanonicalDirection(std::string_view text) {
+  auto equals_lower = [&](std::string_view word) {
+    if (text.size() != word.size()) return false;
+    for (std::size_t i = 0; i < word.size(); ++i) {
+      const char c = text[i] >= 'A' && text[i] <= 'Z' ? static_cast<char>(text[i] - 'A' + 'a') : text[i];
+      if (c != word[i]) return false;
+    }
+    return true;
+  };
+  if (equals_lower("cw")) return "cw";
+  if (equals_lower("ccw")) return "ccw";
+  return std::string(text);
+}
 
 /// The return error of one run, e = absolute - odometry (Borenstein & Feng
 /// eq. 3.1) in the run's start frame: a row of an endpoint CSV, or computed

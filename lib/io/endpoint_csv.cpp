@@ -75,7 +75,7 @@ EndpointData ReadEndpointRows(CsvReader& csv) {
     ReturnError r;
     r.line = csv.line();
     r.run = std::string(csv.Text(cols[kRun]));
-    r.direction = std::string(csv.Text(cols[kDirection]));
+    r.direction = CanonicalDirection(csv.Text(cols[kDirection]));
     if (pose_form) {
       r.ex_m = csv.Number(cols[kXAbs]) - csv.Number(cols[kXOdo]);  // eq. 3.1: e = absolute - odometry
       r.ey_m = csv.Number(cols[kYAbs]) - csv.Number(cols[kYOdo]);

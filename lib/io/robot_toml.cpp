@@ -1,5 +1,6 @@
 // Robot file reader (TOML, contract keys wheelbase_m, wheel_diameter_left_m,
-// wheel_diameter_right_m, ticks_per_rev), also used for a manifest's [robot].
+// wheel_diameter_right_m, ticks_per_rev), also used for a manifest's [robot];
+// a whole manifest given as robot file yields its [robot] table.
 #include "io/robot_toml.hpp"
 
 #include <array>
@@ -57,6 +58,10 @@ RobotParams RobotFromTable(const toml::table& table, const std::string& name) {
 
 RobotParams ParseRobotToml(std::string_view text, const std::string& name) {
   const toml::table table = detail::ParseTomlText(text, name);
+  // A campaign manifest (a [robot] table and experiments) in place of a
+  // robot file: its [robot] table. A lone [robot] table stays an error.
+  if (const toml::table* robot = table.get_as<toml::table>("robot"); robot != nullptr && table.contains("experiment"))
+    return RobotFromTableImpl(*robot, name, false);
   return RobotFromTableImpl(table, name, /*is_root=*/true);
 }
 

@@ -21,6 +21,7 @@ namespace umbmark::io {
 
 /// Throws InputError (file, line, column) for a TOML syntax error, a missing
 /// or non-numeric key, an unknown key, or a value that fails RobotParams::Check().
+/// A campaign manifest (a [robot] table and [[experiment]]s) gives its robot.
 RobotParams ReadRobotToml(const std::string& path);
 RobotParams ParseRobotToml(std::string_view text, const std::string& name);
 

@@ -154,7 +154,7 @@ void TrajectoryReader::State::CheckNewId(std::string_view run_id) const {
 void TrajectoryReader::State::StartRun(std::string_view run_id, std::string_view direction) {
   TrajectoryRun& r = current;
   r.run.assign(run_id);
-  r.direction.assign(direction);
+  r.direction = CanonicalDirection(direction);
   for (auto* v : {&r.t_s, &r.dist_left_m, &r.dist_right_m, &r.gt_x_m, &r.gt_y_m, &r.gt_theta_rad}) v->clear();
   r.ticks_left.clear();
   r.ticks_right.clear();
@@ -282,7 +282,7 @@ bool TrajectoryReader::NextRun(TrajectoryRun& out) {
       if (handed_out) return true;
       continue;
     }
-    if (direction != s.current.direction) {
+    if (direction != s.current.direction && CanonicalDirection(direction) != s.current.direction) {
       direction = csv.Text(*s.c_dir);
       csv.FailCell(s.c_dir->index,
                    fmt::format("direction changes from {} to {} within run {} (a run keeps one direction; give "

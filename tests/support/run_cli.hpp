@@ -34,11 +34,13 @@ inline std::filesystem::path TempDir(const std::string& tag) {
   return dir;
 }
 
-/// Runs `umbmark ARGS` (ARGS is passed to /bin/sh, quote paths yourself).
-inline CliResult RunCli(const std::string& args) {
+/// Runs `umbmark ARGS` (ARGS is passed to /bin/sh, quote paths yourself),
+/// in the working directory `cwd` when given.
+inline CliResult RunCliIn(const std::filesystem::path& cwd, const std::string& args) {
   static const auto dir = TempDir("cli");
   const std::string out = (dir / "stdout").string(), err = (dir / "stderr").string();
-  const std::string cmd = std::string("'") + UMBMARK_EXE + "' " + args + " </dev/null >'" + out + "' 2>'" + err + "'";
+  const std::string cd = cwd.empty() ? std::string() : "cd '" + cwd.string() + "' && ";
+  const std::string cmd = cd + "'" + UMBMARK_EXE + "' " + args + " </dev/null >'" + out + "' 2>'" + err + "'";
   const int raw = std::system(cmd.c_str());
   CliResult r;
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + (WIFSIGNALED(raw) ? WTERMSIG(raw) : 0);
@@ -46,6 +48,8 @@ inline CliResult RunCli(const std::string& args) {
   r.err = Slurp(err);
   return r;
 }
+
+inline CliResult RunCli(const std::string& args) { return RunCliIn({}, args); }
 
 inline std::string Q(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
 

@@ -1,0 +1,58 @@
+// Progress lines on stderr (see progress.hpp).
+#include "progress.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+
+#include <fmt/format.h>
+
+namespace umbmark::cli {
+namespace {
+std::atomic<bool> g_quiet{false};
+constexpr auto kFirstAfter = std::chrono::seconds(2);
+constexpr auto kRefresh = std::chrono::milliseconds(250);
+}  // namespace
+
+void SetQuiet(bool quiet) { g_quiet = quiet; }
+
+bool ProgressWanted() { return !g_quiet && ::isatty(STDERR_FILENO) == 1; }
+
+Progress::Progress(std::string what, double total)
+    : what_(std::move(what)), total_(total), start_(std::chrono::steady_clock::now()) {
+  if (ProgressWanted()) thread_ = std::thread([this] { Tick(); });
+}
+
+Progress::~Progress() {
+  if (!thread_.joinable()) return;
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  thread_.join();
+  if (shown_) {
+    fmt::print(stderr, "\r\033[K");  // clear the progress line
+    std::fflush(stderr);
+  }
+}
+
+void Progress::Tick() {
+  std::unique_lock lock(mutex_);
+  if (wake_.wait_for(lock, kFirstAfter, [this] { return stop_; })) return;
+  do {
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double done = done_.load(std::memory_order_relaxed);
+    std::string line = fmt::format("{}: {:.0f} s", what_, seconds);
+    if (total_ > 0.0 && done > 0.0) {
+      const double fraction = std::min(1.0, done / total_);
+      line = fmt::format("{}: {:3.0f}%  {:.0f} s elapsed, about {:.0f} s left", what_, 100.0 * fraction, seconds,
+                         seconds * (1.0 - fraction) / fraction);
+    }
+    fmt::print(stderr, "\r{}\033[K", line);
+    std::fflush(stderr);
+    shown_ = true;
+  } while (!wake_.wait_for(lock, kRefresh, [this] { return stop_; }));
+}
+
+}  // namespace umbmark::cli
