@@ -1,5 +1,8 @@
-// SVG for `calibrate --plot`: CW/CCW return errors, their centres of gravity
-// and the E_max,syst circle, before and (trajectory input) after correction.
+// Plots of a calibration (calibrate --plot SVG and --report): the cw/ccw
+// return errors before and after correction on ONE common scale, with the
+// centres of gravity and their 95% SEM ellipses and the E_max,syst circles;
+// and, for trajectory input, each run's path: ground truth vs odometry with
+// the recorded and with the corrected parameters.
 #pragma once
 
 #include <string>
@@ -8,9 +11,9 @@
 
 namespace umbmark::cli {
 
-/// `after` / `after_method`: the calibration the "after" panel shows (the
-/// one --use selects).
-std::string CalibrationPlotSvg(const CalibrateInput& input, const CalibrateJobResult& result,
-                               Integrator integrator, const RobotParams& after, const std::string& after_method);
+/// `corrected`: the parameters the "after" panels use, `which`: their name
+/// in titles and legends (e.g. "UMBmark (mean)", "refined").
+std::string CalibrationPlotSvg(const CalibrateInput& input, const CalibrateJobResult& result, Integrator integrator,
+                               const RobotParams& corrected, const std::string& which);
 
 }  // namespace umbmark::cli

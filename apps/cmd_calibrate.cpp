@@ -22,6 +22,7 @@
 #include "core/angles.hpp"
 #include "core/errors.hpp"
 #include "io/atomic_write.hpp"
+#include "io/html_report.hpp"
 #include "io/data_file.hpp"
 #include "io/manifest.hpp"
 #include "io/ros2_params.hpp"
@@ -44,6 +45,7 @@ struct CalibrateOptions {
   std::string ros2;
   std::string controller = "diff_drive_controller";
   std::string plot;
+  std::string report;
   bool refine = false;
   std::vector<std::string> fix, free;
   std::string loss = "huber";
@@ -338,6 +340,109 @@ std::string Ros2Parameters(const CalibrateJobResult& r, const Chosen& chosen, co
        "Load with: ros2 param load /" + controller + " FILE (or add to the controller's --param-file list)"});
 }
 
+// The --report page of one calibration: headline, what to do next, the
+// numbers (parameters with intervals when refined, centres of gravity,
+// E_d/E_b, evaluation before/after), then the plots.
+std::string CalibrationReportHtml(const nlohmann::json& j, const CalibrateJobResult& r, const std::string& plot_svg,
+                                  const std::string& which, const RobotParams& chosen) {
+  const UmbmarkSummary& s = r.umbmark;
+  io::HtmlReport rep("umbmark calibrate", r.label);
+  const double emax = s.E_max_syst_m * 1e3, three_sem = 3e3 * s.sem_m;
+  if (!s.compensation_worthwhile) {
+    rep.Headline(fmt::format("The systematic error E_max,syst = {:.2f} mm lies within the run-to-run scatter (3 SEM = {:.2f} "
+                             "mm): a correction is unlikely to help.",
+                             emax, three_sem),
+                 io::HtmlReport::Level::kInfo);
+  } else if (r.evaluation) {
+    const double after = r.evaluation->E_max_syst_m * 1e3;
+    rep.Headline(fmt::format("Correction worthwhile: E_max,syst {:.2f} mm before, {:.2f} mm after correcting with the {} "
+                             "parameters ({:.1f}x smaller; 3 SEM = {:.2f} mm).",
+                             emax, after, which, emax / std::max(after, 1e-9), three_sem),
+                 r.evaluation->second_pass_worthwhile ? io::HtmlReport::Level::kWarn : io::HtmlReport::Level::kGood);
+  } else {
+    rep.Headline(fmt::format("Correction worthwhile: E_max,syst = {:.2f} mm stands out of the scatter (3 SEM = {:.2f} mm).",
+                             emax, three_sem),
+                 io::HtmlReport::Level::kGood);
+  }
+  std::vector<std::string> steps;
+  if (s.compensation_worthwhile) {
+    steps.push_back(fmt::format("Set the odometry to the {} parameters: wheelbase {:.6f} m, left wheel diameter {:.6f} m, "
+                                "right wheel diameter {:.6f} m (or load the multipliers of --ros2 into diff_drive_controller).",
+                                which, chosen.wheelbase_m, chosen.wheel_diameter_left_m, chosen.wheel_diameter_right_m));
+    steps.push_back("Drive a few new squares with the new parameters and run `umbmark calibrate` on them: a second pass "
+                    "is relative to the new parameters and composes.");
+  } else {
+    steps.push_back("Keep the current parameters; drive more runs per direction if you expected a systematic error (the "
+                    "SEM shrinks with the square root of the number of runs).");
+  }
+  if (r.evaluation && r.evaluation->second_pass_worthwhile)
+    steps.push_back("After correction the systematic error still stands out of the scatter: run a second calibration pass.");
+  if (r.refine_failure)
+    steps.push_back(fmt::format("The refined fit failed its quality gate ({}); the classic result above stands.",
+                                r.refine_failure->what()));
+  rep.NextSteps(steps);
+  std::vector<std::string> warnings;
+  if (j.contains("warnings") && j["warnings"].is_array())
+    for (const auto& w : j["warnings"]) warnings.push_back(w.get<std::string>());
+  for (const auto& f : s.runs)
+    if (f.outlier && !f.rejected)
+      warnings.push_back(fmt::format("run {} ({}) is an outlier (robust score {:.1f}) but was kept; --reject-outliers drops it",
+                                     f.run, f.direction, f.score.value_or(0.0)));
+  rep.Warnings(warnings);
+
+  rep.Heading("Parameters");
+  std::vector<std::vector<std::string>> rows;
+  const char* keys[3] = {"wheelbase_m", "wheel_diameter_left_m", "wheel_diameter_right_m"};
+  const char* names[3] = {"wheelbase [m]", "left wheel diameter [m]", "right wheel diameter [m]"};
+  const double rec[3] = {s.recorded.wheelbase_m, s.recorded.wheel_diameter_left_m, s.recorded.wheel_diameter_right_m};
+  const double umb[3] = {s.corrected.wheelbase_m, s.corrected.wheel_diameter_left_m, s.corrected.wheel_diameter_right_m};
+  const bool refined = j.contains("refined") && j["refined"].contains("parameters");
+  for (int k = 0; k < 3; ++k) {
+    std::vector<std::string> row = {names[k], fmt::format("{:.6f}", rec[k]), fmt::format("{:.6f}", umb[k])};
+    if (refined) {
+      const double v = j["refined"]["parameters"][keys[k]].get<double>();
+      const double sd = std::sqrt(std::max(0.0, j["refined"]["covariance"][k][k].get<double>()));
+      row.push_back(fmt::format("{:.6f} [{:.6f}, {:.6f}]", v, v - 1.96 * sd, v + 1.96 * sd));
+    }
+    rows.push_back(row);
+  }
+  std::vector<std::string> header = {"parameter", "recorded (used by the runs)", "UMBmark"};
+  if (refined) header.push_back("refined, 95% interval");
+  rep.Table(header, rows);
+  rep.Table({"quantity", "value"},
+            {{"E_d (diameter ratio error, eq. 4.22)", fmt::format("{:.6f}", s.selected.E_d)},
+             {"E_b (wheelbase error, eq. 4.24)", fmt::format("{:.6f}", s.selected.E_b)},
+             {"c_L, c_R (diameter factors, eqs. 4.31-4.32)", fmt::format("{:.6f}, {:.6f}", s.c_L, s.c_R)},
+             {"alpha, beta", fmt::format("{:+.4f} deg, {:+.4f} deg", Rad2Deg(s.selected.alpha_rad), Rad2Deg(s.selected.beta_rad))},
+             {"estimator; square side", fmt::format("{}; {} m", UmbmarkEstimatorToString(s.estimator), s.side_m)}});
+  rep.Heading("Return errors: centres of gravity (eq. 3.2)");
+  rows.clear();
+  for (const auto* c : {&s.cw, &s.ccw})
+    rows.push_back({c == &s.cw ? "cw" : "ccw", std::to_string(c->n), fmt::format("{:+.2f}", c->x_cg_m * 1e3),
+                    fmt::format("{:+.2f}", c->y_cg_m * 1e3), fmt::format("{:.2f}", c->r_cg_m * 1e3),
+                    fmt::format("{:.2f}", c->sigma_m * 1e3), fmt::format("{:.2f}", c->sem_m * 1e3)});
+  rep.Table({"direction", "runs", "x_cg [mm]", "y_cg [mm]", "r_cg [mm]", "sigma [mm]", "SEM [mm]"}, rows);
+  if (r.evaluation) {
+    rep.Heading("Odometry vs ground truth on the same runs");
+    auto row = [](const std::string& name, const EvaluationSummary& e) {
+      return std::vector<std::string>{name, fmt::format("{:.2f}", e.mean_final_position_error_m * 1e3),
+                                      fmt::format("{:.2f}", e.max_max_position_error_m * 1e3),
+                                      fmt::format("{:.3f}", Rad2Deg(e.mean_final_heading_error_rad)),
+                                      fmt::format("{:.3f}", Rad2Deg(e.max_max_heading_error_rad))};
+    };
+    rows = {row("recorded parameters", r.evaluation->before), row("UMBmark parameters", r.evaluation->after)};
+    if (r.refined_evaluation) rows.push_back(row("refined parameters", *r.refined_evaluation));
+    rep.Table({"odometry with", "final position error, mean [mm]", "max position error [mm]",
+               "final heading error, mean [deg]", "max heading error [deg]"},
+              rows);
+  }
+  rep.Heading("Plots");
+  rep.Figure(plot_svg, fmt::format("Return errors before and after correction with the {} parameters, on one scale; "
+                                   "then each run's path (first runs).",
+                                   which));
+  return rep.Render();
+}
+
 int RunCalibrate(const CalibrateOptions& o) {
   if (o.use == "refined" && !o.refine) throw InvalidOptions("--use refined needs --refine");
   CalibrateJobOptions jo;
@@ -372,6 +477,7 @@ int RunCalibrate(const CalibrateOptions& o) {
   outs.AddOutput("--json", o.json.path);
   outs.AddOutput("--ros2", o.ros2);
   outs.AddOutput("--plot", o.plot);
+  outs.AddOutput("--report", o.report);
   outs.Check();
 
   // Collect every calibration unit first; with one input, errors propagate
@@ -465,10 +571,21 @@ int RunCalibrate(const CalibrateOptions& o) {
         outs.Write(file, Ros2Parameters(r, chosen, o.controller));
         written.push_back(file + " (ros2_control parameters)");
       }
+      // The plot and the report show the calibration --use selects (by
+      // default the recommended one), and say which.
+      const RobotParams& shown = chosen.parameters;
+      const std::string& which = chosen.method;
+      std::string svg;
+      if (!o.plot.empty() || !o.report.empty()) svg = CalibrationPlotSvg(in, r, jo.integrator, shown, which);
       if (!o.plot.empty()) {
         const std::string file = several ? TaggedPath(o.plot, tag) : o.plot;
-        outs.Write(file, CalibrationPlotSvg(in, r, jo.integrator, chosen.parameters, chosen.method));
-        written.push_back(file + " (plot)");
+        outs.Write(file, svg);
+        written.push_back(file + " (plot: " + which + ")");
+      }
+      if (!o.report.empty()) {
+        const std::string file = several ? TaggedPath(o.report, tag) : o.report;
+        outs.Write(file, CalibrationReportHtml(JsonResult(in, r, o, heldout, check, chosen, warnings), r, svg, which, shown));
+        written.push_back(file + " (HTML report)");
       }
       if (o.json.PrintText()) {
         PrintResult(r);
@@ -551,12 +668,14 @@ Command SetupCalibrate(CLI::App& parent) {
   app->add_option("--controller", opts->controller, "Controller name at the top of the --ros2 file")
       ->capture_default_str();
   app->add_option("--plot", opts->plot,
-                  "Write an SVG of the return errors, centres of gravity and E_max,syst (after: the --use calibration)");
+                  "Write an SVG: return errors before/after (the --use calibration) on one scale, centres of gravity "
+                  "with SEM ellipses, E_max,syst, and each run's path");
   app->add_option("--use", opts->use,
                   "Calibration --ros2 and --plot use: the recommended one (lowest leave-one-run-out error), classic "
                   "UMBmark, or refined (needs --refine)")
       ->check(CLI::IsMember({"recommended", "classic", "refined"}))
       ->capture_default_str();
+  app->add_option("--report", opts->report, "Write a self-contained HTML report (result, next steps, plots)");
   app->add_flag("--refine", opts->refine,
                 "Add the exact Ceres fit (every run, full path geometry for trajectories) with covariance and 95% intervals");
   app->add_option("--fix", opts->fix, "With --refine: hold these parameters at their recorded values (scale)")

@@ -10,6 +10,8 @@
 #include "commands.hpp"
 #include "diagnosis/design_check.hpp"
 #include "io/manifest.hpp"
+#include "diagnose_report.hpp"
+#include "progress.hpp"
 #include "common.hpp"
 #include "core/errors.hpp"
 #include "diagnosis/pieces.hpp"
@@ -26,6 +28,7 @@ struct DiagnoseCliOptions {
   diag::DiagnoseOptions diag;
   std::vector<std::string> effects;
   std::string plot;
+  std::string report;
   bool quality_gate = false;
   JsonFlag json;
 };
@@ -40,21 +43,32 @@ int RunDiagnose(DiagnoseCliOptions o) {
   RegisterInputs({o.manifest});
   outs.AddOutput("--json", o.json.path);
   outs.AddOutput("--plot", o.plot);
+  outs.AddOutput("--report", o.report);
   outs.Check();
   // A design that cannot determine the baseline is refused before fitting.
   if (const std::string why = diag::CampaignDesignProblem(io::ReadManifest(o.manifest)); !why.empty()) {
     throw InputError(o.manifest, why);
   }
   const diag::CampaignData campaign = diag::LoadCampaign(o.manifest, o.diag.pieces);
-  const diag::DiagnoseSummary s = diag::Diagnose(campaign, o.diag);
+  const diag::DiagnoseSummary s = [&] {
+    Progress progress(fmt::format("diagnosing {} ({} null simulations)", o.manifest, o.diag.null_simulations));
+    return diag::Diagnose(campaign, o.diag);
+  }();
   if (o.json.PrintText()) fmt::print("{}", diag::DiagnoseReport(s));
-  if (!o.plot.empty()) {
-    outs.Write(o.plot, diag::DiagnosePlotSvg(s));
-    if (o.json.PrintText()) fmt::print("wrote {}\n", o.plot);
-  }
   nlohmann::json j = diag::DiagnoseToJson(s);
   j["manifest"] = o.manifest;
+  std::vector<std::string> written;
+  if (!o.plot.empty()) {
+    outs.Write(o.plot, DiagnosePlotsSvg(j));
+    written.push_back(o.plot + " (plot)");
+  }
+  if (!o.report.empty()) {
+    outs.Write(o.report, DiagnoseReportHtml(j, o.manifest));
+    written.push_back(o.report + " (HTML report)");
+  }
+  if (!o.json.path.empty() && !o.json.ToStdout()) written.push_back(o.json.path + " (JSON)");
   o.json.Emit(j);
+  PrintWritten(written, o.json.PrintText());
   if (o.quality_gate && s.verdict == "unexplained") {
     throw QualityGateError("the campaign leaves the model and no known effect explains the gap");
   }
@@ -95,7 +109,9 @@ Command SetupDiagnose(CLI::App& parent) {
   app->add_option("--threads", d.threads, "Threads (default 2)")->check(NumberIn(1, 256));
   app->add_option("--where", d.where_top, "Discrepancies listed under 'where' (default 12)")->check(NonNegative());
   app->add_option("--effects", opts->effects, "Effects to try (default: the contract's nine)")->delimiter(',');
-  app->add_option("--plot", opts->plot, "SVG bars of the gap per statistic before/after the winning effect");
+  app->add_option("--plot", opts->plot,
+                  "SVG: located discrepancies against the model's 95% band, shrink per candidate and of the explanation");
+  app->add_option("--report", opts->report, "Write a self-contained HTML report (verdict, next steps, tables, plots)");
   app->add_flag("--fail-unexplained", opts->quality_gate, "Exit 3 when the verdict is 'unexplained'");
   opts->json.Bind(*app);
   return {app, [opts] { return RunDiagnose(*opts); }};

@@ -2,8 +2,10 @@
 // odometry against ground truth along trajectories (any path shape) for the
 // recorded parameters or a calibration, per run and over all runs.
 #include <cmath>
+#include <algorithm>
 #include <memory>
 #include <set>
+#include <optional>
 #include <variant>
 
 #include <fmt/format.h>
@@ -15,6 +17,7 @@
 #include "core/errors.hpp"
 #include "evaluation/run_track.hpp"
 #include "io/atomic_write.hpp"
+#include "io/html_report.hpp"
 #include "io/data_file.hpp"
 #include "io/params_json.hpp"
 #include "io/manifest.hpp"
@@ -31,6 +34,7 @@ struct EvaluateOptions {
   std::string integrator = "arc";
   JsonFlag json;
   std::string plot;
+  std::string report;
 };
 
 /// One file to evaluate: a trajectory CSV, or one experiment of a manifest.
@@ -87,47 +91,145 @@ void PrintSummary(const char* title, const EvaluationSummary& s) {
 /// Runs drawn in the --plot figure (the first ones; keeps it readable).
 constexpr std::size_t kPlotRuns = 12;
 
+// Position and heading error along the travelled distance for every run,
+// recorded parameters vs --params (one common scale), then the paths of the
+// first runs: what `evaluate --plot` and its report show.
 std::string PlotSvg(const std::vector<PlotRun>& runs, const std::optional<RobotParams>& params, Integrator integ) {
-  std::vector<std::string> parts;
-  const double size = 380;
-  double x = 60, y = 40;
-  int col = 0;
-  for (const auto& [source, run] : runs) {
-    const Source& src = *source;
-    io::SvgPanel p(x, y, size, size, fmt::format("{} run {}", src.label, run.run));
-    const RunTrack before = TrackRun(run, src.path, src.recorded, src.recorded, integ);
-    std::vector<io::SvgPoint> gt, od, od2, all;
+  const io::SvgStyle rec{"#c0392b", "", "5,3", 1.2, false}, par{"#1f7a3a", "", "", 1.6, false};
+  struct Curve {
+    std::vector<io::SvgPoint> pos, head;  // (travel m, error mm) and (travel m, error deg)
+  };
+  auto curve = [&](const TrajectoryRun& run, const std::string& path, const RobotParams& p, const RobotParams& recorded) {
+    const RunTrack t = TrackRun(run, path, p, recorded, integ);
+    Curve c;
+    double travel = 0.0;
     for (std::size_t i = 0; i < run.size(); ++i) {
-      if (before.has_ground_truth[i]) gt.push_back({before.ground_truth[i].x, before.ground_truth[i].y});
-      od.push_back({before.odometry[i].x, before.odometry[i].y});
+      if (i > 0) travel += std::hypot(t.odometry[i].x - t.odometry[i - 1].x, t.odometry[i].y - t.odometry[i - 1].y);
+      if (!t.has_ground_truth[i]) continue;
+      c.pos.push_back({travel, 1e3 * std::hypot(t.ground_truth[i].x - t.odometry[i].x, t.ground_truth[i].y - t.odometry[i].y)});
+      c.head.push_back({travel, Rad2Deg(std::abs(WrapAngle(t.ground_truth[i].theta - t.odometry[i].theta)))});
     }
-    all = gt;
-    all.insert(all.end(), od.begin(), od.end());
-    if (params) {
-      const RunTrack after = TrackRun(run, src.path, *params, src.recorded, integ);
-      for (const auto& q : after.odometry) od2.push_back({q.x, q.y});
-      all.insert(all.end(), od2.begin(), od2.end());
-    }
-    p.FitExtent(all, true, true);
-    p.Axes("x [m]", "y [m]");
-    p.Polyline(gt, "#111", 2.0);
-    p.Polyline(od, "#d62728", 1.2, "4,3");
-    if (params) p.Polyline(od2, "#2ca02c", 1.2);
-    std::vector<std::pair<std::string, std::string>> legend = {{"#111", "ground truth"},
-                                                               {"#d62728", "odometry, recorded parameters"}};
-    if (params) legend.push_back({"#2ca02c", "odometry, --params"});
-    p.Legend(legend);
-    parts.push_back(p.Render());
-    if (++col == 3) {
-      col = 0;
-      x = 60;
-      y += size + 60;
-    } else {
-      x += size + 60;
+    return c;
+  };
+  std::vector<Curve> before, after;
+  std::vector<io::SvgPoint> all_pos, all_head;
+  for (const auto& [source, run] : runs) {
+    {
+      const Source& src = *source;
+      before.push_back(curve(run, src.path, src.recorded, src.recorded));
+      if (params) after.push_back(curve(run, src.path, *params, src.recorded));
     }
   }
-  const double rows = std::ceil(static_cast<double>(parts.size()) / 3.0);
-  return io::SvgDocument(3 * (size + 60) + 40, rows * (size + 60) + 40, parts);
+  for (const auto* set : {&before, &after})
+    for (const auto& c : *set) {
+      all_pos.insert(all_pos.end(), c.pos.begin(), c.pos.end());
+      all_head.insert(all_head.end(), c.head.begin(), c.head.end());
+    }
+  std::vector<std::string> parts;
+  io::SvgPanel pp(80, 40, 520, 340, fmt::format("Position error along the path (first {} runs)", before.size()));
+  io::SvgPanel ph(700, 40, 520, 340, "Heading error along the path");
+  pp.FitExtent(all_pos, false, true);
+  ph.FitExtent(all_head, false, true);
+  pp.Axes("distance travelled [m]", "position error [mm]");
+  ph.Axes("distance travelled [m]", "heading error [deg]");
+  for (const auto& c : before) { pp.Polyline(c.pos, rec); ph.Polyline(c.head, rec); }
+  for (const auto& c : after) { pp.Polyline(c.pos, par); ph.Polyline(c.head, par); }
+  std::vector<std::pair<io::SvgStyle, std::string>> legend = {{rec, "odometry with the recorded parameters (one line per run)"}};
+  if (params) legend.push_back({par, "odometry with the --params parameters"});
+  pp.Legend(legend);
+  ph.Legend(legend);
+  parts.push_back(pp.Render());
+  parts.push_back(ph.Render());
+  double bottom = std::max(pp.Bottom(), ph.Bottom()) + 40;
+  // The paths of the first runs, each on its own scale.
+  const io::SvgStyle gt{"#111", "", "", 2.2, false};
+  const double size = 250;
+  int shown = 0;
+  double row_bottom = bottom;
+  for (const auto& [source, run] : runs) {
+    {
+      const Source& src = *source;
+      if (shown >= 8) break;
+      const double left = 80 + (shown % 4) * (size + 60), top = bottom + (shown / 4) * (size + 90);
+      io::SvgPanel p(left, top, size, size, fmt::format("run {} ({})", run.run, run.direction));
+      const RunTrack b = TrackRun(run, src.path, src.recorded, src.recorded, integ);
+      std::vector<io::SvgPoint> g, o0, o1, all;
+      for (std::size_t i = 0; i < run.size(); ++i) {
+        if (b.has_ground_truth[i]) g.push_back({b.ground_truth[i].x, b.ground_truth[i].y});
+        o0.push_back({b.odometry[i].x, b.odometry[i].y});
+      }
+      if (params) {
+        const RunTrack a = TrackRun(run, src.path, *params, src.recorded, integ);
+        for (const auto& q : a.odometry) o1.push_back({q.x, q.y});
+      }
+      all = g;
+      all.insert(all.end(), o0.begin(), o0.end());
+      p.FitExtent(all, true, true);
+      p.Axes("x [m]", "y [m]");
+      p.Polyline(g, gt);
+      p.Polyline(o0, rec);
+      if (params) p.Polyline(o1, par);
+      row_bottom = std::max(row_bottom, p.Bottom());
+      parts.push_back(p.Render());
+      ++shown;
+    }
+  }
+  io::SvgPanel key(80, row_bottom - 36, 0, 0, "");
+  std::vector<std::pair<io::SvgStyle, std::string>> key_entries = {{gt, "ground truth"}, legend.front()};
+  if (params) key_entries.push_back(legend.back());
+  key.Legend(key_entries);
+  parts.push_back(key.Render());
+  return io::SvgDocument(1260, key.Bottom() + 10, parts);
+}
+
+std::string EvaluateReportHtml(const std::vector<std::string>& inputs, const EvaluationSummary& base,
+                               const std::optional<EvaluationSummary>& with_params, const std::string& params_file,
+                               const std::string& svg) {
+  std::string subject;
+  for (const auto& i : inputs) subject += (subject.empty() ? "" : ", ") + i;
+  io::HtmlReport rep("umbmark evaluate", subject);
+  const EvaluationSummary& m = with_params ? *with_params : base;
+  if (with_params) {
+    const double b = base.mean_final_position_error_m * 1e3, a = with_params->mean_final_position_error_m * 1e3;
+    rep.Headline(fmt::format("Mean final position error {:.2f} mm with the recorded parameters, {:.2f} mm with {} ({}).",
+                             b, a, params_file, a < b ? fmt::format("{:.1f}x smaller", b / std::max(a, 1e-9)) : "no better"),
+                 a < b ? io::HtmlReport::Level::kGood : io::HtmlReport::Level::kWarn);
+  } else {
+    rep.Headline(fmt::format("Over {} runs the odometry ends {:.2f} mm (mean) and at worst {:.2f} mm from the ground truth; "
+                             "heading at worst {:.3f} deg.",
+                             m.runs.size(), m.mean_final_position_error_m * 1e3, m.max_final_position_error_m * 1e3,
+                             Rad2Deg(m.max_final_heading_error_rad)),
+                 io::HtmlReport::Level::kInfo);
+  }
+  rep.NextSteps(with_params ? std::vector<std::string>{"If the calibrated parameters reduce the error, load them into the robot's odometry.",
+                                                       "If one run stands out below, check that run (slip, a bump, lost tracking)."}
+                            : std::vector<std::string>{"Calibrate (`umbmark calibrate` on squares) and evaluate again with --params CAL.json."});
+  auto row = [](const std::string& name, const EvaluationSummary& e) {
+    return std::vector<std::string>{name, fmt::format("{:.2f}", e.mean_final_position_error_m * 1e3),
+                                    fmt::format("{:.2f}", e.max_final_position_error_m * 1e3),
+                                    fmt::format("{:.2f}", e.max_max_position_error_m * 1e3),
+                                    fmt::format("{:.3f}", Rad2Deg(e.mean_final_heading_error_rad)),
+                                    fmt::format("{:.3f}", Rad2Deg(e.max_max_heading_error_rad))};
+  };
+  rep.Heading("Summary over runs");
+  std::vector<std::vector<std::string>> rows = {row("recorded parameters", base)};
+  if (with_params) rows.push_back(row(params_file, *with_params));
+  rep.Table({"odometry with", "final position error, mean [mm]", "final, max [mm]", "max along the path [mm]",
+             "final heading error, mean [deg]", "max heading error [deg]"},
+            rows);
+  rep.Heading("Per run");
+  rows.clear();
+  for (const auto& r : m.runs)
+    rows.push_back({fmt::format("{} run {} ({})", r.experiment, r.run, r.direction),
+                    fmt::format("{:.2f}", r.final_position_error_m * 1e3), fmt::format("{:.2f}", r.max_position_error_m * 1e3),
+                    fmt::format("{:.3f}", Rad2Deg(r.final_heading_error_rad)),
+                    fmt::format("{:.3f}", Rad2Deg(r.max_heading_error_rad))});
+  rep.Table({"run", "final position error [mm]", "max position error [mm]", "final heading error [deg]",
+             "max heading error [deg]"},
+            rows);
+  rep.Heading("Plots");
+  rep.Figure(svg, "Error along the travelled distance for every run, then the paths of the first runs.");
+  return rep.Render();
 }
 
 int RunEvaluate(const EvaluateOptions& o) {
@@ -137,6 +239,7 @@ int RunEvaluate(const EvaluateOptions& o) {
   outs.AddInput(o.params_file);
   outs.AddOutput("--json", o.json.path);
   outs.AddOutput("--plot", o.plot);
+  outs.AddOutput("--report", o.report);
   outs.Check();
   const std::vector<Source> sources = ListSources(o);
   std::optional<RobotParams> params;
@@ -159,7 +262,7 @@ int RunEvaluate(const EvaluateOptions& o) {
     while (reader->NextRun(run)) {
       base_runs.push_back(EvaluateRun(run, src.path, src.label, src.recorded, src.recorded, integ));
       if (params) param_runs.push_back(EvaluateRun(run, src.path, src.label, *params, src.recorded, integ));
-      if (!o.plot.empty() && plot_runs.size() < kPlotRuns) plot_runs.push_back({&src, run});
+      if ((!o.plot.empty() || !o.report.empty()) && plot_runs.size() < kPlotRuns) plot_runs.push_back({&src, run});
     }
   }
   for (const auto& src : sources) {
@@ -168,7 +271,9 @@ int RunEvaluate(const EvaluateOptions& o) {
     }
   }
   const EvaluationSummary base = Summarise(std::move(base_runs));
-  const EvaluationSummary& main = params ? Summarise(std::move(param_runs)) : base;
+  std::optional<EvaluationSummary> with_params;
+  if (params) with_params = Summarise(std::move(param_runs));
+  const EvaluationSummary& main = with_params ? *with_params : base;
   if (o.json.PrintText()) {
     if (params) {
       PrintSummary("Recorded parameters", base);
@@ -187,8 +292,20 @@ int RunEvaluate(const EvaluateOptions& o) {
                      {"runs", JsonEvaluationRuns(base)},
                      {"summary", JsonEvaluationSummary(base)}};
   }
-  if (!o.plot.empty()) outs.Write(o.plot, PlotSvg(plot_runs, params, integ));
+  std::vector<std::string> written;
+  std::string svg;
+  if (!o.plot.empty() || !o.report.empty()) svg = PlotSvg(plot_runs, params, integ);
+  if (!o.plot.empty()) {
+    outs.Write(o.plot, svg);
+    written.push_back(o.plot + " (plot)");
+  }
+  if (!o.report.empty()) {
+    outs.Write(o.report, EvaluateReportHtml(o.inputs, base, with_params, o.params_file, svg));
+    written.push_back(o.report + " (HTML report)");
+  }
   o.json.Emit(j);
+  if (!o.json.path.empty() && !o.json.ToStdout()) written.push_back(o.json.path + " (JSON)");
+  PrintWritten(written, o.json.PrintText());
   return 0;
 }
 
@@ -204,7 +321,9 @@ Command SetupEvaluate(CLI::App& parent) {
       ->check(CLI::IsMember({"arc", "midpoint"}))
       ->capture_default_str();
   opts->json.Bind(*app);
-  app->add_option("--plot", opts->plot, "Write an SVG overlaying ground truth and odometry (before/after)");
+  app->add_option("--plot", opts->plot,
+                  "Write an SVG: position and heading error along the travelled distance per run, and the paths");
+  app->add_option("--report", opts->report, "Write a self-contained HTML report (summary, per-run table, plots)");
   return {app, [opts] { return RunEvaluate(*opts); }};
 }
 

@@ -7,6 +7,7 @@
 //    from ground truth at the first and last sample),
 //  - a campaign manifest: every run with ground truth at start and end, with
 //    a systematic mean per experiment and direction.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -24,6 +25,7 @@
 #include "error_models/wheel_noise_fit.hpp"
 #include "error_models/wheel_noise_fit_data.hpp"
 #include "io/atomic_write.hpp"
+#include "io/html_report.hpp"
 #include "io/data_file.hpp"
 #include "io/manifest.hpp"
 #include "io/ros2_params.hpp"
@@ -43,6 +45,7 @@ struct FitNoiseOptions {
   std::string ros2;
   std::string controller = "diff_drive_controller";
   OdometryCovarianceOptions covariance;
+  std::string report;
   JsonFlag json;
   std::string params_json;            // --params CAL.json: the calibrated robot
   std::string systematic = "none";    // none | estimate
@@ -194,50 +197,113 @@ nlohmann::json JsonMatrix(const PoseCovariance& P) {
   return rows;
 }
 
-/// Figure 4 of Chong & Kleeman: run scatter with 95% ellipses, observed
-/// (solid) and fitted (dashed), for ex-ey, ex-etheta, ey-etheta.
-std::string PlotSvg(const WheelNoiseFitSummary& s) {
-  const bool centred = s.groups.size() > 1;
+/// Figure 4 of Chong & Kleeman, per group: each run's return error, and for
+/// each group (experiment and direction) its observed 95% ellipse (solid)
+/// and the fitted model's (dashed), both about the group's own systematic
+/// mean; for ex-ey, ex-etheta, ey-etheta.
+std::string PlotSvg(const WheelNoiseFitSummary& s, const std::vector<WheelNoiseFitRun>& runs) {
   const double scale95 = std::sqrt(-2.0 * std::log(0.05));  // 2-D 95% ellipse: sqrt(chi^2_2(0.95))
   const double unit[3] = {1e3, 1e3, 1e3};                      // mm, mm, mrad
-  const char* label[3] = {"ex [mm]", "ey [mm]", "etheta [mrad]"};
+  const char* label[3] = {"e_x [mm]", "e_y [mm]", "e_theta [mrad]"};
   const int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
-  // Observed centre: sample mean (single group) or 0 (residuals).
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  if (!centred) centre = s.group_means[0];
+  const char* colors[] = {"#1f5fa8", "#c0392b", "#1f7a3a", "#7d3c98", "#b9770e", "#555555"};
+  const char* markers[] = {"circle", "triangle", "square", "diamond", "plus", "cross"};
+  const std::size_t G = s.groups.size();
+  // Per group: members, observed covariance of residuals, mean predicted covariance.
+  std::vector<std::vector<std::size_t>> members(G);
+  for (std::size_t i = 0; i < runs.size() && i < s.residuals.size(); ++i)
+    for (std::size_t g = 0; g < G; ++g)
+      if (runs[i].group == s.groups[g]) members[g].push_back(i);
+  std::vector<PoseCovariance> observed(G, PoseCovariance::Zero()), predicted(G, PoseCovariance::Zero());
+  for (std::size_t g = 0; g < G; ++g) {
+    const double n = static_cast<double>(members[g].size());
+    for (std::size_t i : members[g]) {
+      observed[g] += s.residuals[i] * s.residuals[i].transpose() / std::max(n - 1.0, 1.0);
+      if (i < s.predicted_run_covariance.size()) predicted[g] += s.predicted_run_covariance[i] / n;
+    }
+  }
   std::vector<std::string> parts;
-  const double size = 360;
+  const double size = 340;
+  double bottom = 0;
   for (int k = 0; k < 3; ++k) {
     const int a = pairs[k][0], b = pairs[k][1];
-    io::SvgPanel p(60 + k * (size + 70), 50, size, size,
-                   fmt::format("{} vs {}{}", label[b], label[a], centred ? " (residuals about group means)" : ""));
-    std::vector<io::SvgPoint> pts;
-    for (std::size_t i = 0; i < s.residuals.size(); ++i) {
-      const Eigen::Vector3d& r = s.residuals[i];
-      if (!std::isfinite(r(a)) || !std::isfinite(r(b))) continue;
-      pts.push_back({(r(a) + centre(a)) * unit[a], (r(b) + centre(b)) * unit[b]});
-    }
-    std::vector<io::SvgPoint> extent = pts;
-    const PoseCovariance& O = s.observed_covariance;
-    const PoseCovariance& P = s.predicted_covariance;
-    for (const PoseCovariance* C : {&O, &P}) {
-      const double rx = scale95 * std::sqrt(std::max((*C)(a, a), 0.0)) * unit[a];
-      const double ry = scale95 * std::sqrt(std::max((*C)(b, b), 0.0)) * unit[b];
-      extent.push_back({centre(a) * unit[a] + rx, centre(b) * unit[b] + ry});
-      extent.push_back({centre(a) * unit[a] - rx, centre(b) * unit[b] - ry});
+    io::SvgPanel p(80 + k * (size + 90), 50, size, size, fmt::format("{} vs {}", label[b], label[a]));
+    std::vector<io::SvgPoint> extent;
+    std::vector<std::vector<io::SvgPoint>> pts(G);
+    for (std::size_t g = 0; g < G; ++g) {
+      const Eigen::Vector3d& mu = s.group_means[g];
+      for (std::size_t i : members[g]) {
+        const Eigen::Vector3d e = mu + s.residuals[i];
+        if (std::isfinite(e(a)) && std::isfinite(e(b))) pts[g].push_back({e(a) * unit[a], e(b) * unit[b]});
+      }
+      extent.insert(extent.end(), pts[g].begin(), pts[g].end());
+      for (const PoseCovariance* C : {&observed[g], &predicted[g]}) {
+        const double rx = scale95 * std::sqrt(std::max((*C)(a, a), 0.0)) * unit[a];
+        const double ry = scale95 * std::sqrt(std::max((*C)(b, b), 0.0)) * unit[b];
+        extent.push_back({mu(a) * unit[a] + rx, mu(b) * unit[b] + ry});
+        extent.push_back({mu(a) * unit[a] - rx, mu(b) * unit[b] - ry});
+      }
     }
     p.FitExtent(extent, false, false);
     p.Axes(label[a], label[b]);
-    p.Points(pts, "#1f77b4", 2.5);
-    const io::SvgPoint c{centre(a) * unit[a], centre(b) * unit[b]};
-    p.CovarianceEllipse(c, O(a, a) * unit[a] * unit[a], O(a, b) * unit[a] * unit[b], O(b, b) * unit[b] * unit[b],
-                        scale95, "#111");
-    p.CovarianceEllipse(c, P(a, a) * unit[a] * unit[a], P(a, b) * unit[a] * unit[b], P(b, b) * unit[b] * unit[b],
-                        scale95, "#d62728", "6,4");
-    p.Legend({{"#111", "observed 95%"}, {"#d62728", fmt::format("fitted k_L={:.3g}, k_R={:.3g} 95%", s.k_L, s.k_R)}});
+    std::vector<std::pair<io::SvgStyle, std::string>> legend;
+    for (std::size_t g = 0; g < G; ++g) {
+      const io::SvgStyle dots{colors[g % 6], markers[g % 6], "", 1.5, g % 2 == 0};
+      const io::SvgStyle obs{colors[g % 6], "", "", 1.6, false}, pred{colors[g % 6], "", "6,4", 1.6, false};
+      const Eigen::Vector3d& mu = s.group_means[g];
+      const io::SvgPoint c{mu(a) * unit[a], mu(b) * unit[b]};
+      const PoseCovariance& O = observed[g];
+      const PoseCovariance& P = predicted[g];
+      p.Points(pts[g], dots, 3.0);
+      p.CovarianceEllipse(c, O(a, a) * unit[a] * unit[a], O(a, b) * unit[a] * unit[b], O(b, b) * unit[b] * unit[b],
+                          scale95, obs);
+      p.CovarianceEllipse(c, P(a, a) * unit[a] * unit[a], P(a, b) * unit[a] * unit[b], P(b, b) * unit[b] * unit[b],
+                          scale95, pred);
+      if (k == 0) {
+        legend.push_back({dots, fmt::format("{} ({} runs)", s.groups[g], members[g].size())});
+        legend.push_back({obs, "  observed 95% ellipse about the group mean"});
+        legend.push_back({pred, fmt::format("  model 95% ellipse (k_L = {:.3g}, k_R = {:.3g} m^1/2)", s.k_L, s.k_R)});
+      }
+    }
+    if (k == 0) p.Legend(legend);
+    bottom = std::max(bottom, p.Bottom());
     parts.push_back(p.Render());
   }
-  return io::SvgDocument(3 * (size + 70) + 40, size + 110, parts);
+  return io::SvgDocument(3 * (size + 90) + 60, bottom + 10, parts);
+}
+
+std::string FitNoiseReportHtml(const std::vector<std::string>& inputs, const WheelNoiseFitSummary& s, const std::string& svg) {
+  std::string subject;
+  for (const auto& i : inputs) subject += (subject.empty() ? "" : ", ") + i;
+  io::HtmlReport rep("umbmark fit-noise", subject);
+  bool flagged = false;
+  for (const auto& g : s.goodness_of_fit) flagged |= std::abs(g.z) > 3.0;
+  rep.Headline(fmt::format("Wheel noise k_L = {:.3g} m^1/2 (95%: {:.3g} to {:.3g}), k_R = {:.3g} m^1/2 (95%: {:.3g} to {:.3g}) "
+                           "from {} runs{}.",
+                           s.k_L, s.k_L_ci[0], s.k_L_ci[1], s.k_R, s.k_R_ci[0], s.k_R_ci[1], s.runs,
+                           flagged ? "; the model does not explain every element of the scatter" : ""),
+               flagged ? io::HtmlReport::Level::kWarn : io::HtmlReport::Level::kGood);
+  std::vector<std::string> steps = {
+      "Use k_L, k_R in `umbmark predict` (pose covariance after any path) or in your simulator (wheel travel variance k^2 |travel|)."};
+  if (flagged) steps.push_back("An element with |z| > 3 is not explained by white wheel noise: run `umbmark diagnose` on the campaign.");
+  if (s.runs < 20) steps.push_back("Intervals are wide with few runs: 20 or more runs per group narrow them.");
+  rep.NextSteps(steps);
+  rep.Heading("Systematic mean per group");
+  std::vector<std::vector<std::string>> rows;
+  for (std::size_t g = 0; g < s.groups.size(); ++g)
+    rows.push_back({s.groups[g], fmt::format("{:.3f}", 1e3 * s.group_means[g](0)), fmt::format("{:.3f}", 1e3 * s.group_means[g](1)),
+                    fmt::format("{:.3f}", 1e3 * s.group_means[g](2))});
+  rep.Table({"group", "e_x [mm]", "e_y [mm]", "e_theta [mrad]"}, rows);
+  rep.Heading("Goodness of fit: residual covariance, observed vs model");
+  rows.clear();
+  for (const auto& g : s.goodness_of_fit)
+    rows.push_back({g.element, fmt::format("{:.4e}", g.observed), fmt::format("{:.4e}", g.predicted),
+                    fmt::format("{:.4e}", g.standard_error), fmt::format("{:+.2f}", g.z), std::to_string(g.runs)});
+  rep.Table({"element (m^2, m rad, rad^2)", "observed", "model", "standard error", "z", "runs"}, rows);
+  rep.Heading("Plots");
+  rep.Figure(svg, "Each run's return error; per group the observed 95% ellipse (solid) and the fitted model's (dashed), "
+                  "about the group's own mean.");
+  return rep.Render();
 }
 
 int RunFitNoise(const FitNoiseOptions& o) {
@@ -246,6 +312,7 @@ int RunFitNoise(const FitNoiseOptions& o) {
   if (!o.params_json.empty()) outs.AddInput(o.params_json);
   outs.AddOutput("--json", o.json.path);
   outs.AddOutput("--plot", o.plot);
+  outs.AddOutput("--report", o.report);
   outs.AddOutput("--ros2", o.ros2);
   outs.Check();
   if (!o.params_json.empty() && o.systematic == "estimate")
@@ -370,7 +437,17 @@ int RunFitNoise(const FitNoiseOptions& o) {
   } else {
     for (const auto& w : warnings) fmt::print(stderr, "fit-noise: warning: {}\n", w);
   }
-  if (!o.plot.empty()) CommandOutputs().Write(o.plot, PlotSvg(s));
+  std::vector<std::string> written;
+  std::string svg;
+  if (!o.plot.empty() || !o.report.empty()) svg = PlotSvg(s, data.runs);
+  if (!o.plot.empty()) {
+    CommandOutputs().Write(o.plot, svg);
+    written.push_back(o.plot + " (plot)");
+  }
+  if (!o.report.empty()) {
+    CommandOutputs().Write(o.report, FitNoiseReportHtml(o.inputs, s, svg));
+    written.push_back(o.report + " (HTML report)");
+  }
   if (cov) {
     CommandOutputs().Write(
         o.ros2,
@@ -392,6 +469,8 @@ int RunFitNoise(const FitNoiseOptions& o) {
                                        o.covariance.speed_mps, o.covariance.rate_hz);
   }
   o.json.Emit(j);
+  if (!o.json.path.empty() && !o.json.ToStdout()) written.push_back(o.json.path + " (JSON)");
+  PrintWritten(written, o.json.PrintText());
   return 0;
 }
 
@@ -411,7 +490,9 @@ Command SetupFitNoise(CLI::App& parent) {
       ->delimiter(',');
   app->add_flag("--first-order", opts->first_order, "Fit the first-order model only (no heading-squared term)");
   app->add_flag("--reml", opts->reml, "Restricted maximum likelihood (allow for the fitted systematic means)");
-  app->add_option("--plot", opts->plot, "Write pairwise 95% ellipses, observed vs fitted, over the runs (SVG)");
+  app->add_option("--plot", opts->plot,
+                  "Write an SVG: per group the runs with observed and fitted 95% ellipses about the group mean");
+  app->add_option("--report", opts->report, "Write a self-contained HTML report (k_L, k_R with intervals, checks, plots)");
   app->add_option("--ros2", opts->ros2,
                   "Write diff_drive_controller pose/twist_covariance_diagonal from k_L, k_R (YAML; docs/ros2.md)");
   app->add_option("--controller", opts->controller, "Controller name at the top of the --ros2 file")->capture_default_str();

@@ -24,5 +24,6 @@ Command SetupSimulate(CLI::App& parent);
 Command SetupDiagnose(CLI::App& parent);
 Command SetupPredict(CLI::App& parent);
 Command SetupFitNoise(CLI::App& parent);
+Command SetupSummarize(CLI::App& parent);
 
 }  // namespace umbmark::cli

@@ -1,0 +1,263 @@
+// `umbmark summarize CAL.json... [--json FILE] [--csv FILE] [--report FILE.html]`:
+// a fleet of robots from their `calibrate` JSON outputs (a batch output's
+// `results` count one robot each): one row per robot, the fleet's median and
+// robust spread of each parameter, and the robots that stand out (robust
+// z-score, calibration/fleet.hpp) with the reasons in words.
+#include <cmath>
+#include <memory>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "calibration/fleet.hpp"
+#include "commands.hpp"
+#include "common.hpp"
+#include "core/errors.hpp"
+#include "io/atomic_write.hpp"
+#include "io/html_report.hpp"
+#include "io/svg_plot.hpp"
+
+namespace umbmark::cli {
+namespace {
+
+struct SummarizeOptions {
+  std::vector<std::string> inputs;
+  FleetOptions fleet;
+  JsonFlag json;
+  std::string csv;
+  std::string report;
+};
+
+struct Robot {
+  FleetRobot fleet;
+  nlohmann::json parameters;
+  std::string source;  // "refined" or "umbmark"
+};
+
+// One calibrate result (an object with `parameters`) -> a fleet robot.
+Robot RobotFromResult(const nlohmann::json& j, const std::string& file) {
+  Robot r;
+  r.fleet.file = file;
+  const bool refined = j.contains("refined") && j["refined"].is_object() && j["refined"].contains("parameters");
+  r.parameters = refined ? j["refined"]["parameters"] : j.at("parameters");
+  r.source = refined ? "refined" : "umbmark";
+  auto number = [&](const nlohmann::json& obj, const char* key, FleetQuantity q) {
+    if (obj.contains(key) && obj[key].is_number()) r.fleet.values[q] = obj[key].get<double>();
+  };
+  for (const char* key : {"wheelbase_m", "wheel_diameter_left_m", "wheel_diameter_right_m"}) {
+    if (!r.parameters.contains(key) || !r.parameters[key].is_number())
+      throw InputError(file, fmt::format("calibration JSON without a numeric parameters.{}", key));
+  }
+  number(r.parameters, "wheelbase_m", FleetQuantity::kWheelbase);
+  number(r.parameters, "wheel_diameter_left_m", FleetQuantity::kDiameterLeft);
+  number(r.parameters, "wheel_diameter_right_m", FleetQuantity::kDiameterRight);
+  number(j, "E_d", FleetQuantity::kEd);
+  number(j, "E_b", FleetQuantity::kEb);
+  number(j, "E_max_syst_m", FleetQuantity::kEmaxBefore);
+  if (j.contains("evaluation") && j["evaluation"].contains("after"))
+    number(j["evaluation"]["after"], "max_final_position_error_m", FleetQuantity::kResidualAfter);
+  return r;
+}
+
+std::vector<Robot> ReadRobots(const std::string& path) {
+  nlohmann::json j;
+  const std::string text = io::ReadWholeFile(path);
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(path, fmt::format("not JSON (byte {}): {}", e.byte, e.what()));
+  }
+  std::vector<Robot> out;
+  try {
+    if (j.contains("results") && j["results"].is_array()) {  // a batch calibrate output
+      int k = 0;
+      for (const auto& r : j["results"]) {
+        ++k;
+        if (r.contains("error")) continue;  // a failed calibration in the batch
+        out.push_back(RobotFromResult(r, fmt::format("{}#{}", path, k)));
+      }
+    } else {
+      out.push_back(RobotFromResult(j, path));
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path, fmt::format("not a calibrate JSON output: {}", e.what()));
+  }
+  return out;
+}
+
+std::string Fmt(double v, FleetQuantity q) {
+  switch (q) {
+    case FleetQuantity::kEd:
+    case FleetQuantity::kEb: return fmt::format("{:.6f}", v);
+    case FleetQuantity::kEmaxBefore:
+    case FleetQuantity::kResidualAfter: return fmt::format("{:.2f} mm", v * 1e3);
+    default: return fmt::format("{:.6f} m", v);
+  }
+}
+
+// Robust z-scores of every robot per quantity, outliers marked: a strip
+// chart with the threshold band.
+std::string FleetPlot(const std::vector<Robot>& robots, const FleetSummary& s, double threshold) {
+  std::vector<FleetQuantity> qs;
+  for (FleetQuantity q : kFleetQuantities)
+    if (s.fleet.count(q) && s.fleet.at(q).n >= 3) qs.push_back(q);
+  io::SvgPanel p(90, 40, 760, 360, "Robust z-score of each robot per quantity");
+  double zmax = threshold + 1.0;
+  for (const auto& r : s.robots)
+    for (const auto& [q, z] : r.z) zmax = std::max(zmax, std::abs(z) + 0.5);
+  p.SetExtent(-0.5, static_cast<double>(qs.size()) - 0.5, -zmax, zmax, false);
+  const double right = static_cast<double>(qs.size()) - 0.5;
+  p.Band({{-0.5, -threshold}, {right, -threshold}}, {{-0.5, threshold}, {right, threshold}}, "#888", 0.15);
+  std::vector<io::SvgPoint> normal, outlying;
+  for (std::size_t k = 0; k < qs.size(); ++k) {
+    for (std::size_t i = 0; i < robots.size(); ++i) {
+      const auto it = s.robots[i].z.find(qs[k]);
+      if (it == s.robots[i].z.end()) continue;
+      const double jitter = 0.25 * (static_cast<double>((i * 37) % 17) / 16.0 - 0.5);
+      (std::abs(it->second) > threshold ? outlying : normal).push_back({static_cast<double>(k) + jitter, it->second});
+    }
+    p.Text({static_cast<double>(k) - 0.4, -zmax + 0.3}, FleetQuantityKey(qs[k]), "#111", 10);
+  }
+  p.Axes("quantity (one column each; robots spread sideways)", "robust z = (value - median) / (1.4826 MAD)");
+  p.Points(normal, {"#35608f", "circle", "", 1.5, false}, 3.5);
+  p.Points(outlying, {"#b02020", "triangle", "", 1.5, true}, 5.5);
+  p.Legend({{{"#35608f", "circle", "", 1.5, false}, "robot within the fleet"},
+            {{"#b02020", "triangle", "", 1.5, true}, fmt::format("outlier (|z| > {})", threshold)},
+            {{"#888", "square", "", 1.5, true}, fmt::format("band |z| <= {}", threshold)}});
+  return io::SvgDocument(880, p.Bottom() + 10, {p.Render()});
+}
+
+int RunSummarize(const SummarizeOptions& o) {
+  if (auto e = o.fleet.Check(); !e.empty()) throw InvalidOptions("summarize: " + e);
+  std::vector<Robot> robots;
+  for (const auto& path : o.inputs) {
+    auto more = ReadRobots(path);
+    robots.insert(robots.end(), more.begin(), more.end());
+  }
+  std::vector<FleetRobot> fr;
+  for (const auto& r : robots) fr.push_back(r.fleet);
+  const FleetSummary s = SummarizeFleet(fr, o.fleet);
+  std::vector<std::string> warnings;
+  if (robots.size() < 3) warnings.push_back(fmt::format("{} robot(s): a fleet spread needs at least 3; no outliers are flagged", robots.size()));
+  std::size_t n_out = 0;
+  for (const auto& r : s.robots) n_out += r.outlier ? 1 : 0;
+
+  nlohmann::json j;
+  j["robots"] = nlohmann::json::array();
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    nlohmann::json z = nlohmann::json::object();
+    for (const auto& [q, v] : s.robots[i].z) z[FleetQuantityKey(q)] = v;
+    j["robots"].push_back({{"file", robots[i].fleet.file},
+                           {"parameters", robots[i].parameters},
+                           {"parameters_from", robots[i].source},
+                           {"robust_z", z},
+                           {"outlier", s.robots[i].outlier},
+                           {"outlier_reasons", s.robots[i].reasons}});
+  }
+  j["fleet"] = nlohmann::json::object();
+  for (const auto& [q, st] : s.fleet)
+    j["fleet"][FleetQuantityKey(q)] = {{"n", st.n}, {"median", st.median}, {"mad", st.mad}, {"spread_used", st.spread}};
+  j["threshold"] = o.fleet.threshold;
+  j["outliers"] = n_out;
+  j["warnings"] = warnings;
+
+  std::vector<std::string> written;
+  if (o.json.PrintText()) {
+    fmt::print("Fleet summary: {} robots from {} file(s), {} outlier(s) (robust |z| > {})\n", robots.size(),
+               o.inputs.size(), n_out, o.fleet.threshold);
+    fmt::print("  {:<24} {:>4} {:>16} {:>16}\n", "quantity", "n", "median", "robust SD (MAD)");
+    for (const auto& [q, st] : s.fleet)
+      fmt::print("  {:<24} {:>4} {:>16} {:>16}\n", FleetQuantityKey(q), st.n, Fmt(st.median, q), Fmt(st.mad, q));
+    fmt::print("  {:<40} {:>12} {:>12} {:>12}  {}\n", "robot", "wheelbase_m", "D_left_m", "D_right_m", "outlier");
+    for (std::size_t i = 0; i < robots.size(); ++i) {
+      const auto& p = robots[i].parameters;
+      fmt::print("  {:<40} {:>12.6f} {:>12.6f} {:>12.6f}  {}\n", robots[i].fleet.file, p["wheelbase_m"].get<double>(),
+                 p["wheel_diameter_left_m"].get<double>(), p["wheel_diameter_right_m"].get<double>(),
+                 s.robots[i].outlier ? "OUTLIER" : "-");
+      for (const auto& reason : s.robots[i].reasons) fmt::print("      {}\n", reason);
+    }
+    for (const auto& w : warnings) fmt::print("warning: {}\n", w);
+  }
+  if (!o.csv.empty()) {
+    std::string csv = "file,wheelbase_m,wheel_diameter_left_m,wheel_diameter_right_m,E_d,E_b,E_max_syst_m,residual_after_m,outlier,reasons\n";
+    for (std::size_t i = 0; i < robots.size(); ++i) {
+      std::string row = "\"" + robots[i].fleet.file + "\"";
+      for (FleetQuantity q : kFleetQuantities) {
+        const auto it = robots[i].fleet.values.find(q);
+        row += it == robots[i].fleet.values.end() ? "," : fmt::format(",{:.9g}", it->second);
+      }
+      std::string reasons;
+      for (const auto& r : s.robots[i].reasons) reasons += (reasons.empty() ? "" : "; ") + r;
+      for (auto& c : reasons)
+        if (c == '"') c = '\'';
+      row += fmt::format(",{},\"{}\"\n", s.robots[i].outlier ? "true" : "false", reasons);
+      csv += row;
+    }
+    io::WriteFileAtomically(o.csv, csv);
+    written.push_back(o.csv + " (CSV, one row per robot)");
+  }
+  if (!o.report.empty()) {
+    io::HtmlReport rep("umbmark summarize: fleet of " + std::to_string(robots.size()) + " robots",
+                       fmt::format("{} calibration file(s)", o.inputs.size()));
+    if (n_out == 0)
+      rep.Headline(fmt::format("No robot stands out of the fleet of {} (robust |z| <= {} in every quantity).",
+                               robots.size(), o.fleet.threshold),
+                   io::HtmlReport::Level::kGood);
+    else
+      rep.Headline(fmt::format("{} of {} robots stand out of the fleet (robust |z| > {}).", n_out, robots.size(),
+                               o.fleet.threshold),
+                   io::HtmlReport::Level::kWarn);
+    std::vector<std::string> steps;
+    if (n_out > 0) {
+      steps.push_back("Inspect the flagged robots for the reason given (wheel wear, wheel mounting, tyre pressure).");
+      steps.push_back("Recalibrate a flagged robot after the repair and summarize again.");
+    } else {
+      steps.push_back("Load each robot's corrected parameters (its calibrate JSON, or the --ros2 snippet).");
+    }
+    rep.NextSteps(steps);
+    rep.Warnings(warnings);
+    rep.Heading("Fleet distribution");
+    std::vector<std::vector<std::string>> rows;
+    for (const auto& [q, st] : s.fleet)
+      rows.push_back({FleetQuantityKey(q), std::to_string(st.n), Fmt(st.median, q), Fmt(st.mad, q)});
+    rep.Table({"quantity", "robots", "median", "robust SD (1.4826 MAD)"}, rows);
+    rep.Heading("Robots");
+    rows.clear();
+    for (std::size_t i = 0; i < robots.size(); ++i) {
+      const auto& p = robots[i].parameters;
+      std::string reasons;
+      for (const auto& r : s.robots[i].reasons) reasons += (reasons.empty() ? "" : " | ") + r;
+      rows.push_back({robots[i].fleet.file, fmt::format("{:.6f}", p["wheelbase_m"].get<double>()),
+                      fmt::format("{:.6f}", p["wheel_diameter_left_m"].get<double>()),
+                      fmt::format("{:.6f}", p["wheel_diameter_right_m"].get<double>()),
+                      s.robots[i].outlier ? "OUTLIER" : "-", reasons});
+    }
+    rep.Table({"robot (file)", "wheelbase [m]", "D left [m]", "D right [m]", "outlier", "why"}, rows);
+    rep.Figure(FleetPlot(robots, s, o.fleet.threshold),
+               "Each robot's robust z-score per quantity; the grey band is the outlier threshold. Triangles: outliers.");
+    io::WriteFileAtomically(o.report, rep.Render());
+    written.push_back(o.report + " (HTML report)");
+  }
+  o.json.Emit(j);
+  if (!o.json.path.empty() && !o.json.ToStdout()) written.push_back(o.json.path + " (JSON)");
+  PrintWritten(written, o.json.PrintText());
+  return 0;
+}
+
+}  // namespace
+
+Command SetupSummarize(CLI::App& parent) {
+  auto opts = std::make_shared<SummarizeOptions>();
+  auto* app = parent.add_subcommand("summarize", "Fleet summary of many robots' calibrate JSON outputs: spread and outliers");
+  app->add_option("CAL", opts->inputs, "calibrate JSON outputs (one robot each; a batch output counts each result)")
+      ->required();
+  app->add_option("--threshold", opts->fleet.threshold, "Robust |z| above which a robot is an outlier")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  opts->json.Bind(*app);
+  app->add_option("--csv", opts->csv, "Write one row per robot (CSV)");
+  app->add_option("--report", opts->report, "Write a self-contained HTML report");
+  return {app, [opts] { return RunSummarize(*opts); }};
+}
+
+}  // namespace umbmark::cli
