@@ -119,12 +119,12 @@ std::string CalibrationPlotSvg(const CalibrateInput& input, const CalibrateJobRe
   if (input.trajectories) {
     const io::SvgStyle gt{"#111", "", "", 2.2, false}, od0{"#c0392b", "", "5,3", 1.4, false},
         od1{"#1f7a3a", "", "1.5,2.5", 1.8, false};
-    const double size = 230, top0 = bottom + 40;
+    const double size = 220, top0 = bottom + 40;
     const std::size_t runs = std::min<std::size_t>(input.trajectories->runs.size(), 8);
     double row_bottom = top0;
     for (std::size_t i = 0; i < runs; ++i) {
       const auto& run = input.trajectories->runs[i];
-      const double left = 80 + static_cast<double>(i % 4) * (size + 30);
+      const double left = 80 + static_cast<double>(i % 4) * (size + 75);
       const double top = top0 + static_cast<double>(i / 4) * (size + 90);
       io::SvgPanel p(left, top, size, size, fmt::format("run {} ({})", run.run, run.direction));
       const RunTrack b = TrackRun(run, input.trajectories->path, input.recorded, input.recorded, integrator);
@@ -155,7 +155,7 @@ std::string CalibrationPlotSvg(const CalibrateInput& input, const CalibrateJobRe
                    {od1, fmt::format("odometry, {} parameters", which)}});
     parts.push_back(legend.Render());
     bottom = legend.Bottom() + 10;
-    width = std::max(width, 80 + 4 * (size + 30) + 20);
+    width = std::max(width, 80 + 4 * (size + 75));
     if (runs < input.trajectories->runs.size())
       parts.push_back(fmt::format(R"svg(<text x="80" y="{:.0f}" font-size="11">first {} of {} runs shown</text>)svg",
                                   bottom + 6, runs, input.trajectories->runs.size()));

@@ -116,7 +116,8 @@ std::string FleetPlot(const std::vector<Robot>& robots, const FleetSummary& s, d
       const double jitter = 0.25 * (static_cast<double>((i * 37) % 17) / 16.0 - 0.5);
       (std::abs(it->second) > threshold ? outlying : normal).push_back({static_cast<double>(k) + jitter, it->second});
     }
-    p.Text({static_cast<double>(k) - 0.4, -zmax + 0.3}, FleetQuantityKey(qs[k]), "#111", 10);
+    static const char* kShort[] = {"wheelbase", "D left", "D right", "E_d", "E_b", "E_max,syst", "after"};
+    p.Text({static_cast<double>(k) - 0.3, -zmax + (k % 2 == 0 ? 0.25 : 0.8)}, kShort[static_cast<int>(qs[k])], "#111", 11);
   }
   p.Axes("quantity (one column each; robots spread sideways)", "robust z = (value - median) / (1.4826 MAD)");
   p.Points(normal, {"#35608f", "circle", "", 1.5, false}, 3.5);

@@ -5,6 +5,8 @@
 // structure (a headline, tables, inline plots, no script, no network).
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <regex>
@@ -53,6 +55,7 @@ std::vector<std::string> LegendLabels(const std::string& svg) {
 
 TEST_CASE("NiceTicks: 1-2-5 steps covering the range", "[plot]") {
   CHECK(io::NiceTicks(0.0, 10.0, 5) == std::vector<double>{0, 2, 4, 6, 8, 10});
+  CHECK(io::NiceTicks(0.0, 10.0, 3) == std::vector<double>{0, 5, 10});
   CHECK(io::NiceTicks(-36.55, 36.55, 6) == std::vector<double>{-30, -20, -10, 0, 10, 20, 30});
   const auto t = io::NiceTicks(0.0012, 0.0049, 4);
   REQUIRE(t.size() >= 3);
@@ -76,8 +79,14 @@ TEST_CASE("a panel draws its ticks at the tick values and a legend entry per ser
   const std::string svg = io::SvgDocument(500, p.Bottom(), {p.Render()});
   const auto xt = PanelTicks(svg, "x"), yt = PanelTicks(svg, "y");
   REQUIRE(xt.size() == 1);
-  CHECK(xt[0] == io::NiceTicks(-5.0, 25.0, 5));
-  CHECK(yt[0] == io::NiceTicks(0.0, 1.0, 5));
+  auto same = [](const std::vector<double>& got, const std::vector<double>& want) {
+    if (got.size() != want.size()) return false;
+    for (std::size_t i = 0; i < got.size(); ++i)
+      if (std::abs(got[i] - want[i]) > 1e-9 * (1 + std::abs(want[i]))) return false;
+    return true;
+  };
+  CHECK(same(xt[0], io::NiceTicks(-5.0, 25.0, 5)));
+  CHECK(same(yt[0], io::NiceTicks(0.0, 1.0, 5)));
   CHECK(LegendLabels(svg) == std::vector<std::string>{"series A", "series B"});
   CHECK(svg.find("x [m]") != std::string::npos);
   CHECK(svg.find("stroke-dasharray=\"5,3\"") != std::string::npos);  // dashes, not colour alone

@@ -28,21 +28,28 @@ std::string DashAttr(const std::string& dash) {
   return dash.empty() ? "" : fmt::format(R"svg( stroke-dasharray="{}")svg", dash);
 }
 double TickStep(double lo, double hi, int target) {
+  // The 1-2-5 step nearest (in ratio) to range / target.
   const double raw = (hi - lo) / std::max(target, 1);
   const double p = std::pow(10.0, std::floor(std::log10(raw)));
+  double best = p;
   for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (m * p >= raw) return m * p;
-  return 10.0 * p;
+    if (std::abs(std::log(m * p / raw)) < std::abs(std::log(best / raw))) best = m * p;
+  return best;
 }
 }  // namespace
 
 std::vector<double> NiceTicks(double lo, double hi, int target) {
   if (!std::isfinite(lo) || !std::isfinite(hi) || !(hi > lo)) return {};
-  const double step = TickStep(lo, hi, target);
+  // A narrow range can fall between two round values: refine until at
+  // least three ticks label it.
   std::vector<double> ticks;
-  for (double k = std::ceil(lo / step - 1e-9); k * step <= hi + 1e-9 * step; k += 1.0) {
-    const double v = k * step;
-    ticks.push_back(std::abs(v) < 1e-12 * step ? 0.0 : v);
+  for (int t = std::max(target, 1); ticks.size() < 3 && t <= 64; t *= 2) {
+    const double step = TickStep(lo, hi, t);
+    ticks.clear();
+    for (double k = std::ceil(lo / step - 1e-9); k * step <= hi + 1e-9 * step; k += 1.0) {
+      const double v = k * step;
+      ticks.push_back(std::abs(v) < 1e-12 * step ? 0.0 : v);
+    }
   }
   return ticks;
 }

@@ -30,7 +30,7 @@ struct SvgStyle {
 };
 
 /// Tick values at 1, 2 or 5 times a power of ten covering [lo, hi], about
-/// `target` of them (at least 2 when lo < hi).
+/// `target` of them (at least 3 when lo < hi).
 std::vector<double> NiceTicks(double lo, double hi, int target = 6);
 /// A tick label with just the digits the tick step needs.
 std::string TickLabel(double value, double step);
