@@ -102,7 +102,7 @@ std::string CalibrationPlotSvg(const CalibrateInput& input, const CalibrateJobRe
   std::optional<ErrorPanelData> after;
   if (input.trajectories) {
     const auto errors = ReturnErrorsFromTrajectories(*input.trajectories, corrected, input.recorded, integrator);
-    after = PanelData(fmt::format("After: {} parameters (same runs)", which), errors, s.runs);
+    after = PanelData(fmt::format("After correction: {} parameters (same runs)", which), errors, s.runs);
   }
   // One common scale, so the improvement shows as it is.
   const double half = after ? HalfExtent({&before, &*after}) : HalfExtent({&before});

@@ -130,6 +130,13 @@ std::string FleetPlot(const std::vector<Robot>& robots, const FleetSummary& s, d
 
 int RunSummarize(const SummarizeOptions& o) {
   if (auto e = o.fleet.Check(); !e.empty()) throw InvalidOptions("summarize: " + e);
+  // Output safety: no output may be an input or another output.
+  io::OutputSet& outs = CommandOutputs();
+  RegisterInputs(o.inputs);
+  outs.AddOutput("--json", o.json.path);
+  outs.AddOutput("--csv", o.csv);
+  outs.AddOutput("--report", o.report);
+  outs.Check();
   std::vector<Robot> robots;
   for (const auto& path : o.inputs) {
     auto more = ReadRobots(path);
@@ -194,7 +201,7 @@ int RunSummarize(const SummarizeOptions& o) {
       row += fmt::format(",{},\"{}\"\n", s.robots[i].outlier ? "true" : "false", reasons);
       csv += row;
     }
-    io::WriteFileAtomically(o.csv, csv);
+    outs.Write(o.csv, csv);
     written.push_back(o.csv + " (CSV, one row per robot)");
   }
   if (!o.report.empty()) {
@@ -236,7 +243,7 @@ int RunSummarize(const SummarizeOptions& o) {
     rep.Table({"robot (file)", "wheelbase [m]", "D left [m]", "D right [m]", "outlier", "why"}, rows);
     rep.Figure(FleetPlot(robots, s, o.fleet.threshold),
                "Each robot's robust z-score per quantity; the grey band is the outlier threshold. Triangles: outliers.");
-    io::WriteFileAtomically(o.report, rep.Render());
+    outs.Write(o.report, rep.Render());
     written.push_back(o.report + " (HTML report)");
   }
   o.json.Emit(j);
