@@ -481,7 +481,10 @@ TEST_CASE("umbmark diagnose: contract JSON, report, plot", "[diagnose][cli]") {
   CHECK_THAT(alone["gap"]["p_value"].get<double>(), WithinRel(alone["gap"]["score_p_value"].get<double>(), 1e-12));
   // Usage and input errors.
   CHECK(testing::RunCli("diagnose " + Q(manifest) + " --effects warp").status == 2);
-  CHECK(testing::RunCli("diagnose " + Q(dir / "missing.toml")).status == 2);
+  // A missing input file is bad input (exit 1, naming the file; issue 14), not a usage error.
+  const auto missing = testing::RunCli("diagnose " + Q(dir / "missing.toml"));
+  CHECK(missing.status == 1);
+  CHECK(missing.err.find("missing.toml") != std::string::npos);
 }
 
 TEST_CASE("diagnose: two effects at once (castor kick + time offset) are both named, stepwise", "[diagnose][explanation]") {

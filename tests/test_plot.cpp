@@ -126,7 +126,7 @@ TEST_CASE("a report page is self-contained HTML with the parts a reader needs", 
   CHECK(html.find("<figure class=\"plot\">") != std::string::npos);
 }
 
-TEST_CASE("--report writes one page per command", "[report][cli]") {
+TEST_CASE("each command's --report writes one page", "[report][cli]") {
   const fs::path dir = TempDir("report");
   const auto cal = RunCli("calibrate " + Q(kEx / "calibrate.toml") + " --report " + Q(dir / "cal.html") + " --json " +
                           Q(dir / "cal.json"));
