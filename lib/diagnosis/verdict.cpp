@@ -2,6 +2,7 @@
 #include "diagnosis/verdict.hpp"
 
 #include <algorithm>
+#include <string>
 
 #include <Eigen/Dense>
 #include <fmt/format.h>
@@ -9,6 +10,10 @@
 namespace umbmark::diag {
 
 namespace {
+
+/// "p = 0.0123", or "p < 1e-12" beyond what the tail approximations and
+/// double precision can vouch for.
+std::string P(double p) { return p < 1e-12 ? std::string("p < 1e-12") : fmt::format("p = {:.3g}", p); }
 
 /// Combined p-value of G and the likelihood-ratio tests.
 void Significance(const CandidateFits& fits, double score_p_value, const VerdictOptions& options, Verdict& out) {
@@ -68,9 +73,9 @@ void Decide(const CandidateFits& fits, double score_p_value, double null_quantil
   for (std::size_t i : rank) out.candidates.push_back(fits.candidates[i]);
   const std::string p_text =
       options.likelihood_tests && out.tests > 0
-          ? fmt::format("p = {:.3g}: gap score p = {:.3g}, likelihood-ratio tests p = {:.3g} (Bonferroni over {})",
-                        out.p_value, score_p_value, out.tests_p_value, out.tests)
-          : fmt::format("p = {:.3g}", out.p_value);
+          ? fmt::format("{}: gap score {}, likelihood-ratio tests {} (Bonferroni over {})", P(out.p_value),
+                        P(score_p_value), P(out.tests_p_value), out.tests)
+          : P(out.p_value);
   if (!out.significant) {
     out.verdict = "none";
     out.reason = fmt::format("the gap is not significant ({} >= alpha = {})", p_text, options.alpha);
@@ -84,10 +89,10 @@ void Decide(const CandidateFits& fits, double score_p_value, double null_quantil
     } else if (best && found_alone(*best)) {
       out.verdict = sim::EffectToString(best->effect);
       out.reason = fmt::format(
-          "{} is significant on its own likelihood-ratio test (+{:.1f} nats, p = {:.3g}, {} tests) and gains {:.1f} "
-          "nats on held-out runs; the gap score alone (p = {:.3g}) spreads it over too many statistics to see it, "
+          "{} is significant on its own likelihood-ratio test (+{:.1f} nats, {}, {} tests) and gains {:.1f} "
+          "nats on held-out runs; the gap score alone ({}) spreads it over too many statistics to see it, "
           "and none remains with the effect (G = {:.1f} <= {:.1f})",
-          out.verdict, best->loglik_gain, best->lr_p_value, out.tests, best->heldout_loglik_gain, score_p_value,
+          out.verdict, best->loglik_gain, P(best->lr_p_value), out.tests, best->heldout_loglik_gain, P(score_p_value),
           best->gap_after, null_quantile_alpha);
     } else {
       out.verdict = "unexplained";
