@@ -9,6 +9,7 @@ exe=$1
 src=$2
 out=${3:-$(mktemp -d)}
 mkdir -p "$out"
+out=$(cd "$out" && pwd)   # file:// URLs need an absolute path
 browser=$(command -v chromium || command -v chromium-browser || true)
 if [ -z "$browser" ]; then echo "report_browser_test: chromium not installed"; exit 77; fi
 ex="$src/data/examples"
