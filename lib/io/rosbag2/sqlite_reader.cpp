@@ -53,6 +53,18 @@ SqliteBagFile::SqliteBagFile(std::string path) : path_(std::move(path)) {
     else uri += c;
   }
   uri += immutable ? "?mode=ro&immutable=1" : "?mode=ro";
+  // A constructor that throws runs no destructor, and sqlite3_open_v2 hands
+  // out a handle even when it fails: close it on every throw below.
+  struct CloseOnThrow {
+    sqlite3*& db;
+    bool armed = true;
+    ~CloseOnThrow() {
+      if (armed) {
+        sqlite3_close(db);
+        db = nullptr;
+      }
+    }
+  } close_on_throw{db_};
   if (sqlite3_open_v2(uri.c_str(), &db_, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX | SQLITE_OPEN_URI, nullptr) != SQLITE_OK)
     Fail(fmt::format("cannot open as SQLite3: {}", db_ ? sqlite3_errmsg(db_) : "out of memory"));
   sqlite3_busy_timeout(db_, 0);
@@ -115,6 +127,7 @@ SqliteBagFile::SqliteBagFile(std::string path) : path_(std::move(path)) {
     }
     if (rc != SQLITE_DONE) step_error(rc);
   }
+  close_on_throw.armed = false;
 }
 
 SqliteBagFile::~SqliteBagFile() { sqlite3_close(db_); }
