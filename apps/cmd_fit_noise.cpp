@@ -306,6 +306,9 @@ std::string FitNoiseReportHtml(const std::vector<std::string>& inputs, const Whe
   return rep.Render();
 }
 
+// Long (~165 lines): the command's steps in order (read, systematic errors,
+// fit, gate, print, JSON, --ros2, --plot, --report). Splitting it is
+// listed as follow-up work (issue 11).
 int RunFitNoise(const FitNoiseOptions& o) {
   io::OutputSet& outs = CommandOutputs();
   RegisterInputs(o.inputs, &o.robot);

@@ -126,6 +126,8 @@ MonteCarloErrors StandardErrors(const PoseCovariance& C, std::int64_t n) {
   return e;
 }
 
+// Just over 100 lines: closed form, optional Monte Carlo, gates and output
+// in order; each step is a call, the length is the printing.
 int RunPredict(const PredictOptions& o) {
   RegisterInputs({}, &o.robot);
   CommandOutputs().AddOutput("--json", o.json.path);

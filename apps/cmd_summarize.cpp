@@ -128,6 +128,8 @@ std::string FleetPlot(const std::vector<Robot>& robots, const FleetSummary& s, d
   return io::SvgDocument(880, p.Bottom() + 10, {p.Render()});
 }
 
+// ~120 lines: read the fleet, summarise, then text, CSV, JSON and report in
+// turn. Splitting the outputs into helpers is follow-up work (issue 11).
 int RunSummarize(const SummarizeOptions& o) {
   if (auto e = o.fleet.Check(); !e.empty()) throw InvalidOptions("summarize: " + e);
   // Output safety: no output may be an input or another output.

@@ -214,6 +214,9 @@ Eigen::MatrixXd MeanModel::Jacobian(const ParamVector& p, const std::vector<int>
   return J;
 }
 
+// ~110 lines: one pass over every piece that builds all covariance bases
+// together, since they share the same propagated Jacobians; moving it onto
+// lib/model is follow-up work (issue 11).
 std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanModel& model, const ParamVector& p) {
   std::vector<PieceBases> out(campaign.pieces.size());
   const std::vector<Pose2> motion = model.PredictedPieceMotion(p);

@@ -215,6 +215,9 @@ std::string WheelNoiseFitSummary::BriefReport() const {
                      k_L, k_L_ci[0], k_L_ci[1], k_R, k_R_ci[0], k_R_ci[1], 100 * confidence, runs, groups.size());
 }
 
+// ~150 lines: grouping, the maximum-likelihood fit, both profile-likelihood
+// intervals and the goodness-of-fit table share one set of per-group sums;
+// splitting it into stages is follow-up work (issue 11).
 WheelNoiseFitSummary FitWheelNoise(const std::vector<WheelNoiseFitRun>& runs, const WheelNoiseFitOptions& options) {
   if (auto e = options.Check(); !e.empty()) throw InvalidOptions(e);
   // 1. Check the data can identify the model.
