@@ -6,6 +6,7 @@
 
 #include "core/angles.hpp"
 #include "kinematics/diff_drive.hpp"
+#include "model/true_robot.hpp"
 
 namespace umbmark::diag {
 
@@ -22,16 +23,6 @@ const char* ParamName(int index) {
 }
 
 namespace {
-
-/// Exact constant-curvature step with a heading factor (turn_scrub).
-inline Pose2 Advance(const Pose2& q, double l, double r, double wheelbase, double heading_factor) {
-  const double ds = 0.5 * (l + r);
-  const double dtheta = (r - l) / wheelbase * heading_factor;
-  const double half = 0.5 * dtheta;
-  const double chord = ds * Sinc(half);
-  const double heading = q.theta + half;
-  return {q.x + chord * std::cos(heading), q.y + chord * std::sin(heading), q.theta + dtheta};
-}
 
 /// Mean of poses[lo..hi] over the samples with use(i): positions averaged,
 /// headings averaged as increments from the first one (no wrap-around).
@@ -60,13 +51,15 @@ inline Pose2 Relative(const Pose2& a, const Pose2& b) {
   return {c * dx + s * dy, -s * dx + c * dy, b.theta - a.theta};
 }
 
+/// The true robot of `p` (model/true_robot.hpp: c_L, c_R of E_d) plus the
+/// diagnosis' effects on wheel travel and heading.
 struct TrueFactors {
   double c_L, c_R, scale, back, wheelbase, scrub;
 };
 
 TrueFactors Factors(const ParamVector& p, double wheelbase) {
   const double E_d = p[kParamEd];
-  return {2.0 / (E_d + 1.0), 2.0 * E_d / (E_d + 1.0), 1.0 + p[kParamScale], 1.0 + p[kParamAsym],
+  return {CorrectionLeft(E_d), CorrectionRight(E_d), 1.0 + p[kParamScale], 1.0 + p[kParamAsym],
           p[kParamEb] * wheelbase, 1.0 - p[kParamScrub]};
 }
 
@@ -111,17 +104,17 @@ Pose2 AdvanceInterval(const DiagRun& r, std::size_t i, const TrueFactors& f, dou
     const double fa = j.time_fraction;
     const double ua = fa > 0.0 ? std::min(1.0, u / fa) : 1.0;
     TrueTravel(f, drift, ua * j.left_m, ua * j.right_m, l, rr);
-    q = Advance(q, l, rr, f.wheelbase, HeadingFactor(f, j.class_a));
+    q = TrueStep(q, l, rr, f.wheelbase, HeadingFactor(f, j.class_a));
     if (u <= fa) return q;
     const double ub = fa < 1.0 ? std::min(1.0, (u - fa) / (1.0 - fa)) : 1.0;
     TrueTravel(f, drift, ub * (dl - j.left_m), ub * (dr - j.right_m), l, rr);
-    return Advance(q, l, rr, f.wheelbase, HeadingFactor(f, j.class_b));
+    return TrueStep(q, l, rr, f.wheelbase, HeadingFactor(f, j.class_b));
   }
   if (r.kick[i] != 0) q.theta += kappa * r.kick[i];
   const double w0 = r.window_start[i], w1 = r.window_end[i];
   const double frac = u >= 1.0 ? 1.0 : u <= w0 || w1 <= w0 ? 0.0 : std::min(1.0, (u - w0) / (w1 - w0));
   TrueTravel(f, drift, frac * dl, frac * dr, l, rr);
-  return Advance(q, l, rr, f.wheelbase, HeadingFactor(f, r.interval_class[i]));
+  return TrueStep(q, l, rr, f.wheelbase, HeadingFactor(f, r.interval_class[i]));
 }
 
 }  // namespace
@@ -214,115 +207,175 @@ Eigen::MatrixXd MeanModel::Jacobian(const ParamVector& p, const std::vector<int>
   return J;
 }
 
-// ~110 lines: one pass over every piece that builds all covariance bases
-// together, since they share the same propagated Jacobians; moving it onto
-// lib/model is follow-up work (issue 11).
+namespace {
+
+/// One encoder interval of a piece as an exact arc from `q` (local frame of
+/// the piece start): true wheel travel l, r [m] and the heading's
+/// wheelbase b (E_b b, divided by 1 - k in spot turns).
+struct ArcStep {
+  Pose2 next;
+  /// d(next position, heading) / d(l, r): the wheel-noise lever G_u.
+  Eigen::Matrix<double, 3, 2> G;
+};
+
+ArcStep StepWithJacobian(const Pose2& q, double l, double rr, double b) {
+  const double ds = 0.5 * (l + rr), dtheta = (rr - l) / b, h = 0.5 * dtheta;
+  const double sinc = Sinc(h);
+  // d sinc / d h, stable near 0 (-h/3 + h^3/30).
+  const double dsinc = std::abs(h) < 1e-4 ? -h / 3.0 + h * h * h / 30.0 : (h * std::cos(h) - std::sin(h)) / (h * h);
+  const double chord = ds * sinc;
+  const double hd = q.theta + h, ch = std::cos(hd), sh = std::sin(hd);
+  // d(chord)/dl, d(chord)/dr and d(heading)/dl, dr (heading = theta + h).
+  const double dchord_dl = 0.5 * sinc - ds * dsinc / (2.0 * b);
+  const double dchord_dr = 0.5 * sinc + ds * dsinc / (2.0 * b);
+  const double dh_dl = -1.0 / (2.0 * b), dh_dr = 1.0 / (2.0 * b);
+  ArcStep out;
+  out.G << dchord_dl * ch - chord * sh * dh_dl, dchord_dr * ch - chord * sh * dh_dr,  //
+      dchord_dl * sh + chord * ch * dh_dl, dchord_dr * sh + chord * ch * dh_dr,      //
+      -1.0 / b, 1.0 / b;
+  out.next = TrueStep(q, l, rr, b, 1.0);
+  return out;
+}
+
+/// Kelly's recursion over a piece's intervals (see model.hpp): the wheel
+/// noise bases and the quantisation levers at the piece's first and last
+/// moving interval.
+struct PiecePropagation {
+  Eigen::Matrix3d P_L = Eigen::Matrix3d::Zero(), P_R = Eigen::Matrix3d::Zero(), P_LR = Eigen::Matrix3d::Zero();
+  Eigen::Matrix<double, 3, 2> M_start = Eigen::Matrix<double, 3, 2>::Zero();  ///< first moving G, carried to the end
+  Eigen::Matrix<double, 3, 2> G_last = Eigen::Matrix<double, 3, 2>::Zero();   ///< last moving G
+  bool moved = false;
+  double travel_left_m = 0.0, travel_right_m = 0.0;
+};
+
+/// Wheel geometry of the bases at `p`: heading (r - l) / b, with b divided
+/// by 1 - k in spot turns (turn_scrub scales the wheel noise's heading
+/// effect there too).
+struct BasesGeometry {
+  double b_plain, b_turn, c_L, c_R;
+};
+
+BasesGeometry Geometry(const CampaignData& campaign, const ParamVector& p) {
+  const double b_plain = campaign.robot.wheelbase_m * p[kParamEb];
+  return {b_plain, b_plain / (1.0 - p[kParamScrub]), CorrectionLeft(p[kParamEd]), CorrectionRight(p[kParamEd])};
+}
+
+PiecePropagation Propagate(const DiagRun& r, const Piece& pc, const BasesGeometry& g) {
+  PiecePropagation out;
+  Pose2 q;  // local frame of the piece start
+  for (std::size_t i = pc.a; i < pc.b; ++i) {
+    const double b = r.interval_class[i] == static_cast<signed char>(sim::MotionClass::kTurn) ? g.b_turn : g.b_plain;
+    const double l = (r.left[i + 1] - r.left[i]) * g.c_L, rr = (r.right[i + 1] - r.right[i]) * g.c_R;
+    const ArcStep step = StepWithJacobian(q, l, rr, b);
+    const Eigen::Matrix<double, 3, 2>& G = step.G;
+    Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+    F(0, 2) = -(step.next.y - q.y);
+    F(1, 2) = step.next.x - q.x;
+    const double al = std::abs(l), ar = std::abs(rr);
+    out.P_L = F * out.P_L * F.transpose() + al * G.col(0) * G.col(0).transpose();
+    out.P_R = F * out.P_R * F.transpose() + ar * G.col(1) * G.col(1).transpose();
+    out.P_LR = F * out.P_LR * F.transpose() +
+               std::sqrt(al * ar) * (G.col(0) * G.col(1).transpose() + G.col(1) * G.col(0).transpose());
+    out.M_start = F * out.M_start;
+    if (al + ar > 0.0) {
+      if (!out.moved) {
+        out.M_start = G;
+        out.moved = true;
+      }
+      out.G_last = G;
+    }
+    out.travel_left_m += al;
+    out.travel_right_m += ar;
+    q = step.next;
+  }
+  return out;
+}
+
+/// Encoder quantisation (Q and its levers) and the start / stop slip basis
+/// F of a piece that moved on a logged run.
+void QuantisationAndSlip(const DiagRun& r, const Piece& pc, const PiecePropagation& pp, PieceBases& B) {
+  if (!pp.moved || r.endpoint) return;
+  B.quant_start = pp.M_start;
+  B.quant_end = pp.G_last;
+  // A wheel that did not turn in the piece has the same count error at
+  // both ends: it cancels.
+  const double va[2] = {std::pow(r.q_sd_left[pc.a], 2), std::pow(r.q_sd_right[pc.a], 2)};
+  const double vb[2] = {std::pow(r.q_sd_left[pc.b], 2), std::pow(r.q_sd_right[pc.b], 2)};
+  const bool turned[2] = {B.travel_left_m > 0.0, B.travel_right_m > 0.0};
+  for (int w = 0; w < 2; ++w) {
+    if (!turned[w]) continue;
+    B.Q += va[w] * pp.M_start.col(w) * pp.M_start.col(w).transpose() +
+           vb[w] * pp.G_last.col(w) * pp.G_last.col(w).transpose();
+  }
+  if (pc.starts_from_standstill) B.F += 0.5 * pp.M_start * pp.M_start.transpose();
+  if (pc.ends_at_standstill) B.F += 0.5 * pp.G_last * pp.G_last.transpose();
+}
+
+/// run_time_offset's levers: d eps / d tau on either side of p's tau. The
+/// pose is not smooth in time where a motion starts or stops (a lag shows
+/// the motion, a lead the standstill), so with tau_i symmetric about 0 the
+/// second moment is tau_sd^2 (J+ J+^T + J- J-^T) / 2.
+class TimeOffsetLevers {
+ public:
+  TimeOffsetLevers(const MeanModel& model, const ParamVector& p) {
+    model.Residuals(p, eps0_);
+    ParamVector pt = p;
+    pt[kParamTau] = p[kParamTau] + kStep;
+    model.Residuals(pt, plus_);
+    pt[kParamTau] = p[kParamTau] - kStep;
+    model.Residuals(pt, minus_);
+  }
+
+  /// T of piece j (zero when a difference is not finite).
+  Eigen::Matrix3d Basis(std::size_t j) const {
+    Eigen::Vector3d jp, jm;
+    for (int k = 0; k < 3; ++k) {
+      jp[k] = (plus_[3 * j + k] - eps0_[3 * j + k]) / kStep;
+      jm[k] = (eps0_[3 * j + k] - minus_[3 * j + k]) / kStep;
+    }
+    if (jp.allFinite() && jm.allFinite()) return 0.5 * (jp * jp.transpose() + jm * jm.transpose());
+    return Eigen::Matrix3d::Zero();
+  }
+
+ private:
+  static constexpr double kStep = 1e-3;  // s
+  std::vector<double> eps0_, plus_, minus_;
+};
+
+/// Ground-truth noise at both ends of a piece with predicted motion `motion`,
+/// each end averaged over its samples.
+void GroundTruthBases(const Piece& pc, const Pose2& motion, PieceBases& B) {
+  const double wa = pc.a_weight, wb = pc.b_weight;
+  B.G_xy = Eigen::Vector3d(wa + wb, wa + wb, 0.0).asDiagonal();
+  const Eigen::Vector3d jv(motion.y, -motion.x, -1.0);
+  B.G_theta = wa * jv * jv.transpose();
+  B.G_theta(2, 2) += wb;
+}
+
+}  // namespace
+
 std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanModel& model, const ParamVector& p) {
   std::vector<PieceBases> out(campaign.pieces.size());
   const std::vector<Pose2> motion = model.PredictedPieceMotion(p);
-  // Heading of an interval: (r - l) / b, times (1 - k) in spot turns
-  // (turn_scrub scales the wheel noise's heading effect there too).
-  const double b_plain = campaign.robot.wheelbase_m * p[kParamEb];
-  const double b_turn = b_plain / (1.0 - p[kParamScrub]);
-  const double E_d = p[kParamEd];
-  const double c_L = 2.0 / (E_d + 1.0), c_R = 2.0 * E_d / (E_d + 1.0);
-  // run_time_offset's levers: d eps / d tau on either side of p's tau. The
-  // pose is not smooth in time where a motion starts or stops (a lag shows
-  // the motion, a lead the standstill), so with tau_i symmetric about 0 the
-  // second moment is tau_sd^2 (J+ J+^T + J- J-^T) / 2.
-  constexpr double kTauStep = 1e-3;  // s
-  std::vector<double> eps0, eps_plus, eps_minus;
-  model.Residuals(p, eps0);
-  ParamVector pt = p;
-  pt[kParamTau] = p[kParamTau] + kTauStep;
-  model.Residuals(pt, eps_plus);
-  pt[kParamTau] = p[kParamTau] - kTauStep;
-  model.Residuals(pt, eps_minus);
+  const BasesGeometry geometry = Geometry(campaign, p);
+  const TimeOffsetLevers tau(model, p);
   for (std::size_t j = 0; j < campaign.pieces.size(); ++j) {
     const Piece& pc = campaign.pieces[j];
     const DiagRun& r = campaign.runs[pc.run];
     PieceBases& B = out[j];
-    Pose2 q;  // local frame of the piece start
-    Eigen::Matrix3d P_L = Eigen::Matrix3d::Zero(), P_R = P_L, P_LR = P_L;
-    Eigen::Matrix<double, 3, 2> M_start = Eigen::Matrix<double, 3, 2>::Zero();
-    bool first_moving = true;
-    Eigen::Matrix<double, 3, 2> G_last = Eigen::Matrix<double, 3, 2>::Zero();
-    for (std::size_t i = pc.a; i < pc.b; ++i) {
-      const double b = r.interval_class[i] == static_cast<signed char>(sim::MotionClass::kTurn) ? b_turn : b_plain;
-      const double l = (r.left[i + 1] - r.left[i]) * c_L, rr = (r.right[i + 1] - r.right[i]) * c_R;
-      const double ds = 0.5 * (l + rr), dtheta = (rr - l) / b, h = 0.5 * dtheta;
-      const double sinc = Sinc(h);
-      // d sinc / d h, stable near 0 (-h/3 + h^3/30).
-      const double dsinc = std::abs(h) < 1e-4 ? -h / 3.0 + h * h * h / 30.0 : (h * std::cos(h) - std::sin(h)) / (h * h);
-      const double chord = ds * sinc;
-      const double hd = q.theta + h, ch = std::cos(hd), sh = std::sin(hd);
-      // d(chord)/dl, d(chord)/dr and d(heading)/dl, dr (heading = theta + h).
-      const double dchord_dl = 0.5 * sinc - ds * dsinc / (2.0 * b);
-      const double dchord_dr = 0.5 * sinc + ds * dsinc / (2.0 * b);
-      const double dh_dl = -1.0 / (2.0 * b), dh_dr = 1.0 / (2.0 * b);
-      Eigen::Matrix<double, 3, 2> G;
-      G << dchord_dl * ch - chord * sh * dh_dl, dchord_dr * ch - chord * sh * dh_dr,  //
-          dchord_dl * sh + chord * ch * dh_dl, dchord_dr * sh + chord * ch * dh_dr,   //
-          -1.0 / b, 1.0 / b;
-      const Pose2 next = {q.x + chord * ch, q.y + chord * sh, q.theta + dtheta};
-      Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
-      F(0, 2) = -(next.y - q.y);
-      F(1, 2) = next.x - q.x;
-      const double al = std::abs(l), ar = std::abs(rr);
-      P_L = F * P_L * F.transpose() + al * G.col(0) * G.col(0).transpose();
-      P_R = F * P_R * F.transpose() + ar * G.col(1) * G.col(1).transpose();
-      P_LR = F * P_LR * F.transpose() +
-             std::sqrt(al * ar) * (G.col(0) * G.col(1).transpose() + G.col(1) * G.col(0).transpose());
-      M_start = F * M_start;
-      if (al + ar > 0.0) {
-        if (first_moving) {
-          M_start = G;
-          first_moving = false;
-        }
-        G_last = G;
-      }
-      B.travel_left_m += al;
-      B.travel_right_m += ar;
-      q = next;
-    }
-    Eigen::Matrix3d P_Q = Eigen::Matrix3d::Zero();
-    if (!first_moving && !r.endpoint) {
-      B.quant_start = M_start;
-      B.quant_end = G_last;
-      // A wheel that did not turn in the piece has the same count error at
-      // both ends: it cancels.
-      const double va[2] = {std::pow(r.q_sd_left[pc.a], 2), std::pow(r.q_sd_right[pc.a], 2)};
-      const double vb[2] = {std::pow(r.q_sd_left[pc.b], 2), std::pow(r.q_sd_right[pc.b], 2)};
-      const bool turned[2] = {B.travel_left_m > 0.0, B.travel_right_m > 0.0};
-      for (int w = 0; w < 2; ++w) {
-        if (!turned[w]) continue;
-        P_Q += va[w] * M_start.col(w) * M_start.col(w).transpose() + vb[w] * G_last.col(w) * G_last.col(w).transpose();
-      }
-    }
-    B.A_L = P_L;
-    B.A_R = P_R;
-    B.A_LR = P_LR;
-    B.Q = P_Q;
-    if (!first_moving && !r.endpoint) {
-      if (pc.starts_from_standstill) B.F += 0.5 * M_start * M_start.transpose();
-      if (pc.ends_at_standstill) B.F += 0.5 * G_last * G_last.transpose();
-    }
+    const PiecePropagation pp = Propagate(r, pc, geometry);
+    B.A_L = pp.P_L;
+    B.A_R = pp.P_R;
+    B.A_LR = pp.P_LR;
+    B.travel_left_m = pp.travel_left_m;
+    B.travel_right_m = pp.travel_right_m;
+    QuantisationAndSlip(r, pc, pp, B);
     if (pc.ends_at_standstill) {
       B.S_xy = Eigen::Vector3d(1.0, 1.0, 0.0).asDiagonal();
       B.S_theta(2, 2) = 1.0;
     }
-    Eigen::Vector3d jp, jm;
-    for (int k = 0; k < 3; ++k) {
-      jp[k] = (eps_plus[3 * j + k] - eps0[3 * j + k]) / kTauStep;
-      jm[k] = (eps0[3 * j + k] - eps_minus[3 * j + k]) / kTauStep;
-    }
-    if (jp.allFinite() && jm.allFinite()) B.T = 0.5 * (jp * jp.transpose() + jm * jm.transpose());
-    // Ground-truth noise at both ends, each averaged over its samples.
-    const double wa = pc.a_weight, wb = pc.b_weight;
-    B.G_xy = Eigen::Vector3d(wa + wb, wa + wb, 0.0).asDiagonal();
-    const Eigen::Vector3d jv(motion[j].y, -motion[j].x, -1.0);
-    B.G_theta = wa * jv * jv.transpose();
-    B.G_theta(2, 2) += wb;
+    B.T = tau.Basis(j);
+    GroundTruthBases(pc, motion[j], B);
   }
   return out;
 }
