@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
@@ -12,6 +11,7 @@
 
 #include "diagnosis/mean_fit.hpp"
 #include "core/parallel_for.hpp"
+#include "stats/distributions.hpp"
 
 namespace umbmark::diag {
 
@@ -81,15 +81,6 @@ double Gap(double score, double null_median) { return std::max(0.0, score - null
 double Shrink(double after, double before) { return before > 0.0 ? std::max(-1.0, 1.0 - after / before) : 0.0; }
 
 namespace {
-
-/// Upper tail of chi^2 with 1 or 2 degrees of freedom (the candidates have
-/// at most two parameters).
-double ChiSquareSurvival(double x, int df) {
-  if (!(x > 0.0)) return 1.0;
-  if (df == 1) return std::erfc(std::sqrt(0.5 * x));
-  if (df == 2) return std::exp(-0.5 * x);
-  throw std::logic_error("ChiSquareSurvival: df must be 1 or 2");
-}
 
 /// Everything the candidate fits share.
 struct Shared {

@@ -8,6 +8,8 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
 
+#include "stats/distributions.hpp"
+
 namespace umbmark::diag {
 
 const char* StatKindToString(StatKind k) {
@@ -26,42 +28,6 @@ const char* ComponentName(int c) {
   return c >= 0 && c < 3 ? names[c] : "?";
 }
 
-double NormalCdf(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
-
-double NormalInverse(double p) {
-  // Acklam's rational approximation (relative error 1.15e-9) refined by one
-  // Halley step on erfc, which brings it to full double precision.
-  if (!(p > 0.0)) return -38.0;
-  if (!(p < 1.0)) return 38.0;
-  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02,
-                             1.383577518672690e+02,  -3.066479806614716e+01, 2.506628277459239e+00};
-  static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
-                             6.680131188771972e+01,  -1.328068155288572e+01};
-  static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
-                             -2.549732539343734e+00, 4.374664141464968e+00,  2.938163982698783e+00};
-  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
-                             3.754408661907416e+00};
-  const double plow = 0.02425;
-  double x;
-  if (p < plow) {
-    const double q = std::sqrt(-2.0 * std::log(p));
-    x = (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
-        ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
-  } else if (p <= 1.0 - plow) {
-    const double q = p - 0.5, r = q * q;
-    x = (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
-        (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0);
-  } else {
-    const double q = std::sqrt(-2.0 * std::log(1.0 - p));
-    x = -(((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
-        ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
-  }
-  const double e = NormalCdf(x) - p;
-  const double u = e * std::sqrt(2.0 * M_PI) * std::exp(x * x / 2.0);
-  x = x - u / (1.0 + x * u / 2.0);
-  return std::clamp(x, -38.0, 38.0);
-}
-
 namespace {
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
@@ -75,19 +41,12 @@ Eigen::Matrix3d Permute(const Eigen::Matrix3d& C) {
   return P;
 }
 
-/// log P(X >= k) for X ~ Binomial(n, p).
-double BinomialUpperTail(int n, int k, double p) {
-  if (k <= 0) return 1.0;
-  if (k > n) return 0.0;
-  const double lp = std::log(p), lq = std::log1p(-p);
-  double sum = 0.0;
-  for (int i = k; i <= n && i < k + 200; ++i) {
-    const double lt = std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) + i * lp + (n - i) * lq;
-    const double t = std::exp(lt);
-    sum += t;
-    if (t < 1e-18 * sum) break;
-  }
-  return std::min(1.0, sum);
+/// Standard normal quantile as a score: clamped to |z| <= 38 (p = 0 or 1,
+/// or a tail below the smallest double, gives -38 or 38).
+double ScoreQuantile(double p) {
+  if (!(p > 0.0)) return -38.0;
+  if (!(p < 1.0)) return 38.0;
+  return std::clamp(NormalQuantile(p), -38.0, 38.0);
 }
 
 }  // namespace
@@ -127,7 +86,7 @@ std::vector<Scores> PieceScores(const std::vector<double>& eps, const std::vecto
       // Smaller tail for precision: z = -Phi^-1(P(W beyond |w|, same side)).
       double tail = 0.0;
       for (int k = 0; k < m.components; ++k) tail += m.weight[k] * NormalCdf(-std::abs(w[c]) / sd[k][c]);
-      const double z = -NormalInverse(std::max(tail, 1e-300));
+      const double z = -ScoreQuantile(std::max(tail, 1e-300));
       out[j][c] = w[c] >= 0.0 ? z : -z;
     }
   }
@@ -199,8 +158,8 @@ GapSummary ComputeGap(const CampaignData& campaign, const std::vector<Scores>& s
       if (n < options.min_pieces) continue;
       add(subset, StatKind::kMean, c, -1, a.sum[c] / std::sqrt(n), n);
       add(subset, StatKind::kVariance, c, -1, (a.sq[c] / n - 1.0) / std::sqrt(2.0 / n), n);
-      const double tail = BinomialUpperTail(n, a.tail[c], p_tail);
-      add(subset, StatKind::kTail, c, -1, tail < 0.5 ? -NormalInverse(tail) : 0.0, n);
+      const double tail = BinomialUpperTail(a.tail[c], n, p_tail);
+      add(subset, StatKind::kTail, c, -1, tail < 0.5 ? -ScoreQuantile(tail) : 0.0, n);
       // Trend over runs: weighted least squares of the run means on the run index.
       double W = 0.0, Wi = 0.0, Wm = 0.0;
       int runs = 0;

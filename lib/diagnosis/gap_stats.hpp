@@ -77,8 +77,4 @@ struct GapOptions {
 GapSummary ComputeGap(const CampaignData& campaign, const std::vector<Scores>& scores, const GapOptions& options,
                       const std::vector<char>* use = nullptr);
 
-/// Standard normal CDF and its inverse (clamped to |z| <= 38).
-double NormalCdf(double z);
-double NormalInverse(double p);
-
 }  // namespace umbmark::diag
