@@ -2,14 +2,143 @@
 #include "diagnose_report.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <fmt/format.h>
 
+#include "diagnosis/advice.hpp"
 #include "io/html_report.hpp"
 #include "io/svg_plot.hpp"
 
 namespace umbmark::cli {
+
+namespace {
+
+/// One component of one piece's standardised residual (JSON piece_residuals).
+struct PieceMark {
+  int experiment = 0;  ///< 1-based
+  std::string run, type;
+  double travel_start_m = 0.0;
+  int component = 0;  ///< 0 x, 1 y, 2 theta
+  double z = 0.0;
+};
+
+constexpr const char* kComponentNames[3] = {"x (along)", "y (lateral)", "theta"};
+
+/// The `n` largest |z| over every piece and component, largest first.
+std::vector<PieceMark> TopPieceResiduals(const nlohmann::json& j, std::size_t n) {
+  std::vector<PieceMark> all;
+  if (!j.contains("piece_residuals")) return all;
+  for (const auto& p : j["piece_residuals"].value("pieces", nlohmann::json::array())) {
+    const auto& z = p.at("z");
+    for (int k = 0; k < 3; ++k) {
+      if (!z[k].is_number()) continue;
+      all.push_back({p.value("experiment", 0), p.value("run", ""), p.value("type", ""), p.value("travel_start_m", 0.0), k,
+                     z[k].get<double>()});
+    }
+  }
+  const std::size_t m = std::min(n, all.size());
+  std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(m), all.end(),
+                    [](const PieceMark& a, const PieceMark& b) { return std::abs(a.z) > std::abs(b.z); });
+  all.resize(m);
+  return all;
+}
+
+constexpr std::size_t kTopPieces = 8;
+
+// One panel per experiment: every piece's standardised residual (x, y,
+// theta) at its place along the experiment's runs laid end to end, against
+// the band +-1.96 that holds 95 % of them when the baseline is right; the
+// kTopPieces largest of the campaign ringed and numbered (listed in the
+// report's table). Values beyond the axis limit (10 SE at most, so the band
+// stays readable) are drawn at the edge and said so. Returns the bottom.
+double ResidualPanels(const nlohmann::json& j, double top, std::vector<std::string>& parts) {
+  if (!j.contains("piece_residuals")) return top;
+  const auto& pieces = j["piece_residuals"].value("pieces", nlohmann::json::array());
+  const auto labels = j.value("experiments", nlohmann::json::array());
+  const auto ranked = TopPieceResiduals(j, kTopPieces);
+  int experiments = 0;
+  for (const auto& p : pieces) experiments = std::max(experiments, p.value("experiment", 0));
+  for (int e = 1; e <= experiments; ++e) {
+    std::array<std::vector<io::SvgPoint>, 3> comp;
+    std::vector<io::SvgPoint> clipped, marks;
+    std::vector<double> run_starts;
+    std::vector<std::pair<io::SvgPoint, int>> mark_labels;
+    double offset = 0.0, run_end = 0.0, zmax = 0.0;
+    std::string run;
+    int total = 0, outside = 0;
+    for (const auto& p : pieces) {
+      if (p.value("experiment", 0) != e) continue;
+      const std::string id = p.value("run", "");
+      if (id != run) {
+        if (!run.empty()) { offset = run_end; run_starts.push_back(offset); }
+        run = id;
+      }
+      const double start = p.value("travel_start_m", 0.0), len = p.value("travel_m", 0.0);
+      run_end = std::max(run_end, offset + start + len);
+      const auto& z = p.at("z");
+      for (int k = 0; k < 3; ++k) {
+        if (!z[k].is_number()) continue;
+        const double v = z[k].get<double>();
+        ++total;
+        outside += std::abs(v) > 1.96 ? 1 : 0;
+        zmax = std::max(zmax, std::abs(v));
+        comp[k].push_back({offset + start + 0.5 * len, v});
+        for (std::size_t r = 0; r < ranked.size(); ++r)
+          if (ranked[r].experiment == e && ranked[r].run == id && ranked[r].travel_start_m == start &&
+              ranked[r].component == k && ranked[r].z == v)
+            mark_labels.push_back({comp[k].back(), static_cast<int>(r + 1)});
+      }
+    }
+    if (total == 0) continue;
+    const double limit = std::clamp(1.1 * zmax, 4.0, 10.0);
+    for (auto& c : comp)
+      for (auto& pt : c)
+        if (std::abs(pt.y) > limit) {
+          pt.y = std::copysign(limit, pt.y);
+          clipped.push_back(pt);
+        }
+    for (auto& [pt, r] : mark_labels) {
+      pt.y = std::clamp(pt.y, -limit, limit);
+      marks.push_back(pt);
+    }
+    const std::string label =
+        e - 1 < static_cast<int>(labels.size()) ? labels[e - 1].get<std::string>() : fmt::format("{}", e);
+    io::SvgPanel p(90, top + 24, 760, 220, fmt::format("Experiment {}: residual of every piece", label));
+    const double right = std::max(run_end, 1e-3);
+    p.SetExtent(-0.02 * right, 1.02 * right, -limit * 1.05, limit * 1.05, false);
+    p.Band({{-0.02 * right, -1.96}, {1.02 * right, -1.96}}, {{-0.02 * right, 1.96}, {1.02 * right, 1.96}}, "#777", 0.22);
+    p.Axes("travel along the experiment's runs, end to end [m] (file order; dotted: a run starts)",
+           "residual [standard errors]");
+    const io::SvgStyle run_line{"#999", "", "2,3", 0.8, false};
+    for (double x : run_starts) p.VLine(x, run_line);
+    const io::SvgStyle styles[3] = {{"#1f5fa8", "circle", "", 1.5, false},
+                                    {"#c0601a", "square", "", 1.5, false},
+                                    {"#222222", "triangle", "", 1.5, true}};
+    for (int k = 0; k < 3; ++k) p.Points(comp[k], styles[k], 2.6, kComponentNames[k]);
+    const io::SvgStyle mark_style{"#b02020", "circle", "", 1.5, false};
+    p.Points(marks, mark_style, 8.0, "largest");
+    for (const auto& [pt, r] : mark_labels) p.Text({pt.x, pt.y}, fmt::format("  {}", r), "#b02020", 12);
+    std::vector<std::pair<io::SvgStyle, std::string>> legend = {
+        {{"#777", "square", "", 1.5, true},
+         fmt::format("95% band of the baseline (|z| <= 1.96): {:.1f}% of the values lie outside (5% expected)",
+                     100.0 * outside / total)},
+        {styles[0], "x: along the piece's start heading"},
+        {styles[1], "y: lateral (to the left)"},
+        {styles[2], "theta: heading"},
+        {mark_style, fmt::format("the {} largest of the campaign (numbered as in the table)", ranked.size())}};
+    if (!clipped.empty())
+      legend.push_back({{"#999", "", "", 0.0, false},
+                        fmt::format("{} value(s) beyond +-{:.0f} drawn at the edge", clipped.size(), limit)});
+    p.Legend(legend);
+    parts.push_back(p.Render());
+    top = p.Bottom() + 16;
+  }
+  return top;
+}
+
+}  // namespace
 
 // Plots of a diagnosis, from its JSON (so they follow whatever the diagnosis
 // provides): the standardised size of each located discrepancy against the
@@ -19,10 +148,10 @@ namespace umbmark::cli {
 // they are added.
 std::string DiagnosePlotsSvg(const nlohmann::json& j) {
   std::vector<std::string> parts;
-  double bottom = 20;
+  double bottom = ResidualPanels(j, 0, parts) + 20;
   const auto& where = j.at("gap").value("where", nlohmann::json::array());
   if (!where.empty()) {
-    io::SvgPanel p(90, 40, 760, 300, "Where the runs leave the model: standardised discrepancies");
+    io::SvgPanel p(90, bottom + 20, 760, 300, "Which statistics leave the model: ranked discrepancies (per subset of pieces)");
     std::vector<io::SvgPoint> in_band, out_band;
     double zmax = 3.0;
     std::vector<std::string> labels;
@@ -86,58 +215,166 @@ std::string DiagnosePlotsSvg(const nlohmann::json& j) {
   return io::SvgDocument(900, bottom + 10, parts);
 }
 
+namespace {
+
+double Number(const nlohmann::json& j, const char* key) {
+  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : NAN;
+}
+
+/// "p = 0.0031" or "p < 1e-12".
+std::string PText(double p) {
+  const std::string v = diag::FormatPValue(p);
+  return v.rfind("<", 0) == 0 ? "p " + v : "p = " + v;
+}
+
+/// Fitted parameters with units (and standard errors when given).
+std::string ParamsText(const nlohmann::json& params, const nlohmann::json& se) {
+  std::string out;
+  for (const auto& [k, val] : params.items()) {
+    if (!val.is_number()) continue;
+    const double e = se.contains(k) && se[k].is_number() ? se[k].get<double>() : NAN;
+    out += (out.empty() ? "" : ", ") + diag::FormatEffectParam(k, val.get<double>(), e);
+  }
+  return out;
+}
+
+std::string Percent(double v) {
+  if (!std::isfinite(v)) return "-";
+  const double pct = std::round(100.0 * v);
+  return fmt::format("{:.0f}%", pct == 0.0 ? 0.0 : pct);  // no "-0%"
+}
+
+/// The baseline's numbers with units.
+void BaselineTable(io::HtmlReport& rep, const nlohmann::json& b) {
+  rep.Heading("Baseline model (fitted to these runs)");
+  rep.Table({"parameter", "value"},
+            {{"E_d (wheel diameter ratio)", fmt::format("{:.6f}", Number(b, "E_d"))},
+             {"E_b (wheelbase factor)", fmt::format("{:.6f}", Number(b, "E_b"))},
+             {"k_L, k_R (wheel noise)", fmt::format("{:.3g}, {:.3g} m^1/2 ({:.2f}, {:.2f} mm after 1 m)", Number(b, "k_L"),
+                                                    Number(b, "k_R"), 1e3 * Number(b, "k_L"), 1e3 * Number(b, "k_R"))},
+             {fmt::format("ground truth noise ({})", b.value("ground_truth_noise_estimated", false) ? "estimated" : "as stated"),
+              fmt::format("{:.3g} mm, {:.3g} mrad", 1e3 * Number(b, "sigma_xy_m"), 1e3 * Number(b, "sigma_theta_rad"))},
+             {"runs, pieces compared", fmt::format("{}, {}", b.value("runs", 0), b.value("pieces", 0))}});
+}
+
+/// Candidate effects: parameters with units, shrink, evidence in words,
+/// and the impossible fits flagged as symptoms.
+void CandidateTable(io::HtmlReport& rep, const nlohmann::json& j) {
+  rep.Heading("Candidate effects (best first)");
+  rep.Paragraph("Each effect is fitted on top of the baseline. Shrink: the fraction of the gap it closes (1 = gap gone); "
+                "held-out: measured on runs not used to fit it, which is what to trust. Evidence: held-out "
+                "log-likelihood gain minus a penalty per parameter, graded on Kass & Raftery's scale for Bayes factors (none, weak, positive, strong, very strong). "
+                "LR p: likelihood-ratio test against the baseline.");
+  std::vector<std::vector<std::string>> rows;
+  std::vector<std::string> symptoms;
+  for (const auto& c : j.value("candidates", nlohmann::json::array())) {
+    const double gain = Number(c, "heldout_loglik_gain_nats"), ev = Number(c, "evidence_nats");
+    const std::string words = diag::EvidenceInWords(gain, ev, Number(c, "heldout_shrink"));
+    const std::string unphysical = c.value("unphysical", "");
+    const std::string effect = c.value("effect", "?");
+    if (!unphysical.empty()) symptoms.push_back(effect + ": " + unphysical);
+    rows.push_back({effect, ParamsText(c.value("params", nlohmann::json::object()), c.value("params_se", nlohmann::json::object())),
+                    Percent(Number(c, "heldout_shrink")), Percent(Number(c, "shrink")),
+                    words.substr(0, words.find(':')) + (std::isfinite(ev) ? fmt::format(" ({:+.1f} nats)", ev) : ""),
+                    c.contains("lr_p_value") && c["lr_p_value"].is_number() ? diag::FormatPValue(c["lr_p_value"].get<double>())
+                                                                           : std::string("-"),
+                    unphysical.empty() ? std::string("plausible") : "IMPOSSIBLE: a symptom"});
+  }
+  rep.Table({"effect", "fitted parameters", "held-out shrink", "shrink", "evidence", "LR p", "physically"}, rows, 2);
+  if (!symptoms.empty()) {
+    rep.Heading("Impossible fits: symptoms, not causes");
+    rep.Paragraph("These effects fitted values no robot can have. The effect is not the cause: it bent itself to imitate "
+                  "something else in the runs, so the gap is something else.");
+    rep.Warnings(symptoms);
+  }
+}
+
+/// The stepwise explanation: cumulative shrink and size per step.
+void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
+  const auto& ex = j.value("explanation", nlohmann::json::array());
+  if (ex.empty()) return;
+  rep.Heading("The explanation: effects added one at a time, fitted jointly");
+  std::vector<std::vector<std::string>> rows;
+  int k = 0;
+  for (const auto& e : ex)
+    rows.push_back({fmt::format("{}", ++k), e.value("effect", "?"),
+                    ParamsText(e.value("params", nlohmann::json::object()), nlohmann::json::object()),
+                    Percent(Number(e, "cumulative_heldout_shrink")), Percent(Number(e, "cumulative_shrink")),
+                    fmt::format("{:.2f} mm / {:.2f} mrad", Number(e, "size_mm"), Number(e, "size_mrad")),
+                    fmt::format("{:.2f}{}", Number(e, "relative_size"), e.value("negligible", false) ? " (negligible)" : "")});
+  rep.Table({"step", "effect", "parameters", "gap closed, held-out", "in-sample", "size over a run",
+             "size / noise of one piece"},
+            rows, 3);
+  const auto& v = j.at("verdict");
+  rep.Paragraph(fmt::format("{} of the gap stays unexplained on held-out runs. An effect is negligible when its size is "
+                            "below {:.2g} x the noise of one piece (1 m of travel or a spot turn): then it is reported "
+                            "but never the verdict.",
+                            Percent(Number(v, "unexplained_fraction")), Number(v, "negligible_threshold")));
+}
+
+/// The largest piece residuals, numbered as in the plot.
+void TopPiecesTable(io::HtmlReport& rep, const nlohmann::json& j) {
+  const auto top = TopPieceResiduals(j, kTopPieces);
+  if (top.empty()) return;
+  rep.Heading("The largest piece residuals (numbered as in the plot)");
+  std::vector<std::vector<std::string>> rows;
+  for (std::size_t i = 0; i < top.size(); ++i) {
+    const auto& t = top[i];
+    rows.push_back({fmt::format("{}", i + 1), fmt::format("{}", t.experiment), t.run, t.type,
+                    fmt::format("{:.2f} m", t.travel_start_m), kComponentNames[t.component], fmt::format("{:+.2f}", t.z)});
+  }
+  rep.Table({"#", "experiment", "run", "piece", "starts after", "component", "residual [SE]"}, rows, 4);
+}
+
+}  // namespace
+
+// The page: verdict and next steps first (from the diagnosis' own
+// next_steps), then the numbers (gap, baseline, candidates with units and
+// evidence in words, explanation, largest residuals), then the plots.
 std::string DiagnoseReportHtml(const nlohmann::json& j, const std::string& manifest) {
   io::HtmlReport rep("umbmark diagnose", manifest);
   const auto& v = j.at("verdict");
   const std::string effect = v.value("effect", "?");
   const auto& gap = j.at("gap");
-  const double p = gap.value("p_value", NAN);
+  const double p = Number(gap, "p_value");
   if (effect == "none") {
-    rep.Headline(fmt::format("No significant gap between the runs and the model (p = {:.3g}).", p), io::HtmlReport::Level::kGood);
+    rep.Headline(fmt::format("No gap that matters between the runs and the model ({}). {}", PText(p), v.value("reason", "")),
+                 io::HtmlReport::Level::kGood);
   } else if (effect == "unexplained") {
-    rep.Headline(fmt::format("The runs leave the model (p = {:.3g}) and no known effect explains it.", p),
+    rep.Headline(fmt::format("The runs leave the model ({}) and no known effect explains it. {}", PText(p),
+                             v.value("reason", "")),
                  io::HtmlReport::Level::kBad);
   } else {
-    rep.Headline(fmt::format("The runs leave the model (p = {:.3g}); the cause: {}. {}", p, effect, v.value("reason", "")),
+    rep.Headline(fmt::format("The runs leave the model ({}); the cause: {}. {}", PText(p), effect, v.value("reason", "")),
                  io::HtmlReport::Level::kWarn);
   }
   std::vector<std::string> steps;
-  if (effect == "none") {
-    steps.push_back("The calibrated model describes these runs: use it (calibrate JSON, fit-noise k_L/k_R) in your simulation.");
-  } else if (effect == "unexplained") {
-    steps.push_back("Look at the largest discrepancies below: which experiment, which motion, which component.");
-    steps.push_back("Record a campaign with more kinds of motion (arcs, back-and-forth, free paths) so effects can be told apart.");
-  } else {
-    steps.push_back(fmt::format("Model or fix `{}` (its fitted parameters are in the table below), then diagnose again.", effect));
-    steps.push_back("Simulate with the effect (`umbmark simulate --effect ...`) to check your simulation reproduces the runs.");
-  }
+  for (const auto& s : j.value("next_steps", nlohmann::json::array()))
+    if (s.is_string()) steps.push_back(s.get<std::string>());
   rep.NextSteps(steps);
   std::vector<std::string> warnings;
   for (const auto& w : j.value("warnings", nlohmann::json::array())) warnings.push_back(w.get<std::string>());
   for (const auto& w : j.value("notes", nlohmann::json::array()))
     if (w.is_string()) warnings.push_back(w.get<std::string>());
+  for (const auto& w : j.value("indistinguishable", nlohmann::json::array()))
+    if (w.is_string()) warnings.push_back("cannot tell apart: " + w.get<std::string>());
   rep.Warnings(warnings);
   rep.Heading("Gap");
   rep.Table({"quantity", "value"},
-            {{"gap score", fmt::format("{:.3g}", gap.value("score", NAN))},
-             {"p-value (combined)", fmt::format("{:.3g}", p)},
-             {"null simulations; alpha", fmt::format("{}; {}", gap.value("null_simulations", 0), gap.value("alpha", NAN))}});
-  rep.Heading("Candidate effects (best first)");
-  std::vector<std::vector<std::string>> rows;
-  for (const auto& c : j.value("candidates", nlohmann::json::array())) {
-    std::string params;
-    const nlohmann::json fitted = c.value("params", nlohmann::json::object());
-    for (const auto& [k, val] : fitted.items())
-      params += fmt::format("{}{} = {}", params.empty() ? "" : ", ", k, val.is_number() ? fmt::format("{:.4g}", val.get<double>()) : val.dump());
-    auto num = [&](const char* key) {
-      return c.contains(key) && c[key].is_number() ? fmt::format("{:.3f}", c[key].get<double>()) : std::string("-");
-    };
-    rows.push_back({c.value("effect", "?"), params, num("shrink"), num("heldout_shrink")});
-  }
-  rep.Table({"effect", "fitted parameters", "shrink", "held-out shrink"}, rows, 2);
+            {{"gap score G (0 = the model's own noise)",
+              fmt::format("{:.3g} (null median {:.3g})", Number(gap, "score"), Number(gap, "null_median"))},
+             {"p-value (combined: G and the likelihood-ratio tests)", diag::FormatPValue(p)},
+             {"p-value of G alone", diag::FormatPValue(Number(gap, "score_p_value"))},
+             {"null simulations; alpha", fmt::format("{}; {}", gap.value("null_simulations", 0), Number(gap, "alpha"))}});
+  if (j.contains("baseline")) BaselineTable(rep, j["baseline"]);
+  CandidateTable(rep, j);
+  ExplanationTable(rep, j);
+  TopPiecesTable(rep, j);
   rep.Heading("Plots");
-  rep.Figure(DiagnosePlotsSvg(j), "Top: the located discrepancies in standard errors against the model's 95% band. "
-                                  "Below: how much of the gap each effect closes.");
+  rep.Figure(DiagnosePlotsSvg(j),
+             "First: every piece's residual under the baseline, per experiment, in standard errors, against the band "
+             "that holds 95% of them when the model is right; the largest are ringed and numbered. Then: the ranked "
+             "discrepancies per subset of pieces, how much of the gap each effect closes, and the explanation.");
   return rep.Render();
 }
 

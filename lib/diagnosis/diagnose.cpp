@@ -10,6 +10,7 @@
 #include <fmt/ranges.h>
 
 #include "core/errors.hpp"
+#include "diagnosis/advice.hpp"
 #include "diagnosis/baseline.hpp"
 #include "diagnosis/candidates.hpp"
 #include "diagnosis/cross_validation.hpp"
@@ -163,6 +164,7 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
   out.gap_score = gap.score;
   out.gap_by_kind = gap.by_kind;
   out.where = LocateGap(c, gap, options.where_top);
+  out.piece_residuals = StandardisedPieceResiduals(c, base);
   const NullDistribution null = SimulateNullDistribution(
       c, model, base, NullOptions{options.null_simulations, options.alpha, options.seed, options.threads, options.gap});
   out.null_simulations = options.null_simulations;
@@ -213,6 +215,7 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
     NameEffects(ex, options, out);
     timer.Lap("stepwise explanation");
   }
+  out.next_steps = AdviseNextSteps(c, out);
   out.timings = timer.Finish();
   return out;
 }

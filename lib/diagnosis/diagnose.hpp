@@ -60,6 +60,7 @@
 #include "diagnosis/gap_stats.hpp"
 #include "diagnosis/model.hpp"
 #include "diagnosis/piece_noise.hpp"
+#include "diagnosis/piece_residuals.hpp"
 #include "diagnosis/pieces.hpp"
 #include "diagnosis/return_check.hpp"
 #include "diagnosis/where.hpp"
@@ -142,6 +143,9 @@ struct DiagnoseSummary {
   bool significant = false;
   std::array<double, kNumStatKinds> gap_by_kind{};
   std::vector<WhereItem> where;
+  /// Every piece's standardised residual under the baseline
+  /// (piece_residuals.hpp), in campaign order: where the runs leave the model.
+  std::vector<PieceResidual> piece_residuals;
   std::vector<Candidate> candidates;  ///< best first
   std::string verdict;                ///< effect name | none | unexplained
   std::string verdict_reason;
@@ -159,6 +163,8 @@ struct DiagnoseSummary {
   std::vector<std::pair<std::string, double>> timings;  ///< stage, seconds
   std::vector<std::string> experiment_labels;
   std::vector<std::string> notes;
+  /// What to do next, for a person (advice.hpp).
+  std::vector<std::string> next_steps;
   std::uint64_t seed = 0;
 };
 

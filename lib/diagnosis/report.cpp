@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/angles.hpp"
+#include "diagnosis/advice.hpp"
 #include "diagnosis/diagnose.hpp"
 #include "io/svg_plot.hpp"
 
@@ -33,20 +34,8 @@ nlohmann::json ByKind(const std::array<double, kNumStatKinds>& a) {
   return j;
 }
 
-/// "name = value unit" in the unit an engineer reads: mm, mrad, ms, per
-/// metre, per run; dimensionless factors as they are.
-std::string FormatParam(const std::string& name, double v) {
-  if (name == "dx" || name == "dy" || name == "sigma" || name == "sigma_xy") return fmt::format("{} = {:.3g} mm", name, 1e3 * v);
-  if (name == "kappa" || name == "sigma_theta") return fmt::format("{} = {:.3g} mrad", name, 1e3 * v);
-  if (name == "tau" || name == "tau_sd") return fmt::format("{} = {:.3g} ms", name, 1e3 * v);
-  if (name == "rate") return fmt::format("{} = {:.3g} per metre", name, v);
-  if (name == "r") return fmt::format("{} = {:.3g} per run", name, v);
-  return fmt::format("{} = {:.4g}", name, v);
-}
-
-/// p-values below what double precision and the model's approximations
-/// can vouch for print as "< 1e-12".
-std::string FormatP(double p) { return p < 1e-12 ? std::string("< 1e-12") : fmt::format("{:.3g}", p); }
+std::string FormatParam(const std::string& name, double v) { return FormatEffectParam(name, v); }
+std::string FormatP(double p) { return FormatPValue(p); }
 
 const Candidate* Winner(const DiagnoseSummary& s) {
   for (const auto& c : s.candidates)
@@ -107,7 +96,8 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
                      {"E_d", Num(c.E_d)},
                      {"E_b", Num(c.E_b)},
                      {"gap_after_by_statistic", ByKind(c.gap_by_kind)},
-                     {"note", c.note}});
+                     {"note", c.note},
+                     {"unphysical", UnphysicalFit(sim::EffectToString(c.effect), c.params, s.baseline.runs)}});
   }
   const BaselineSummary& b = s.baseline;
   nlohmann::json returns = nlohmann::json::array();
@@ -173,7 +163,9 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
             {"return_errors", returns},
             {"residual_growth", growth}}},
           {"experiments", s.experiment_labels},
+          {"piece_residuals", PieceResidualsToJson(s.piece_residuals)},
           {"notes", s.notes},
+          {"next_steps", s.next_steps},
           {"timing_s", timing}};
 }
 
@@ -187,8 +179,8 @@ std::string DiagnoseReport(const DiagnoseSummary& s) {
   line("1. Baseline (E_d, E_b, k_L, k_R; ground-truth noise " +
        std::string(b.ground_truth_estimated ? "estimated" : "as stated in the manifest") + ")");
   line(fmt::format("  E_d = {:.6f}   E_b = {:.6f}   k_L = {:.3g} m^1/2   k_R = {:.3g} m^1/2", b.E_d, b.E_b, b.k_L, b.k_R));
-  line(fmt::format("  ground truth: sigma_xy = {:.3g} m, sigma_theta = {:.3g} rad; start: {}", b.sigma_xy_m,
-                   b.sigma_theta_rad, b.start));
+  line(fmt::format("  ground truth: sigma_xy = {:.3g} mm, sigma_theta = {:.3g} mrad; start: {}", 1e3 * b.sigma_xy_m,
+                   1e3 * b.sigma_theta_rad, b.start));
   line(fmt::format("  {} runs, {} pieces", b.runs, b.pieces));
   if (b.return_fit)
     line(fmt::format("  cross-check, fit-noise on the runs' return errors: k_L = {:.3g} [{:.3g}, {:.3g}], k_R = {:.3g} "
@@ -216,16 +208,16 @@ std::string DiagnoseReport(const DiagnoseSummary& s) {
                      1e3 * g.observed_rms[2], 1e3 * g.predicted_rms[2]));
   }
   line("");
-  line(fmt::format("2. Where: gap score G = {:.2f} (null median {:.2f}, {:.0f}% quantile {:.2f}); p = {:.4g} from {} "
+  line(fmt::format("2. Where: gap score G = {:.2f} (null median {:.2f}, {:.0f}% quantile {:.2f}); p = {} from {} "
                    "simulations of the baseline",
-                   s.gap_score, s.null_median, 100.0 * (1.0 - s.alpha), s.null_quantile_alpha, s.score_p_value,
+                   s.gap_score, s.null_median, 100.0 * (1.0 - s.alpha), s.null_quantile_alpha, FormatP(s.score_p_value),
                    s.null_simulations));
   if (s.tests > 0)
-    line(fmt::format("   likelihood-ratio tests of the candidates: p = {:.4g} (Bonferroni over {}); combined p = {:.4g} "
+    line(fmt::format("   likelihood-ratio tests of the candidates: p = {} (Bonferroni over {}); combined p = {} "
                      "-> {}",
-                     s.tests_p_value, s.tests, s.p_value, s.significant ? "significant" : "not significant"));
+                     FormatP(s.tests_p_value), s.tests, FormatP(s.p_value), s.significant ? "significant" : "not significant"));
   else
-    line(fmt::format("   p = {:.4g} -> {}", s.p_value, s.significant ? "significant" : "not significant"));
+    line(fmt::format("   p = {} -> {}", FormatP(s.p_value), s.significant ? "significant" : "not significant"));
   for (const auto& w : s.where) {
     line(fmt::format("    {:+8.2f} SE  {:<6} {:<40} {:<11} {}", w.z,
                      w.experiment >= 0 ? fmt::format("exp {}", w.experiment + 1) : std::string("all"), w.subset,
@@ -239,10 +231,11 @@ std::string DiagnoseReport(const DiagnoseSummary& s) {
     std::string params;
     for (const auto& [k, v] : c.params) {
       const auto se = c.param_se.find(k);
-      params += se != c.param_se.end() ? fmt::format("{} (se {:.2g})  ", FormatParam(k, v), se->second)
-                                       : FormatParam(k, v) + "  ";
+      params += FormatEffectParam(k, v, se != c.param_se.end() ? se->second : NAN) + "  ";
     }
     if (!c.note.empty()) params += "(" + c.note + ")";
+    if (const auto why = UnphysicalFit(sim::EffectToString(c.effect), c.params, b.runs); !why.empty())
+      params += " IMPOSSIBLE VALUE, a symptom (the gap is something else): " + why;
     line(fmt::format("    {:<20} {:>8.3f} {:>9.3f} {:>9.1f} n {:>10}  {}", sim::EffectToString(c.effect), c.shrink,
                      c.heldout_shrink, c.evidence, c.tested ? FormatP(c.lr_p_value) : std::string("-"),
                      params));
@@ -271,6 +264,12 @@ std::string DiagnoseReport(const DiagnoseSummary& s) {
   line("  " + s.verdict_reason);
   for (const auto& i : s.indistinguishable) line("  cannot tell apart: " + i);
   for (const auto& n : s.notes) line("  note: " + n);
+  if (const Candidate* w = Winner(s); w && s.verdict != "none")
+    line(std::string("  evidence for ") + sim::EffectToString(w->effect) + ": " +
+         EvidenceInWords(w->heldout_loglik_gain, w->evidence, w->heldout_shrink));
+  line("");
+  line("What to do next:");
+  for (std::size_t i = 0; i < s.next_steps.size(); ++i) line(fmt::format("  {}. {}", i + 1, s.next_steps[i]));
   line("");
   line("Time per stage:");
   for (const auto& [k, v] : s.timings) line(fmt::format("  {:<42} {:8.3f} s", k, v));

@@ -116,10 +116,11 @@ std::string SvgPanel::Marker(double x, double y, const SvgStyle& st, double r) c
   return fmt::format(R"svg(<circle cx="{:.1f}" cy="{:.1f}" r="{:.1f}" {}/>)svg", x, y, r, paint);
 }
 
-void SvgPanel::Points(const std::vector<SvgPoint>& pts, const SvgStyle& style, double r) {
+void SvgPanel::Points(const std::vector<SvgPoint>& pts, const SvgStyle& style, double r, const std::string& name) {
   SvgStyle st = style;
   if (st.marker.empty()) st.marker = "circle";
-  body_ += fmt::format(R"svg(<g class="series points" data-n="{}">)svg", pts.size());
+  body_ += fmt::format(R"svg(<g class="series points" data-n="{}"{}>)svg", pts.size(),
+                       name.empty() ? std::string() : fmt::format(R"svg( data-name="{}")svg", SvgEscape(name)));
   for (const auto& p : pts) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
     body_ += Marker(Px(p.x), Py(p.y), st, r);

@@ -51,7 +51,9 @@ class SvgPanel {
   double ymin() const { return ymin_; }
   double ymax() const { return ymax_; }
 
-  void Points(const std::vector<SvgPoint>& pts, const SvgStyle& style, double radius_px = 3.5);
+  /// Markers at `pts`; `name` (optional) tags the series (data-name) for tests.
+  void Points(const std::vector<SvgPoint>& pts, const SvgStyle& style, double radius_px = 3.5,
+              const std::string& name = "");
   void Polyline(const std::vector<SvgPoint>& pts, const SvgStyle& style);
   void Circle(SvgPoint centre, double radius_data, const SvgStyle& style);
   /// Ellipse from a 2x2 covariance scaled to `scale` sigma (e.g. 2.4477 for 95%).

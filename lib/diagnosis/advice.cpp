@@ -1,0 +1,178 @@
+// Reading a diagnosis for a person (see advice.hpp).
+#include "diagnosis/advice.hpp"
+
+#include <cmath>
+#include <utility>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "diagnosis/diagnose.hpp"
+
+namespace umbmark::diag {
+
+namespace {
+/// Scale and unit an engineer reads a parameter in.
+std::pair<double, const char*> ParamUnit(const std::string& name) {
+  if (name == "dx" || name == "dy" || name == "sigma" || name == "sigma_xy") return {1e3, " mm"};
+  if (name == "kappa" || name == "sigma_theta") return {1e3, " mrad"};
+  if (name == "tau" || name == "tau_sd") return {1e3, " ms"};
+  if (name == "rate") return {1.0, " per metre"};
+  if (name == "r") return {1.0, " per run"};
+  if (name == "s" || name == "a") return {1e2, " %"};
+  return {1.0, ""};
+}
+}  // namespace
+
+std::string FormatEffectParam(const std::string& name, double v, double se) {
+  const auto [scale, unit] = ParamUnit(name);
+  if (std::isfinite(se)) return fmt::format("{} = {:.3g}{} (se {:.2g})", name, scale * v, unit, scale * se);
+  return fmt::format("{} = {:.3g}{}", name, scale * v, unit);
+}
+
+std::string FormatPValue(double p) {
+  if (!std::isfinite(p)) return "-";
+  return p < 1e-12 ? std::string("< 1e-12") : fmt::format("{:.3g}", p);
+}
+
+std::string EvidenceInWords(double gain, double evidence, double heldout_shrink) {
+  if (!std::isfinite(gain) || !std::isfinite(evidence)) return "not measured";
+  const char* grade = evidence < 0.0   ? "no evidence"
+                      : evidence < 1.0 ? "weak evidence"
+                      : evidence < 3.0 ? "positive evidence"
+                      : evidence < 5.0 ? "strong evidence"
+                                       : "very strong evidence";
+  std::string odds = gain > 700.0 ? "overwhelmingly"
+                                  : gain > 0.0 ? fmt::format("{:.3g} times", std::exp(gain)) : std::string("not");
+  return fmt::format("{}: on runs not used to fit it the effect closes {:.0f}% of the gap, and those runs are {} more "
+                     "probable with it ({:+.1f} nats; {:+.1f} after the penalty for its parameters)",
+                     grade, 100.0 * std::max(heldout_shrink, 0.0), odds, gain, evidence);
+}
+
+std::string UnphysicalFit(const std::string& effect, const std::map<std::string, double>& params, int runs) {
+  auto get = [&](const char* k) {
+    const auto it = params.find(k);
+    return it == params.end() ? 0.0 : it->second;
+  };
+  if (effect == "turn_scrub" && get("k") < -0.01)
+    return fmt::format("a negative turn scrub (k = {:.3g}): scrubbing can only lose rotation, never add it", get("k"));
+  if (effect == "turn_scrub" && get("k") >= 1.0)
+    return fmt::format("a turn scrub of k = {:.3g}: the robot would not turn at all", get("k"));
+  if (effect == "correlated_noise" && std::abs(get("rho")) > 0.95)
+    return fmt::format("a wheel-noise correlation at its bound (rho = {:.3g}): the noise is not wheel noise", get("rho"));
+  if (effect == "scale_error" && std::abs(get("s")) > 0.1)
+    return fmt::format("both wheels {:.1f}% off their nominal diameter: a unit or configuration error, not wear",
+                       100.0 * get("s"));
+  if (effect == "direction_asymmetry" && std::abs(get("a")) > 0.1)
+    return fmt::format("wheels {:.1f}% larger backwards than forwards: no rigid wheel does that", 100.0 * get("a"));
+  if (effect == "castor_kick" && std::abs(get("kappa")) > 0.05)
+    return fmt::format("a castor kick of {:.0f} mrad ({:.1f} deg) at every start: far beyond what a castor swings the "
+                       "robot", 1e3 * get("kappa"), get("kappa") * 180.0 / 3.14159265358979);
+  if (effect == "gt_offset" && std::hypot(get("dx"), get("dy")) > 0.3)
+    return fmt::format("a ground-truth marker {:.0f} mm from the axle midpoint: off the robot",
+                       1e3 * std::hypot(get("dx"), get("dy")));
+  if (effect == "parameter_drift" && std::abs(get("r")) * std::max(runs - 1, 1) > 0.05)
+    return fmt::format("the right wheel changing by {:.1f}% over {} runs", 100.0 * get("r") * std::max(runs - 1, 1), runs);
+  for (const char* k : {"sigma", "sigma_xy"})
+    if (params.count(k) && get(k) > 0.05)
+      return fmt::format("{} mm of noise per event ({}): larger than any slip or settling; a ground-truth glitch or a "
+                         "mismatched run is more likely", fmt::format("{:.0f}", 1e3 * get(k)), k);
+  if (effect == "run_time_offset" && get("tau_sd") > 1.0)
+    return fmt::format("run time offsets of {:.1f} s: the recordings are not aligned at all", get("tau_sd"));
+  return {};
+}
+
+namespace {
+
+/// The experiments and motions a campaign lacks to tell effects apart.
+std::vector<std::string> MissingDesign(const CampaignData& c) {
+  bool square = false, back_forth = false, free_path = false, pauses = false, arcs = false;
+  for (const auto& e : c.experiments) {
+    square |= e.kind == ExperimentKind::kSquare;
+    back_forth |= e.kind == ExperimentKind::kBackAndForth;
+    free_path |= e.kind == ExperimentKind::kFree;
+  }
+  for (const auto& p : c.pieces) {
+    pauses |= p.type == PieceType::kStand;
+    arcs |= p.type == PieceType::kArc;
+  }
+  std::vector<std::string> out;
+  if (!back_forth)
+    out.push_back("Add a back_and_forth experiment (drive a straight line out and back, 10 runs): it separates "
+                  "direction_asymmetry, scale_error and castor_kick, which squares alone confuse.");
+  if (!square)
+    out.push_back("Add squares in both directions (UMBmark, 5+ runs each): they pin E_d and E_b, so the other "
+                  "effects stand out against a well-determined baseline.");
+  if (!free_path && !arcs)
+    out.push_back("Add free paths with arcs of different radii: turn_scrub, gt_offset and the wheelbase are told "
+                  "apart only when the robot turns while it drives.");
+  if (!pauses)
+    out.push_back("Stop for 1-2 s between legs: standstills show motion while the encoders are still "
+                  "(standstill_motion) and average the ground truth's noise down.");
+  return out;
+}
+
+}  // namespace
+
+// The steps follow the verdict. For `unexplained` they start from the data
+// (the largest discrepancy and where it lies), then the campaign's design
+// (what is missing to separate effects), then the symptoms (impossible
+// fits), then the partial explanation.
+std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSummary& s) {
+  std::vector<std::string> out;
+  if (s.verdict == "none") {
+    out.push_back("The baseline model describes these runs: simulate with its E_d, E_b and k_L, k_R (calibrate JSON, "
+                  "fit-noise).");
+    return out;
+  }
+  std::vector<std::string> symptoms;
+  for (const auto& cand : s.candidates) {
+    const std::string name = sim::EffectToString(cand.effect);
+    if (const std::string why = UnphysicalFit(name, cand.params, s.baseline.runs); !why.empty())
+      symptoms.push_back(fmt::format("{} ({})", name, why));
+  }
+  if (s.verdict != "unexplained") {
+    out.push_back(fmt::format("Model or fix {} (fitted values in the candidate table), then diagnose again: the gap "
+                              "should be gone.", fmt::join(s.verdict_effects.empty() ? std::vector<std::string>{s.verdict}
+                                                                                     : s.verdict_effects, " and ")));
+    std::vector<std::string> specs;
+    for (const auto& step : s.explanation) {
+      if (step.negligible) continue;
+      std::vector<std::string> kv;
+      for (const auto& [k, v] : step.params) kv.push_back(fmt::format("{}={:.4g}", k, v));
+      specs.push_back(fmt::format("--effect {}:{}", sim::EffectToString(step.effect), fmt::join(kv, ",")));
+    }
+    if (!specs.empty())
+      out.push_back(fmt::format("Check your simulation reproduces the runs: umbmark simulate {} --out DIR {} (the "
+                                "fitted values, SI units), then diagnose DIR/campaign.toml: the verdict should be none.",
+                                c.path, fmt::join(specs, " ")));
+    if (!symptoms.empty())
+      out.push_back("Some other candidates fitted impossible values (a symptom, not a cause): " +
+                    fmt::format("{}", fmt::join(symptoms, "; ")) + ".");
+    return out;
+  }
+  if (!s.where.empty()) {
+    const WhereItem& w = s.where.front();
+    const std::string exp = w.experiment >= 0 && w.experiment < static_cast<int>(s.experiment_labels.size())
+                                ? "experiment " + s.experiment_labels[w.experiment]
+                                : std::string("all experiments");
+    out.push_back(fmt::format("Look first at {}, {}: its {} of the {} component is {:.1f} standard errors off the "
+                              "model. Plot those runs' odometry against the ground truth (umbmark evaluate --report) "
+                              "and check the ground truth there (marker swaps, dropped samples, timing).",
+                              exp, w.subset, StatKindToString(w.statistic), w.component, w.z));
+  }
+  if (!symptoms.empty())
+    out.push_back("These effects fitted impossible values, so the gap is something else that they try to imitate: " +
+                  fmt::format("{}", fmt::join(symptoms, "; ")) + ".");
+  for (auto& m : MissingDesign(c)) out.push_back(std::move(m));
+  if (!s.verdict_effects.empty())
+    out.push_back(fmt::format("{} close{} part of the gap ({:.0f}% stays unexplained on held-out runs): model {} "
+                              "and diagnose again; what is left is what to look for.",
+                              fmt::join(s.verdict_effects, " + "), s.verdict_effects.size() > 1 ? "" : "s",
+                              100.0 * s.unexplained_fraction, s.verdict_effects.size() > 1 ? "them" : "it"));
+  out.push_back("Check the recording itself: one clock for encoders and ground truth, the marker rigidly on the "
+                "robot, the same floor and load for every run. docs/diagnosis.md lists what each effect looks like.");
+  return out;
+}
+
+}  // namespace umbmark::diag

@@ -1,0 +1,53 @@
+// What a person reads into a diagnosis: parameters in the units an engineer
+// uses, p-values no finer than the computation can vouch for, the held-out
+// evidence in words, fits that took physically impossible values (a
+// symptom: the gap is something else than that effect), and, when the gap
+// stays unexplained, which experiment to add and what to look at next.
+// Used by the text report (report.cpp), the JSON (`next_steps`,
+// `candidates[].unphysical`) and the HTML page (apps/diagnose_report.cpp).
+#pragma once
+
+#include <cmath>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "diagnosis/pieces.hpp"
+
+namespace umbmark::diag {
+
+struct DiagnoseSummary;
+
+/// "name = value unit": mm (dx, dy, sigma, sigma_xy), mrad (kappa,
+/// sigma_theta), ms (tau, tau_sd), per metre (rate), per run (r);
+/// percent (s, a); dimensionless factors (k, rho) as they are. `se`: its
+/// standard error in the same unit, when finite.
+std::string FormatEffectParam(const std::string& name, double value, double se = NAN);
+
+/// "< 1e-12" below 1e-12 (beyond what the chi^2 and bootstrap
+/// approximations can vouch for), else three significant digits.
+std::string FormatPValue(double p);
+
+/// The held-out evidence in words. `heldout_gain_nats`: log-likelihood
+/// gained on runs not used to fit; `evidence_nats`: the same minus the
+/// complexity penalty; `heldout_shrink`: fraction of the gap closed held
+/// out. Grades on the evidence in nats (Kass & Raftery 1995, on ln B):
+/// < 0 none, < 1 weak, < 3 positive, < 5 strong, else very strong.
+std::string EvidenceInWords(double heldout_gain_nats, double evidence_nats, double heldout_shrink);
+
+/// Why a fitted effect is physically impossible or implausible (empty when
+/// it is not): a negative or >= 1 turn scrub, a correlation at +-1, a wheel
+/// diameter off by more than 10 %, a castor kick over 50 mrad (3 deg), a
+/// ground-truth marker more than 0.3 m off the axle, a right wheel
+/// drifting by more than 5 % over the campaign (`runs`), noise of more
+/// than 50 mm per event, run time offsets over 1 s. Such a fit is a
+/// symptom: the effect soaked up something else.
+std::string UnphysicalFit(const std::string& effect, const std::map<std::string, double>& params, int runs);
+
+/// What to do next, in order: for `none`, use the model; for a named
+/// verdict, model the effects; for `unexplained`, the largest discrepancy
+/// to look at, the experiments the campaign lacks to tell effects apart,
+/// and the fits that came out unphysical.
+std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSummary& s);
+
+}  // namespace umbmark::diag
