@@ -43,6 +43,15 @@ for page in calibrate evaluate fit-noise diagnose summarize; do
   # Console messages of the page (errors of the page itself, not the browser's own start-up noise).
   grep -E 'CONSOLE|Uncaught|Failed to load' "$out/$page.log" && problems+=("console errors")
   [ -s "$out/$page.png" ] || problems+=("no screenshot")
+  # Page-specific elements: what each report must show.
+  case $page in
+    diagnose)
+      grep -q 'data-title="Experiment 1' "$out/$page.dom" || problems+=("no residual panel per experiment")
+      grep -q 'data-name="largest"' "$out/$page.dom" || problems+=("largest residuals not marked")
+      grep -q 'class="series band"' "$out/$page.dom" || problems+=("no 95% band")
+      grep -q 'What to do next' "$out/$page.dom" || problems+=("no next steps")
+      grep -q ' mrad (se ' "$out/$page.dom" || problems+=("candidate parameters without units") ;;
+  esac
   if [ ${#problems[@]} -gt 0 ]; then
     echo "FAIL $page: ${problems[*]}"
     fail=1
