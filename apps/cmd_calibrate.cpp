@@ -533,6 +533,14 @@ int RunCalibrate(const CalibrateOptions& o) {
                 in.label, mirrored, in.errors.size()));
           }
         }
+        // Unit mix-ups show in the data too: return errors as large as the
+        // square, or runs that travel far more or less than 4 sides.
+        if (in.trajectories) {
+          if (auto problem = CheckTravelScale(*in.trajectories, in.recorded, in.side_m); !problem.empty())
+            throw InputError(in.label, problem);
+        }
+        if (auto problem = CheckReturnErrorScale(in.errors, in.side_m); !problem.empty())
+          throw InputError(in.label, problem);
         r = RunCalibrateJob(in, jo);
         // Plausibility gates: never print or write an impossible result.
         gate = CheckUmbmarkPlausibility(r.umbmark);
@@ -648,7 +656,7 @@ Command SetupCalibrate(CLI::App& parent) {
   app->add_option("DATA", opts->inputs, "Endpoint or trajectory CSV, or campaign manifest (.toml); several = batch")
       ->required();
   opts->robot.Bind(*app);
-  app->add_option("--side", opts->side_m, "Square side L [m] (required for CSV input)")->check(Positive());
+  app->add_option("--side", opts->side_m, "Square side L [m] (required for CSV input)")->check(Plausible("side_m"));
   app->add_option("--estimator", opts->estimator, "alpha/beta from x (4.20a, 4.24a), y (4.20b, 4.24b) or their mean")
       ->check(CLI::IsMember({"x", "y", "mean"}))
       ->capture_default_str();

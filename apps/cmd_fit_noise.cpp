@@ -486,7 +486,7 @@ Command SetupFitNoise(CLI::App& parent) {
       ->required();
   opts->robot.Bind(*app);
   app->add_option("--distance", opts->distance_m, "Endpoint data: each run drove D forward, then D back [m]")
-      ->check(Positive());
+      ->check(Plausible("distance_m"));
   app->add_option("--meas-sigma", opts->meas_sigma,
                   "Noise of the external reference per measured pose: SXY[,STHETA] [m, rad] (default: the "
                   "manifest's [ground_truth], else 0)")

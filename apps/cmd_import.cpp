@@ -262,8 +262,8 @@ Command SetupImport(CLI::App& parent) {
   rb->add_flag("--list", ro->list, "Print every topic with type, message count and rate, and what it can serve as; write nothing");
   rb->add_option("--out", ro->out, "Output directory");
   rb->add_option("--experiment", ro->experiment, "Experiment kind")->check(CLI::IsMember({"square", "back_and_forth", "free"}));
-  rb->add_option("--side", ro->side_m, "Square side [m] (square)");
-  rb->add_option("--distance", ro->distance_m, "Leg length [m] (back_and_forth)");
+  rb->add_option("--side", ro->side_m, "Square side [m] (square)")->check(Plausible("side_m"));
+  rb->add_option("--distance", ro->distance_m, "Leg length [m] (back_and_forth)")->check(Plausible("distance_m"));
   auto* wheels = rb->add_option("--wheels", ro->import.wheels_topic, "sensor_msgs/msg/JointState topic with the wheel positions [rad]");
   auto* odom = rb->add_option("--odometry", ro->import.odometry_topic,
                               "nav_msgs/msg/Odometry topic as the robot computed it (inverted with the wheelbase)");

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
+#include "core/plausible_units.hpp"
 #include "core/utf8.hpp"
 #include "io/atomic_write.hpp"
 #include "io/manifest.hpp"
@@ -17,13 +18,13 @@ namespace umbmark::cli {
 
 void RobotFlags::Bind(CLI::App& app) {
   app.add_option("--robot", robot_file, "Robot file (TOML): the parameters the odometry USED");
-  app.add_option("--wheelbase", wheelbase_m, "Override wheelbase_m [m]")->check(Positive());
+  app.add_option("--wheelbase", wheelbase_m, "Override wheelbase_m [m]")->check(Plausible("wheelbase_m"));
   app.add_option("--diameter-left", diameter_left_m, "Override wheel_diameter_left_m [m]")
-      ->check(Positive());
+      ->check(Plausible("wheel_diameter_left_m"));
   app.add_option("--diameter-right", diameter_right_m, "Override wheel_diameter_right_m [m]")
-      ->check(Positive());
+      ->check(Plausible("wheel_diameter_right_m"));
   app.add_option("--ticks-per-rev", ticks_per_rev, "Override ticks_per_rev (ticks per wheel revolution)")
-      ->check(Positive());
+      ->check(Plausible("ticks_per_rev"));
 }
 
 bool RobotFlags::Given() const {
@@ -93,6 +94,16 @@ CLI::Validator Positive() {
         const auto x = WholeNumber(v);
         if (!x || !(*x > 0.0)) return fmt::format("must be a finite number > 0 (got '{}')", v);
         return {};
+      },
+      "POSITIVE");
+}
+
+CLI::Validator Plausible(std::string_view key) {
+  return CLI::Validator(
+      [key](std::string& v) -> std::string {
+        const auto x = WholeNumber(v);
+        if (!x || !(*x > 0.0)) return fmt::format("must be a finite number > 0 (got '{}')", v);
+        return ImplausibleValue(key, *x);
       },
       "POSITIVE");
 }

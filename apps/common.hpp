@@ -57,6 +57,11 @@ CLI::Validator NumberIn(double lo, double hi);
 CLI::Validator Positive();
 CLI::Validator NonNegative();
 
+/// A finite number > 0 inside the plausible range of `key`
+/// (core/plausible_units.hpp: wheelbase_m, side_m, ...): refuses unit
+/// mix-ups such as `--side 4000` (millimetres) with the range and a hint.
+CLI::Validator Plausible(std::string_view key);
+
 /// Validator for --seed: a whole number in [0, 2^64), quoted back as given
 /// (CLI11 would turn "-1" silently into 2^64-1).
 CLI::Validator SeedValidator();

@@ -33,6 +33,20 @@ struct PlausibilityReport {
 constexpr double kMinMultiplier = 0.5;
 constexpr double kMaxMultiplier = 2.0;
 
+/// Corrections larger than UMBmark can support (correction_support.hpp;
+/// docs/safety.md): a failure when the first-order formulas' bias at the
+/// estimate (exact square model) exceeds kBiasFailFraction of the
+/// correction |E - 1|, the data's 95 % half-width and a floor; a warning
+/// (second pass) when it only exceeds the half-width and a smaller floor.
+constexpr double kBiasFailFraction = 0.25;
+constexpr double kBiasFailFloorEb = 0.002, kBiasFailFloorEd = 0.0005;
+constexpr double kBiasWarnFloorEb = 0.001, kBiasWarnFloorEd = 0.0002;
+/// Reversed labels: the centres sit kMirrorRatio times (in squared
+/// distance) closer to the other direction's diagonals, and off their own
+/// ones with p < kMirrorP (CorrectionSupport::p_off_labels).
+constexpr double kMirrorRatio = 4.0;
+constexpr double kMirrorP = 0.001;
+
 /// Gates and warnings for a classic UMBmark result.
 PlausibilityReport CheckUmbmarkPlausibility(const UmbmarkSummary& s);
 
@@ -47,5 +61,17 @@ void CheckRefinedPlausibility(const RobotParams& recorded, const RobotParams& re
 /// square runs whose odometry turns the other way (then the channels, or
 /// the ticks' sign, are swapped).
 int CountMirroredRuns(const TrajectoryData& data, const RobotParams& recorded);
+
+/// Unit mix-ups seen in the data before any fit; each returns a message
+/// (empty when fine). Return errors: the median return position error of
+/// the cw/ccw runs is at least kMaxErrorPerSide of the side (errors in
+/// millimetres written as metres, or a side too small).
+constexpr double kMaxErrorPerSide = 0.5;
+std::string CheckReturnErrorScale(const std::vector<ReturnError>& errors, double side_m);
+/// Trajectories: the median net wheel travel ((s_L + s_R)/2) of a square
+/// run against 4 * side, outside (1/kTravelRatio, kTravelRatio): a wrong
+/// side, ticks_per_rev or wheel diameter (e.g. in millimetres).
+constexpr double kTravelRatio = 2.0;
+std::string CheckTravelScale(const TrajectoryData& data, const RobotParams& recorded, double side_m);
 
 }  // namespace umbmark

@@ -9,6 +9,7 @@
 #include <toml++/toml.h>
 
 #include "core/errors.hpp"
+#include "core/plausible_units.hpp"
 #include "io/atomic_write.hpp"
 #include "io/robot_toml.hpp"
 #include "io/toml_util.hpp"
@@ -30,6 +31,7 @@ const toml::table& RequireTable(const toml::table& root, std::string_view key, c
 double PositiveValue(const toml::node& node, std::string_view key, const std::string& name) {
   const double v = detail::NumberValue(node, key, name);
   if (!(v > 0.0)) FailAt(name, node.source(), fmt::format("{} = {} must be > 0", key, v));
+  if (const std::string problem = ImplausibleValue(key, v); !problem.empty()) FailAt(name, node.source(), problem);
   return v;
 }
 

@@ -9,6 +9,7 @@
 #include <toml++/toml.h>
 
 #include "core/errors.hpp"
+#include "core/plausible_units.hpp"
 #include "io/atomic_write.hpp"
 #include "io/toml_util.hpp"
 
@@ -46,6 +47,13 @@ RobotParams RobotFromTableImpl(const toml::table& table, const std::string& name
       }
     }
     throw InputError(name, problem);
+  }
+  // Unit mix-ups (a wheelbase of 200: millimetres), refused at the value.
+  for (const auto key : kKeys) {
+    const toml::node* node = table.get(key);
+    if (node == nullptr) continue;
+    if (const std::string problem = ImplausibleValue(key, detail::NumberValue(*node, key, name)); !problem.empty())
+      detail::FailAt(name, node->source(), problem);
   }
   return robot;
 }
