@@ -5,11 +5,13 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <limits>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
 
 #include "core/angles.hpp"
+#include "stats/optimize.hpp"
 
 namespace umbmark::diag {
 
@@ -126,6 +128,17 @@ double TotalLogLik(const std::vector<double>& eps, const std::vector<PieceBases>
 constexpr double kTrimChi2[4] = {0.0, 10.83, 13.82, 16.27};
 /// 1 / E[m | m < q_0.999] * d for chi^2_3: the variance lost by trimming.
 constexpr double kTrimConsistency = 1.0051;
+
+/// FitBumps' stopping rule (NLopt Sbplx, per start): relative x and f
+/// tolerances and an evaluation limit. Against the hand-written Nelder-Mead
+/// it replaced (1e300 walls as bounds, stop at an f spread of 1e-6), on 3
+/// simulated bump_outliers campaigns, data/examples and June OptiOdom: the
+/// held-out log-likelihood gain is never lower (+0.001 to +0.12 nats; +73
+/// nats on OptiOdom, where Nelder-Mead stalled), verdicts identical, 1.2x
+/// the CPU time of the five diagnoses (18.1 s against 15.1 s).
+constexpr double kBumpFitXTolerance = 1e-4;
+constexpr double kBumpFitFTolerance = 1e-7;
+constexpr int kBumpFitMaxEvaluations = 1000;
 
 /// Gaussian log-likelihood without constants: -1/2 sum (m_j + log det C_j).
 double Objective(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
@@ -371,8 +384,10 @@ NoiseParams FitPieceNoise(const std::vector<double>& eps, const std::vector<Piec
 
 NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
                      const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start) {
-  // Nelder-Mead over x = [log kL2, log kR2, log rate, log sb2].
-  auto unpack = [&](const std::array<double, 4>& x) {
+  // Bounded minimisation (NLopt Sbplx) of -log L over x = [log kL2, log kR2,
+  // log rate, log sb2], from up to three starts; the box is the header's
+  // physical bumps.
+  auto unpack = [&](const std::vector<double>& x) {
     NoiseParams n = start;
     n.c_LR = 0.0;
     n.kL2 = std::exp(x[0]);
@@ -381,16 +396,11 @@ NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBase
     n.bump_s2 = std::exp(x[3]);
     return n;
   };
-  auto cost = [&](const std::array<double, 4>& x) {
-    for (double v : x)
-      if (!std::isfinite(v) || std::abs(v) > 60.0) return 1e300;
-    // Physical bumps only (see the header): outside, a steep wall.
-    if (x[2] < std::log(1e-4) || x[2] > std::log(2.0) || x[3] < std::log(1e-10) || x[3] > std::log(1e-2))
-      return 1e300;
-    return -TotalLogLik(eps, bases, pieces, use, unpack(x));
-  };
+  auto cost = [&](const std::vector<double>& x) { return -TotalLogLik(eps, bases, pieces, use, unpack(x)); };
+  const std::vector<double> lower = {-60.0, -60.0, std::log(1e-4), std::log(1e-10)};
+  const std::vector<double> upper = {60.0, 60.0, std::log(2.0), std::log(1e-2)};
   const double k2 = std::max(0.5 * (start.kL2 + start.kR2), 1e-12);
-  std::vector<std::array<double, 4>> starts = {
+  std::vector<std::vector<double>> starts = {
       {std::log(std::max(start.kL2, 1e-14) * 0.7), std::log(std::max(start.kR2, 1e-14) * 0.7), std::log(0.2),
        std::log(30.0 * k2)},
       {std::log(std::max(start.kL2, 1e-14) * 0.9), std::log(std::max(start.kR2, 1e-14) * 0.9), std::log(1.0),
@@ -402,72 +412,18 @@ NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBase
     x[2] = std::clamp(x[2], std::log(2e-4), std::log(1.9));
     x[3] = std::clamp(x[3], std::log(2e-10), std::log(0.5e-2));
   }
-  std::array<double, 4> best_x = starts.front();
-  double best_f = 1e300;
+  BoundedMinimizeOptions options;
+  options.initial_step = {0.5, 0.5, 1.0, 1.0};
+  options.x_tolerance = kBumpFitXTolerance;
+  options.f_tolerance = kBumpFitFTolerance;
+  options.max_evaluations = kBumpFitMaxEvaluations;
+  std::vector<double> best_x = starts.front();
+  double best_f = std::numeric_limits<double>::infinity();
   for (const auto& x0 : starts) {
-    std::array<std::array<double, 4>, 5> s;
-    std::array<double, 5> f;
-    s[0] = x0;
-    for (int i = 0; i < 4; ++i) {
-      s[i + 1] = x0;
-      s[i + 1][i] += i >= 2 ? 1.0 : 0.5;
-    }
-    for (int i = 0; i < 5; ++i) f[i] = cost(s[i]);
-    for (int it = 0; it < 250; ++it) {
-      std::array<int, 5> idx = {0, 1, 2, 3, 4};
-      std::sort(idx.begin(), idx.end(), [&](int a, int b) { return f[a] < f[b]; });
-      std::array<std::array<double, 4>, 5> s2;
-      std::array<double, 5> f2;
-      for (int i = 0; i < 5; ++i) {
-        s2[i] = s[idx[i]];
-        f2[i] = f[idx[i]];
-      }
-      s = s2;
-      f = f2;
-      if (std::abs(f[4] - f[0]) < 1e-6 * (1.0 + std::abs(f[0]))) break;
-      std::array<double, 4> c{};
-      for (int i = 0; i < 4; ++i)
-        for (int k = 0; k < 4; ++k) c[k] += s[i][k] / 4.0;
-      auto along = [&](double t) {
-        std::array<double, 4> x;
-        for (int k = 0; k < 4; ++k) x[k] = c[k] + t * (s[4][k] - c[k]);
-        return x;
-      };
-      const auto xr = along(-1.0);
-      const double fr = cost(xr);
-      if (fr < f[0]) {
-        const auto xe = along(-2.0);
-        const double fe = cost(xe);
-        if (fe < fr) {
-          s[4] = xe;
-          f[4] = fe;
-        } else {
-          s[4] = xr;
-          f[4] = fr;
-        }
-      } else if (fr < f[3]) {
-        s[4] = xr;
-        f[4] = fr;
-      } else {
-        const auto xc = along(fr < f[4] ? -0.5 : 0.5);
-        const double fc = cost(xc);
-        if (fc < std::min(fr, f[4])) {
-          s[4] = xc;
-          f[4] = fc;
-        } else {
-          for (int i = 1; i < 5; ++i) {
-            for (int k = 0; k < 4; ++k) s[i][k] = s[0][k] + 0.5 * (s[i][k] - s[0][k]);
-            f[i] = cost(s[i]);
-          }
-        }
-      }
-    }
-    int bi = 0;
-    for (int i = 1; i < 5; ++i)
-      if (f[i] < f[bi]) bi = i;
-    if (f[bi] < best_f) {
-      best_f = f[bi];
-      best_x = s[bi];
+    const BoundedMinimum m = MinimizeBounded(cost, x0, lower, upper, options);
+    if (m.f < best_f) {
+      best_f = m.f;
+      best_x = m.x;
     }
   }
   return unpack(best_x);

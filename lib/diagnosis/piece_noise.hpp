@@ -18,7 +18,7 @@
 // (m ~ Poisson(rate (|L| + |R|)), truncated at kMaxBumpsPerPiece) its covariance is
 //   C_j + m sigma_b^2 (A_L / |L| + A_R / |R|) / 2
 // (a bump's effect averaged over where on the piece, and which wheel, it
-// strikes). FitBumps maximises that mixture likelihood by Nelder-Mead.
+// strikes). FitBumps maximises that mixture likelihood (NLopt Sbplx, bounded).
 #pragma once
 
 #include <string>
@@ -92,7 +92,7 @@ NoiseParams FitPieceNoise(const std::vector<double>& eps, const std::vector<Piec
                      const PieceNoiseFitOptions& options);
 
 /// As FitPieceNoise, plus bump_outliers' rate and sigma_b (mixture likelihood,
-/// Nelder-Mead over log k_L^2, log k_R^2, log rate, log sigma_b^2; ground
+/// bounded Sbplx over log k_L^2, log k_R^2, log rate, log sigma_b^2; ground
 /// truth noise fixed at `start`'s). The search is bounded to physical
 /// bumps: rate in [1e-4, 2] per metre, sigma_b in [0.01, 100] mm.
 NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
