@@ -52,7 +52,9 @@ int RunDiagnose(DiagnoseCliOptions o) {
   const diag::CampaignData campaign = diag::LoadCampaign(o.manifest, o.diag.pieces);
   const diag::DiagnoseSummary s = [&] {
     Progress progress(fmt::format("diagnosing {} ({} null simulations)", o.manifest, o.diag.null_simulations));
-    return diag::Diagnose(campaign, o.diag);
+    diag::DiagnoseOptions d = o.diag;
+    d.progress = progress.Callback();
+    return diag::Diagnose(campaign, d);
   }();
   if (o.json.PrintText()) fmt::print("{}", diag::DiagnoseReport(s));
   nlohmann::json j = diag::DiagnoseToJson(s);

@@ -191,6 +191,7 @@ int RunPredict(const PredictOptions& o) {
     mo.threads = o.threads;
     const sim::MonteCarloSummary mc = [&] {
       Progress progress(fmt::format("Monte Carlo, {} runs", mo.runs));
+      mo.progress = progress.Callback();
       return sim::RunMonteCarlo(plan, mo);
     }();
     const Pose2 mc_mean{mc.mean.x, mc.mean.y, mc.mean.theta + theta_shift};

@@ -9,6 +9,7 @@
 
 #include "calibration/refine.hpp"
 #include "calibration/umbmark.hpp"
+#include "core/progress.hpp"
 #include "core/runs.hpp"
 #include "evaluation/return_error.hpp"
 #include "evaluation/trajectory_eval.hpp"
@@ -38,6 +39,9 @@ struct CalibrateJobOptions {
   /// A failed refined fit: false (default) throws RefineError; true keeps
   /// the classic result and records the failure in `refine_failure`.
   bool keep_classic_on_refine_failure = false;
+  /// Progress of the held-out comparison (heldout.hpp), in folds
+  /// (core/progress.hpp). Default: none.
+  ProgressCallback progress;
 };
 
 /// What the corrected parameters do on the same runs (trajectory input).

@@ -153,6 +153,7 @@ HeldoutComparison CompareMethodsHeldout(const CalibrateInput& input, const Calib
   }
   std::vector<bool> complete;  // every method predicted this fold
   std::vector<bool> in_fold(used.size(), false);
+  ProgressCounter progress(options.progress, static_cast<double>(folds.size()));
   for (std::size_t f = 0; f < folds.size(); ++f) {
     for (std::size_t k : folds[f]) in_fold[k] = true;
     std::vector<std::size_t> rest;
@@ -180,6 +181,7 @@ HeldoutComparison CompareMethodsHeldout(const CalibrateInput& input, const Calib
       all = all && std::isfinite(err);
     }
     complete.push_back(all);
+    progress.Add();
   }
   int formed = 0;
   for (std::size_t k = 0; k < complete.size(); ++k) {

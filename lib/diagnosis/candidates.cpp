@@ -268,7 +268,7 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
   const std::vector<sim::EffectKind>& effects = options.effects;
   out.candidates.resize(effects.size());
   out.projected.resize(effects.size());
-  ParallelFor(options.threads, static_cast<int>(effects.size()), [&](int i) {
+  const auto fit_one = [&](int i) {
     const auto ei = static_cast<std::size_t>(i);
     const sim::EffectKind kind = effects[ei];
     Candidate& cd = out.candidates[ei];
@@ -287,6 +287,11 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
     }
     cd.shrink = Shrink(Gap(cd.gap_after, null_median), x.gap_before);
     cd.evidence = cd.heldout_loglik_gain - options.complexity_penalty_nats * cd.parameters;
+  };
+  ProgressCounter progress(options.progress, static_cast<double>(effects.size()));
+  ParallelFor(options.threads, static_cast<int>(effects.size()), [&](int i) {
+    fit_one(i);
+    progress.Add();
   });
   return out;
 }

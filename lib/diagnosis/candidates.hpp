@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "core/progress.hpp"
 #include "diagnosis/baseline.hpp"
 #include "diagnosis/cross_validation.hpp"
 #include "diagnosis/gap_stats.hpp"
@@ -78,6 +79,8 @@ struct CandidateOptions {
   /// Threads (>= 1); results do not depend on them. Default 2.
   int threads = 2;
   GapOptions gap;
+  /// Progress in candidate effects fitted (core/progress.hpp). Default: none.
+  ProgressCallback progress;
 };
 
 struct CandidateFits {

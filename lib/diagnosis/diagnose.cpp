@@ -166,7 +166,9 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
   out.where = LocateGap(c, gap, options.where_top);
   out.piece_residuals = StandardisedPieceResiduals(c, base);
   const NullDistribution null = SimulateNullDistribution(
-      c, model, base, NullOptions{options.null_simulations, options.alpha, options.seed, options.threads, options.gap});
+      c, model, base,
+      NullOptions{options.null_simulations, options.alpha, options.seed, options.threads, options.gap,
+                  StageProgress(options.progress, 0.0, 400.0, 1000.0)});
   out.null_simulations = options.null_simulations;
   out.score_p_value = NullPValue(null.sorted, out.gap_score);
   out.null_median = null.median;
@@ -179,6 +181,7 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
   co.complexity_penalty_nats = options.complexity_penalty_nats;
   co.threads = options.threads;
   co.gap = options.gap;
+  co.progress = StageProgress(options.progress, 400.0, 700.0, 1000.0);
   const Folds folds = MakeFolds(c);
   const CandidateFits fits = FitCandidates(c, model, base, folds, out.gap_score, out.null_median, co);
   timer.Lap("candidate effects and cross-validation");
@@ -206,6 +209,7 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
     eo.negligible = options.negligible;
     eo.threads = options.threads;
     eo.gap = options.gap;
+    eo.progress = StageProgress(options.progress, 700.0, 1000.0, 1000.0);
     std::vector<sim::EffectKind> first;
     if (const auto k = sim::EffectFromString(out.verdict)) first.push_back(*k);
     const Explanation ex = Explain(c, model, base, folds, out.candidates, first, out.gap_score,
@@ -215,6 +219,7 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
     NameEffects(ex, options, out);
     timer.Lap("stepwise explanation");
   }
+  if (options.progress) options.progress(1000.0, 1000.0);
   out.next_steps = AdviseNextSteps(c, out);
   out.timings = timer.Finish();
   return out;

@@ -104,6 +104,11 @@ struct DiagnoseOptions {
   std::vector<sim::EffectKind> effects;
   PieceOptions pieces;
   GapOptions gap;
+  /// Progress of the whole diagnosis (core/progress.hpp), in thousandths:
+  /// 0-400 the null simulations, 400-700 the candidate fits, 700-1000 the
+  /// stepwise explanation (skipped, i.e. jumped over, without a significant
+  /// gap). Default: none.
+  ProgressCallback progress;
 
   std::string Check() const;
 };

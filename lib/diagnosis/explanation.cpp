@@ -188,10 +188,13 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
     ex.steps.push_back(s);
     current = f;
   };
+  ProgressCounter progress(options.progress,
+                           static_cast<double>(options.max_effects) * static_cast<double>(std::max<std::size_t>(candidates.size(), 1)));
   for (sim::EffectKind e : first) {
     std::vector<sim::EffectKind> set = chosen;
     set.push_back(e);
     add(e, FitSet(c, model, b, folds, set, options.gap));
+    progress.Add();
   }
   // Candidates worth trying: identifiable ones that gained held out alone.
   std::vector<sim::EffectKind> pool;
@@ -215,6 +218,7 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
       std::vector<sim::EffectKind> set = chosen;
       set.push_back(remaining[static_cast<std::size_t>(i)]);
       trial[static_cast<std::size_t>(i)] = FitSet(c, model, b, folds, set, options.gap);
+      progress.Add();
     });
     std::size_t best = 0;
     double best_evidence = -1e300;
@@ -231,6 +235,7 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
     }
     add(remaining[best], trial[best]);
   }
+  progress.Finish();
   ex.gap_left = current.gap_after > null_quantile;
   const PieceScatter scatter = Scatter(c, b);
   for (ExplanationStep& s : ex.steps) {

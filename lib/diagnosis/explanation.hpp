@@ -42,6 +42,10 @@ struct ExplanationOptions {
   /// Threads (>= 1); results do not depend on them. Default 2.
   int threads = 2;
   GapOptions gap;
+  /// Progress in effect sets fitted, of at most max_effects x the candidates
+  /// (core/progress.hpp); reaches the total when the search stops early.
+  /// Default: none.
+  ProgressCallback progress;
 };
 
 struct ExplanationStep {

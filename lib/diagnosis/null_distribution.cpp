@@ -154,8 +154,11 @@ NullDistribution SimulateNullDistribution(const CampaignData& c, const MeanModel
   for (Eigen::Index k = 0; k < A.rows(); ++k) A(k, k) *= 1.0 + 1e-12;
   const Eigen::MatrixXd K = A.ldlt().solve(Jw.transpose());
   std::vector<double> null(static_cast<std::size_t>(options.simulations));
-  ParallelFor(options.threads, options.simulations,
-              [&](int rep) { null[static_cast<std::size_t>(rep)] = SimulateNull(c, b, options, np, K, rep); });
+  ProgressCounter progress(options.progress, options.simulations);
+  ParallelFor(options.threads, options.simulations, [&](int rep) {
+    null[static_cast<std::size_t>(rep)] = SimulateNull(c, b, options, np, K, rep);
+    progress.Add();
+  });
   NullDistribution out;
   out.sorted = null;
   std::sort(out.sorted.begin(), out.sorted.end());

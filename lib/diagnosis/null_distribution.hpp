@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/progress.hpp"
 #include "diagnosis/baseline.hpp"
 #include "diagnosis/gap_stats.hpp"
 
@@ -24,6 +25,8 @@ struct NullOptions {
   /// Threads (>= 1); the result does not depend on them. Default 2.
   int threads = 2;
   GapOptions gap;
+  /// Progress in simulated campaigns (core/progress.hpp). Default: none.
+  ProgressCallback progress;
 };
 
 struct NullDistribution {

@@ -49,6 +49,7 @@ MonteCarloSummary RunMonteCarlo(const SimPlan& plan, const MonteCarloOptions& op
   MonteCarloSummary out;
   if (options.keep_runs) out.finals.resize(static_cast<std::size_t>(runs));
   const auto t0 = std::chrono::steady_clock::now();
+  ProgressCounter progress(options.progress, static_cast<double>(runs));
   ParallelFor(threads, nblocks, [&](std::int64_t k) {
     std::array<Pose2, kBlock> poses;
     const std::int64_t first = k * kBlock;
@@ -62,6 +63,7 @@ MonteCarloSummary RunMonteCarlo(const SimPlan& plan, const MonteCarloOptions& op
       s.outer += d * d.transpose();
       if (options.keep_runs) out.finals[static_cast<std::size_t>(first + i)] = p;
     }
+    progress.Add(static_cast<double>(n));
   });
   const auto t1 = std::chrono::steady_clock::now();
 

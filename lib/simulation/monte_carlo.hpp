@@ -10,6 +10,7 @@
 
 #include "error_models/wheel_noise.hpp"
 #include "core/pose2.hpp"
+#include "core/progress.hpp"
 #include "simulation/monte_carlo_plan.hpp"
 
 namespace umbmark::sim {
@@ -23,6 +24,8 @@ struct MonteCarloOptions {
   int threads = 0;
   /// Keep every run's final pose in the summary (memory: 24 bytes per run).
   bool keep_runs = false;
+  /// Progress in runs done of `runs` (core/progress.hpp). Default: none.
+  ProgressCallback progress;
 
   /// Empty when valid, else a message naming the bad field.
   std::string Check() const;
