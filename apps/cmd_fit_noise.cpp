@@ -19,6 +19,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "progress.hpp"
 #include "core/angles.hpp"
 #include "core/errors.hpp"
 #include "error_models/odometry_covariance.hpp"
@@ -332,6 +333,8 @@ int RunFitNoise(const FitNoiseOptions& o) {
       s = FitWheelNoiseWithSystematics([&](const SystematicErrors& x) { return Load(o, x).runs; }, fo, &e);
       estimated = e;
     } else {
+      Progress progress(fmt::format("fitting k_L, k_R to {} runs", data.runs.size()));
+      fo.progress = progress.Callback();
       s = FitWheelNoise(data.runs, fo);
     }
   } catch (const InputError& e) {

@@ -8,9 +8,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <mutex>
+#include <random>
 #include <vector>
 
 #include "core/progress.hpp"
+#include "error_models/path_covariance.hpp"
+#include "error_models/wheel_noise_fit.hpp"
 #include "diagnosis/diagnose.hpp"
 #include "simulation/campaign_sim.hpp"
 #include "simulation/monte_carlo.hpp"
@@ -146,4 +149,30 @@ TEST_CASE("umbmark: progress on a terminal only, with percentage; --quiet silenc
   CHECK(quiet.find("Monte Carlo, 60000 runs: ") == std::string::npos);
   CHECK(quiet.find("Monte Carlo (60000 runs") != std::string::npos);  // the result itself is printed
   ::unsetenv("UMBMARK_PROGRESS_DELAY_S");
+}
+
+TEST_CASE("progress callback: fit-noise reports its fit and both intervals", "[progress]") {
+  // 40 runs of a 10 m line whose return errors scatter by a few mm.
+  const std::vector<WheelSegment> path{{10.0, 10.0}};
+  const PathCovarianceSummary pc = PredictPathCovariance(path, 0.3, WheelNoise{}, PoseCovariance::Zero());
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> N01;
+  std::vector<WheelNoiseFitRun> runs;
+  for (int i = 0; i < 40; ++i) {
+    WheelNoiseFitRun r;
+    r.group = "line";
+    r.run = std::to_string(i + 1);
+    r.error = Eigen::Vector3d(0.003 * N01(rng), 0.02 * N01(rng), 0.004 * N01(rng));
+    r.basis = pc.motion;
+    r.measurement = MeasurementCovariance(1e-3, 1e-3, pc.mean);
+    runs.push_back(r);
+  }
+  Recorder rec;
+  WheelNoiseFitOptions o;
+  o.progress = rec.Callback();
+  const WheelNoiseFitSummary s = FitWheelNoise(runs, o);
+  CHECK(s.k_L > 0.0);
+  REQUIRE(rec.calls.size() == 3);
+  CHECK(rec.Monotone());
+  CHECK(rec.calls.back() == std::make_pair(3.0, 3.0));
 }

@@ -267,7 +267,9 @@ WheelNoiseFitSummary FitWheelNoise(const std::vector<WheelNoiseFitRun>& runs, co
   double nll0 = 0.0;
   if (!ProfiledNll(runs, grp, q(0), q(1), &nll0))
     throw QualityGateError("fit-noise: the starting point has a singular run covariance");
+  ProgressCounter progress(options.progress, options.intervals ? 3.0 : 1.0);
   const Minimum best = Minimise(cost, start, options.max_iterations);
+  progress.Add();
   if (!best.ok)
     throw QualityGateError(fmt::format("fit-noise: the maximum-likelihood solver did not converge ({})", best.message));
 
@@ -318,7 +320,9 @@ WheelNoiseFitSummary FitWheelNoise(const std::vector<WheelNoiseFitRun>& runs, co
   };
   if (options.intervals) {
     out.k_L_ci = interval(0);
+    progress.Add();
     out.k_R_ci = interval(1);
+    progress.Add();
   } else {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     out.k_L_ci = out.k_R_ci = {nan, nan};

@@ -36,6 +36,7 @@
 
 #include <Eigen/Core>
 
+#include "core/progress.hpp"
 #include "error_models/path_spec.hpp"
 #include "error_models/second_order.hpp"
 #include "error_models/wheel_noise.hpp"
@@ -81,6 +82,9 @@ struct WheelNoiseFitOptions {
   /// Compute the profile-likelihood intervals (the costly part). false:
   /// k_L_ci, k_R_ci are left NaN (inner fits of a joint estimate).
   bool intervals = true;
+  /// Progress in stages (core/progress.hpp): the maximum-likelihood fit,
+  /// then each of the two profile intervals. Default: none.
+  ProgressCallback progress;
   /// Empty when valid, else a message naming the bad field.
   std::string Check() const;
 };

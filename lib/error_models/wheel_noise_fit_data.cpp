@@ -185,6 +185,7 @@ WheelNoiseFitSummary FitWheelNoiseWithSystematics(
     const WheelNoiseFitOptions& options, SystematicErrors* estimated) {
   WheelNoiseFitOptions quick = options;
   quick.intervals = false;
+  quick.progress = nullptr;  // only the final fit reports (its stages are the long part)
   const std::vector<WheelNoiseFitRun> runs0 = build(SystematicErrors{});
   const SystematicErrors from_means = EstimateSystematicErrors(runs0, FitWheelNoise(runs0, quick));
   // E_d by profile likelihood, the mean diameter factor and E_b kept.
