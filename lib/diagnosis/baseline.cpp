@@ -35,15 +35,7 @@ BaselineStart StartBaseline(const CampaignData& c, bool use_refine) {
         sq.side_m = c.experiments[e].side_m;
         sq.recorded = c.robot;
         sq.source = c.experiments[e].file;
-        for (const auto& r : std::get<EndpointData>(c.files[e]).runs) {
-          ReturnError re;
-          re.run = r.run;
-          re.direction = r.direction;
-          re.ex_m = r.ex_m;
-          re.ey_m = r.ey_m;
-          re.etheta_rad = r.etheta_rad;
-          sq.errors.push_back(re);
-        }
+        sq.errors = std::get<EndpointData>(c.files[e]).runs;
         ssets.push_back(sq);
       }
     }

@@ -399,121 +399,139 @@ void BuildEndpointRun(DiagRun& r, const ReturnError& e, double side_m, const Rob
   r.has_heading = e.etheta_rad.has_value();
 }
 
-}  // namespace
+/// Adds the runs and pieces of one experiment's file to a campaign: the
+/// shared bookkeeping (run numbering, subsets, folds) and one function per
+/// kind of file.
+class CampaignBuilder {
+ public:
+  CampaignBuilder(CampaignData& c, const Manifest& manifest, const PieceOptions& options)
+      : c_(c), manifest_(manifest), options_(options), subsets_{{}, &c.subsets} {}
 
-CampaignData BuildCampaign(const Manifest& manifest, const std::vector<std::variant<EndpointData, TrajectoryData>>& files,
-                           const PieceOptions& options) {
-  if (auto e = options.Check(); !e.empty()) throw InvalidOptions("PieceOptions: " + e);
-  if (files.size() != manifest.experiments.size())
-    throw InvalidOptions("BuildCampaign: one data file per experiment is needed");
-  CampaignData c;
-  c.path = manifest.path;
-  c.robot = manifest.robot;
-  c.ground_truth = manifest.ground_truth;
-  c.folds = options.folds;
-  SubsetTable subsets{{}, &c.subsets};
-  bool any_ticks = false;
-  int campaign_index = 0;
-  for (std::size_t e = 0; e < manifest.experiments.size(); ++e) {
-    const Experiment& ex = manifest.experiments[e];
+  void AddExperiment(std::size_t e, const std::variant<EndpointData, TrajectoryData>& file) {
+    const Experiment& ex = manifest_.experiments[e];
     ExperimentInfo info;
     info.kind = ex.kind;
     info.file = ex.file;
     info.side_m = ex.side_m;
     info.distance_m = ex.distance_m;
-    const std::string& fname = ex.resolved_file.empty() ? ex.file : ex.resolved_file;
-    std::map<std::string, int> per_direction;
-    auto fold_of = [&](const std::string& direction) { return per_direction[direction]++ % options.folds; };
-    if (const auto* ep = std::get_if<EndpointData>(&files[e])) {
-      if (ex.kind != ExperimentKind::kSquare)
-        throw InputError(fname, fmt::format("experiment {} ({}): endpoint data is only usable for squares", e + 1,
-                                            ExperimentKindToString(ex.kind)));
-      info.endpoint = true;
-      for (const ReturnError& er : ep->runs) {
-        if (!SquareDirectionFromString(er.direction))
-          throw InputError(fname, er.line, 0, fmt::format("run {}: direction '{}' must be cw or ccw", er.run, er.direction));
-        DiagRun r;
-        r.experiment = static_cast<int>(e);
-        r.index_in_experiment = info.runs++;
-        r.campaign_index = campaign_index++;
-        r.id = er.run;
-        r.direction = er.direction;
-        r.endpoint = true;
-        BuildEndpointRun(r, er, ex.side_m, manifest.robot);
-        sim::MotionOptions mo = options.motion;
-        mo.min_stand_intervals = 2;
-        r.motions = sim::SegmentMotions(r.left, r.right, manifest.robot.wheelbase_m, mo);
+    per_direction_.clear();
+    if (const auto* ep = std::get_if<EndpointData>(&file))
+      AddEndpointRuns(e, *ep, info);
+    else
+      AddTrajectoryRuns(e, std::get<TrajectoryData>(file), info);
+    c_.experiments.push_back(info);
+  }
+
+  bool any_ticks() const { return any_ticks_; }
+
+ private:
+  const std::string& FileName(const Experiment& ex) const { return ex.resolved_file.empty() ? ex.file : ex.resolved_file; }
+
+  /// Cross-validation fold of the next run in `direction`: runs of each
+  /// direction are dealt to the folds in turn.
+  int FoldOf(const std::string& direction) { return per_direction_[direction]++ % options_.folds; }
+
+  /// A run with its place in the experiment and the campaign.
+  DiagRun NewRun(std::size_t e, ExperimentInfo& info, const std::string& id, const std::string& direction) {
+    DiagRun r;
+    r.experiment = static_cast<int>(e);
+    r.index_in_experiment = info.runs++;
+    r.campaign_index = campaign_index_++;
+    r.id = id;
+    r.direction = direction;
+    return r;
+  }
+
+  void AddEndpointRuns(std::size_t e, const EndpointData& ep, ExperimentInfo& info) {
+    const Experiment& ex = manifest_.experiments[e];
+    if (ex.kind != ExperimentKind::kSquare)
+      throw InputError(FileName(ex), fmt::format("experiment {} ({}): endpoint data is only usable for squares", e + 1,
+                                                 ExperimentKindToString(ex.kind)));
+    info.endpoint = true;
+    for (const ReturnError& er : ep.runs) {
+      if (!SquareDirectionFromString(er.direction))
+        throw InputError(FileName(ex), er.line, 0,
+                         fmt::format("run {}: direction '{}' must be cw or ccw", er.run, er.direction));
+      DiagRun r = NewRun(e, info, er.run, er.direction);
+      r.endpoint = true;
+      BuildEndpointRun(r, er, ex.side_m, manifest_.robot);
+      sim::MotionOptions mo = options_.motion;
+      mo.min_stand_intervals = 2;
+      r.motions = sim::SegmentMotions(r.left, r.right, manifest_.robot.wheelbase_m, mo);
+      r.q_sd_left.assign(r.t.size(), 0.0);
+      r.q_sd_right.assign(r.t.size(), 0.0);
+      AnnotateIntervals(r);
+      FindJunctions(r);
+      const int fold = FoldOf(r.direction);
+      c_.runs.push_back(std::move(r));
+      const DiagRun& run = c_.runs.back();
+      Piece p;
+      p.run = static_cast<int>(c_.runs.size()) - 1;
+      p.a = p.a_lo = p.a_hi = 0;
+      p.b = p.b_lo = p.b_hi = run.t.size() - 1;
+      p.type = PieceType::kReturn;
+      p.components = run.has_heading ? 3 : 2;
+      p.subset = subsets_.Get(static_cast<int>(e), run.direction + ", return error");
+      p.pooled_subset = subsets_.Get(static_cast<int>(e), "all runs, return error");
+      p.fold = fold;
+      p.travel_m = 4.0 * ex.side_m;
+      c_.pieces.push_back(p);
+    }
+  }
+
+  void AddTrajectoryRuns(std::size_t e, const TrajectoryData& td, ExperimentInfo& info) {
+    const Experiment& ex = manifest_.experiments[e];
+    const RobotParams& robot = manifest_.robot;
+    for (const TrajectoryRun& tr : td.runs) {
+      if (tr.size() < 2) continue;
+      if (!tr.HasGroundTruth(0) || !tr.HasGroundTruth(tr.size() - 1))
+        throw InputError(FileName(ex), tr.lines.empty() ? 0 : tr.lines.front(), 0,
+                         fmt::format("run {}: ground truth is needed at its first and last sample", tr.run));
+      DiagRun r = NewRun(e, info, tr.run, tr.direction);
+      const WheelTravel w = ComputeWheelTravel(tr, robot, robot);
+      any_ticks_ = any_ticks_ || tr.has_ticks();
+      r.t = tr.t_s;
+      r.left = w.left_m;
+      r.right = w.right_m;
+      r.gt.resize(tr.size());
+      r.has_gt.resize(tr.size());
+      for (std::size_t i = 0; i < tr.size(); ++i) {
+        r.has_gt[i] = tr.HasGroundTruth(i);
+        r.gt[i] = r.has_gt[i] ? tr.GroundTruth(i) : Pose2{kNan, kNan, kNan};
+      }
+      sim::MotionOptions mo = options_.motion;
+      if (tr.has_ticks()) mo.stand_eps_m = 0.5 * std::min(robot.MetresPerTickLeft(), robot.MetresPerTickRight());
+      r.motions = sim::SegmentMotions(r.left, r.right, robot.wheelbase_m, mo);
+      if (tr.has_ticks()) {
+        QuantisationPhase(tr.ticks_left, r.motions, robot.MetresPerTickLeft(), r.left, r.q_sd_left);
+        QuantisationPhase(tr.ticks_right, r.motions, robot.MetresPerTickRight(), r.right, r.q_sd_right);
+      } else {
         r.q_sd_left.assign(r.t.size(), 0.0);
         r.q_sd_right.assign(r.t.size(), 0.0);
-        AnnotateIntervals(r);
-        FindJunctions(r);
-        const int fold = fold_of(r.direction);
-        c.runs.push_back(std::move(r));
-        Piece p;
-        p.run = static_cast<int>(c.runs.size()) - 1;
-        p.a = p.a_lo = p.a_hi = 0;
-        p.b = p.b_lo = p.b_hi = c.runs.back().t.size() - 1;
-        p.type = PieceType::kReturn;
-        p.components = c.runs.back().has_heading ? 3 : 2;
-        p.subset = subsets.Get(static_cast<int>(e), c.runs.back().direction + ", return error");
-        p.pooled_subset = subsets.Get(static_cast<int>(e), "all runs, return error");
-        p.fold = fold;
-        p.travel_m = 4.0 * ex.side_m;
-        c.pieces.push_back(p);
       }
-    } else {
-      const TrajectoryData& td = std::get<TrajectoryData>(files[e]);
-      for (const TrajectoryRun& tr : td.runs) {
-        if (tr.size() < 2) continue;
-        if (!tr.HasGroundTruth(0) || !tr.HasGroundTruth(tr.size() - 1))
-          throw InputError(fname, tr.lines.empty() ? 0 : tr.lines.front(), 0,
-                           fmt::format("run {}: ground truth is needed at its first and last sample", tr.run));
-        DiagRun r;
-        r.experiment = static_cast<int>(e);
-        r.index_in_experiment = info.runs++;
-        r.campaign_index = campaign_index++;
-        r.id = tr.run;
-        r.direction = tr.direction;
-        const WheelTravel w = ComputeWheelTravel(tr, manifest.robot, manifest.robot);
-        any_ticks = any_ticks || tr.has_ticks();
-        r.t = tr.t_s;
-        r.left = w.left_m;
-        r.right = w.right_m;
-        r.gt.resize(tr.size());
-        r.has_gt.resize(tr.size());
-        for (std::size_t i = 0; i < tr.size(); ++i) {
-          r.has_gt[i] = tr.HasGroundTruth(i);
-          r.gt[i] = r.has_gt[i] ? tr.GroundTruth(i) : Pose2{kNan, kNan, kNan};
-        }
-        sim::MotionOptions mo = options.motion;
-        if (tr.has_ticks())
-          mo.stand_eps_m = 0.5 * std::min(manifest.robot.MetresPerTickLeft(), manifest.robot.MetresPerTickRight());
-        r.motions = sim::SegmentMotions(r.left, r.right, manifest.robot.wheelbase_m, mo);
-        if (tr.has_ticks()) {
-          QuantisationPhase(tr.ticks_left, r.motions, manifest.robot.MetresPerTickLeft(), r.left, r.q_sd_left);
-          QuantisationPhase(tr.ticks_right, r.motions, manifest.robot.MetresPerTickRight(), r.right, r.q_sd_right);
-        } else {
-          r.q_sd_left.assign(r.t.size(), 0.0);
-          r.q_sd_right.assign(r.t.size(), 0.0);
-        }
-        AnnotateIntervals(r);
-        FindJunctions(r);
-        const int fold = fold_of(r.direction);
-        c.runs.push_back(std::move(r));
-        const std::size_t before = c.pieces.size();
-        AddTrajectoryPieces(c, static_cast<int>(c.runs.size()) - 1, ex.kind, options, subsets);
-        for (std::size_t k = before; k < c.pieces.size(); ++k) c.pieces[k].fold = fold;
-      }
+      AnnotateIntervals(r);
+      FindJunctions(r);
+      const int fold = FoldOf(r.direction);
+      c_.runs.push_back(std::move(r));
+      const std::size_t before = c_.pieces.size();
+      AddTrajectoryPieces(c_, static_cast<int>(c_.runs.size()) - 1, ex.kind, options_, subsets_);
+      for (std::size_t k = before; k < c_.pieces.size(); ++k) c_.pieces[k].fold = fold;
     }
-    c.experiments.push_back(info);
   }
-  if (any_ticks) {
-    c.tick_left_m = manifest.robot.MetresPerTickLeft();
-    c.tick_right_m = manifest.robot.MetresPerTickRight();
-  }
-  if (c.pieces.empty()) throw InputError(manifest.path, "no run of the campaign gives a piece to compare with the model");
-  // A pooled subset holding exactly the pieces of one finer subset (one
-  // direction only, one experiment only) would repeat its statistics.
+
+  CampaignData& c_;
+  const Manifest& manifest_;
+  const PieceOptions& options_;
+  SubsetTable subsets_;
+  std::map<std::string, int> per_direction_;
+  int campaign_index_ = 0;
+  bool any_ticks_ = false;
+};
+
+/// A pooled subset holding exactly the pieces of one finer subset (one
+/// direction only, one experiment only) would repeat its statistics: it is
+/// dropped.
+void DropRepeatedSubsets(CampaignData& c) {
   auto drop_duplicates = [&](int Piece::*coarse, auto fine_of) {
     std::map<int, std::map<int, int>> members;  // coarse -> finer -> count
     std::map<int, int> size, fine_size;
@@ -532,6 +550,28 @@ CampaignData BuildCampaign(const Manifest& manifest, const std::vector<std::vari
   drop_duplicates(&Piece::pooled_subset, [](const Piece& p) { return p.subset; });
   drop_duplicates(&Piece::campaign_subset,
                   [](const Piece& p) { return p.pooled_subset >= 0 ? p.pooled_subset : p.subset; });
+}
+
+}  // namespace
+
+CampaignData BuildCampaign(const Manifest& manifest, const std::vector<std::variant<EndpointData, TrajectoryData>>& files,
+                           const PieceOptions& options) {
+  if (auto e = options.Check(); !e.empty()) throw InvalidOptions("PieceOptions: " + e);
+  if (files.size() != manifest.experiments.size())
+    throw InvalidOptions("BuildCampaign: one data file per experiment is needed");
+  CampaignData c;
+  c.path = manifest.path;
+  c.robot = manifest.robot;
+  c.ground_truth = manifest.ground_truth;
+  c.folds = options.folds;
+  CampaignBuilder builder(c, manifest, options);
+  for (std::size_t e = 0; e < manifest.experiments.size(); ++e) builder.AddExperiment(e, files[e]);
+  if (builder.any_ticks()) {
+    c.tick_left_m = manifest.robot.MetresPerTickLeft();
+    c.tick_right_m = manifest.robot.MetresPerTickRight();
+  }
+  if (c.pieces.empty()) throw InputError(manifest.path, "no run of the campaign gives a piece to compare with the model");
+  DropRepeatedSubsets(c);
   c.files = files;
   return c;
 }
