@@ -7,6 +7,7 @@
 // complete old or complete new, with no temporary file behind.
 #include <catch2/catch.hpp>
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdlib>
@@ -14,6 +15,7 @@
 #include <fstream>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "support/run_cli.hpp"
 
@@ -176,7 +178,8 @@ TEST_CASE("fault injection: simulate killed at every rename", "[safety][simulate
       CHECK((tree == old_tree || tree == new_tree));
       if (n <= 5) CHECK(r.status >= 128);
       if (n == 6) CHECK(tree == new_tree);
-      // SIGKILL cannot be caught: its temporaries stay (named .NAME.tmp.PID.*).
+      // SIGKILL cannot be caught: its temporaries stay (.NAME.tmp.PID.HOST.*)
+      // until the next run that writes the same output (tested below).
       if (std::string(sig) != "KILL") CHECK(Temporaries(dir) == 0);
       if (n == 6) {
         ::unsetenv("UMBMARK_TEST_KILL_AT_RENAME");
@@ -209,5 +212,84 @@ TEST_CASE("fault injection: calibrate --json --ros2 --plot killed at every renam
       CHECK((now == text || now == new_files.at(name)));
     }
     CHECK(Temporaries(dir) == 0);
+  }
+}
+
+namespace {
+
+/// Names (not recursive) in `dir` that look like our temporaries.
+std::vector<std::string> TemporaryNames(const fs::path& dir) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename().string().find(".tmp.") != std::string::npos) out.push_back(e.path().filename().string());
+  return out;
+}
+
+/// A PID that no longer runs: a child that has exited and been reaped.
+long DeadPid() {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  return child;
+}
+
+/// `name` (".NAME.tmp.PID.HOST.SUFFIX") with its PID or HOST field replaced.
+std::string WithField(const std::string& name, const std::string& head, int field, const std::string& value) {
+  std::string rest = name.substr(head.size());
+  const auto dot1 = rest.find('.'), dot2 = rest.find('.', dot1 + 1);
+  if (field == 0) return head + value + rest.substr(dot1);
+  return head + rest.substr(0, dot1 + 1) + value + rest.substr(dot2);
+}
+
+}  // namespace
+
+TEST_CASE("SIGKILL leaves temporaries; the next write of the same output deletes them", "[safety][cli][fault]") {
+  SECTION("calibrate --json: a file") {
+    const fs::path dir = CopyExamples("sweepfile");
+    const std::string cmd = Calibrate(dir, "--json " + Q(dir / "o.json"));
+    {
+      ScopedEnv kill_at("UMBMARK_TEST_KILL_AT_RENAME", "1");
+      ScopedEnv kill_sig("UMBMARK_TEST_KILL_SIGNAL", "KILL");
+      CHECK(RunCli(cmd).status == 128 + 9);
+    }
+    const auto left = TemporaryNames(dir);
+    REQUIRE(left.size() == 1);  // ".o.json.tmp.PID.HOST.N"
+    const std::string head = ".o.json.tmp.";
+    REQUIRE(left[0].rfind(head, 0) == 0);
+    // Temporaries that must stay: a live process's (this test's PID) and a
+    // dead PID of another host (its PID means nothing here).
+    const std::string live = WithField(left[0], head, 0, std::to_string(::getpid()));
+    const std::string other_host = WithField(WithField(left[0], head, 1, "otherhost"), head, 0, std::to_string(DeadPid()));
+    const std::string dead_here = WithField(left[0], head, 0, std::to_string(DeadPid()));
+    Write(dir / live, "x");
+    Write(dir / other_host, "x");
+    Write(dir / dead_here, "x");
+    Write(dir / ".endpoints.csv.tmp.1.x.1", "another output's temporary");
+    REQUIRE(RunCli(cmd).status == 0);
+    CHECK(fs::exists(dir / "o.json"));
+    CHECK_FALSE(fs::exists(dir / left[0]));
+    CHECK_FALSE(fs::exists(dir / dead_here));
+    CHECK(fs::exists(dir / live));
+    CHECK(fs::exists(dir / other_host));
+    CHECK(fs::exists(dir / ".endpoints.csv.tmp.1.x.1"));
+  }
+  SECTION("simulate --out: the staging folder") {
+    const fs::path dir = umbmark::testing::TempDir("sweepdir");
+    Write(dir / "m.toml",
+          "[robot]\nwheelbase_m = 0.3\nwheel_diameter_left_m = 0.08\nwheel_diameter_right_m = 0.08\n"
+          "ticks_per_rev = 2000\n\n[[experiment]]\nkind = \"square\"\nside_m = 1.0\nfile = \"sq.csv\"\n");
+    const std::string sim = "simulate " + Q(dir / "m.toml") + " --square-runs 2 --out " + Q(dir / "out");
+    {
+      ScopedEnv kill_at("UMBMARK_TEST_KILL_AT_RENAME", "2");
+      ScopedEnv kill_sig("UMBMARK_TEST_KILL_SIGNAL", "KILL");
+      CHECK(RunCli(sim).status == 128 + 9);
+    }
+    REQUIRE(TemporaryNames(dir).size() == 1);  // ".out.tmp.PID.HOST.XXXXXX/" with files inside
+    CHECK_FALSE(fs::exists(dir / "out"));
+    REQUIRE(RunCli(sim).status == 0);
+    CHECK(TemporaryNames(dir).empty());
+    CHECK(Temporaries(dir) == 0);
+    CHECK(fs::exists(dir / "out" / "sq.csv"));
   }
 }

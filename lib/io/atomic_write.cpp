@@ -115,6 +115,59 @@ bool InPendingDirectory(const fs::path& p) {
   return false;
 }
 
+// ---- Temporaries left by SIGKILL ----------------------------------------
+// Temporary names are ".NAME.tmp.PID.HOST.SUFFIX": the next write of NAME
+// deletes those whose HOST is this machine and whose PID no longer runs.
+
+/// This machine's name, reduced to [A-Za-z0-9-] (at most 32 characters) so
+/// it never contains the '.' that separates the name's fields.
+const std::string& HostTag() {
+  static const std::string tag = [] {
+    char buf[256] = {};
+    std::string out;
+    if (::gethostname(buf, sizeof buf - 1) == 0) {
+      for (const char* c = buf; *c && out.size() < 32; ++c) {
+        const bool keep = (*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') || *c == '-';
+        out += keep ? *c : '-';
+      }
+    }
+    return out.empty() ? std::string("host") : out;
+  }();
+  return tag;
+}
+
+/// ".NAME.tmp.PID.HOST." for this process.
+std::string TemporaryPrefix(const std::string& name) {
+  return fmt::format(".{}.tmp.{}.{}.", name, ::getpid(), HostTag());
+}
+
+/// Deletes, in `dir`, the temporaries of `name` that a process of this host
+/// left behind and that no longer runs (kill(pid, 0) fails with ESRCH; a
+/// process of another user, EPERM, is alive). Best effort: errors are ignored.
+void SweepStaleTemporaries(const fs::path& dir, const std::string& name) noexcept {
+  const std::string head = "." + name + ".tmp.";
+  std::error_code ec;
+  fs::directory_iterator it(dir.empty() ? fs::path(".") : dir, ec);
+  if (ec) return;
+  for (const fs::directory_iterator end; it != end; it.increment(ec)) {
+    if (ec) return;
+    const std::string entry = it->path().filename().string();
+    if (entry.rfind(head, 0) != 0) continue;
+    // PID.HOST.SUFFIX
+    const std::string rest = entry.substr(head.size());
+    const auto dot1 = rest.find('.');
+    if (dot1 == std::string::npos || dot1 == 0 || dot1 > 10) continue;
+    if (rest.find_first_not_of("0123456789") < dot1) continue;
+    const auto dot2 = rest.find('.', dot1 + 1);
+    if (dot2 == std::string::npos || rest.compare(dot1 + 1, dot2 - dot1 - 1, HostTag()) != 0) continue;
+    const long pid = std::strtol(rest.c_str(), nullptr, 10);
+    if (pid <= 0 || pid == ::getpid() || pid > 0x7fffffffL) continue;
+    if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
+    std::error_code rm;
+    fs::remove_all(it->path(), rm);
+  }
+}
+
 bool UnderSpecialTree(const std::string& p) {
   return p == "/dev" || p.rfind("/dev/", 0) == 0 || p == "/proc" || p.rfind("/proc/", 0) == 0;
 }
@@ -157,11 +210,12 @@ void WriteFileAtomically(const std::string& path, std::string_view content) {
   struct stat old {};
   const bool had_old = ::stat(target.c_str(), &old) == 0;
 
+  SweepStaleTemporaries(target.parent_path(), target.filename().string());
   static std::atomic<unsigned> counter{0};
   std::string tmp;
   int fd = -1;
   for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
-    const std::string tmp_name = fmt::format(".{}.tmp.{}.{}", target.filename().string(), ::getpid(), counter++);
+    const std::string tmp_name = TemporaryPrefix(target.filename().string()) + std::to_string(counter++);
     tmp = (target.parent_path() / tmp_name).string();
     fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd < 0 && errno != EEXIST) {
@@ -221,7 +275,8 @@ std::string MakeStagingDirectory(const std::string& dir) {
     if (!d.has_filename()) d = d.parent_path();
   }
   const fs::path parent = d.parent_path().empty() ? fs::path(".") : d.parent_path();
-  std::string templ = (parent / fmt::format(".{}.tmp.{}.XXXXXX", d.filename().string(), ::getpid())).string();
+  SweepStaleTemporaries(parent, d.filename().string());
+  std::string templ = (parent / (TemporaryPrefix(d.filename().string()) + "XXXXXX")).string();
   if (::mkdtemp(templ.data()) == nullptr) {
     throw InputError(dir, fmt::format("cannot create a temporary folder in '{}': {}", parent.string(), ErrnoText(errno)));
   }

@@ -23,7 +23,10 @@ namespace umbmark::io {
 /// device, FIFO, socket or directory, and links into /dev or /proc (e.g.
 /// /dev/stdout; use '-' for standard output). The new file keeps the old
 /// file's permission bits. Throws InputError(path, reason) on failure; the
-/// temporary file is removed on every error path.
+/// temporary file is removed on every error path. The temporary is named
+/// ".NAME.tmp.PID.HOST.N"; leftovers of NAME from a process of this host
+/// that no longer runs (SIGKILL) are deleted first (also for staging
+/// directories).
 void WriteFileAtomically(const std::string& path, std::string_view content);
 
 /// Where WriteFileAtomically(path) would write: the final regular-file path
