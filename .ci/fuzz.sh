@@ -5,7 +5,9 @@
 # of tests/data/rosbag2 for fuzz_mcap and fuzz_cdr). Fails on any crash, sanitizer
 # report, timeout or out-of-memory; the reproducer is left in
 # $FUZZ_BUILD_DIR/artifacts/.
-#   env: FUZZ_SECONDS (60), FUZZ_NEW_SECONDS (30: fuzz_params_json), FUZZ_BUILD_DIR (build-fuzz), FUZZ_CXX (clang++)
+# Budget with the defaults: 4 targets x 60 s + 3 x 30 s (fuzz_params_json,
+# fuzz_manifest, fuzz_endpoint_csv) = 5.5 min of fuzzing plus the build.
+#   env: FUZZ_SECONDS (60), FUZZ_NEW_SECONDS (30: the three newer targets), FUZZ_BUILD_DIR (build-fuzz), FUZZ_CXX (clang++)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -109,6 +111,13 @@ for target in "${targets[@]}"; do
     fuzz_cdr)
       dict=""
       cp tests/data/rosbag2/cdr/*.bin "$seeds/" ;;
+    fuzz_manifest)
+      dict=toml.dict
+      find tests/data data -maxdepth 3 -type f -name '*.toml' -exec cp {} "$seeds/" \; ;;
+    fuzz_endpoint_csv)
+      dict=csv.dict
+      find tests/data data -maxdepth 3 -type f -name '*.csv' -size -64k -exec grep -l -e 'ex_m' -e 'ex_mm' -e 'x_abs' {} + \
+        | xargs -r cp -t "$seeds/" ;;
     fuzz_params_json)
       dict=json.dict
       cat > "$seeds/cal.json" <<'JSON'
@@ -123,7 +132,7 @@ JSON
   esac
   # Targets added by issue 9 run FUZZ_NEW_SECONDS (default 30) to keep CI short.
   t_seconds=$seconds
-  case $target in fuzz_params_json) t_seconds=${FUZZ_NEW_SECONDS:-30} ;; esac
+  case $target in fuzz_params_json | fuzz_manifest | fuzz_endpoint_csv) t_seconds=${FUZZ_NEW_SECONDS:-30} ;; esac
   echo "== $target: $(ls "$seeds" | wc -l) seed files, $(ls "$corpus" | wc -l) corpus files, ${t_seconds} s"
   args=(-max_total_time="$t_seconds" -timeout=10 -rss_limit_mb=2048 -max_len=16384 -print_final_stats=1
         -artifact_prefix="$build/artifacts/$target-")
