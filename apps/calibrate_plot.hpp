@@ -1,8 +1,10 @@
 // Plots of a calibration (calibrate --plot SVG and --report): the cw/ccw
 // return errors before and after correction on ONE common scale, with the
 // centres of gravity and their 95% SEM ellipses and the E_max,syst circles;
-// and, for trajectory input, each run's path: ground truth vs odometry with
-// the recorded and with the corrected parameters.
+// and, for trajectory input, every run's path (small multiples in file
+// order, up to 48: beyond, the 48 with the largest final error after
+// correction): ground truth vs odometry with the recorded and with the
+// corrected parameters, the 3 largest final errors marked.
 #pragma once
 
 #include <string>

@@ -438,7 +438,7 @@ std::string CalibrationReportHtml(const nlohmann::json& j, const CalibrateJobRes
   }
   rep.Heading("Plots");
   rep.Figure(plot_svg, fmt::format("Return errors before and after correction with the {} parameters, on one scale; "
-                                   "then each run's path (first runs).",
+                                   "then every run's path (up to 48; the largest final errors after correction marked).",
                                    which));
   return rep.Render();
 }

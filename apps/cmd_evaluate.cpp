@@ -88,14 +88,22 @@ void PrintSummary(const char* title, const EvaluationSummary& s) {
              Rad2Deg(s.max_max_heading_error_rad));
 }
 
-/// Runs drawn in the --plot figure (the first ones; keeps it readable).
-constexpr std::size_t kPlotRuns = 12;
+/// Runs kept for the --plot figure: every run up to this many (the plot
+/// says when there were more).
+constexpr std::size_t kPlotRuns = 200;
+/// Runs with the largest final error: highlighted and drawn as paths.
+constexpr std::size_t kWorstRuns = 8;
 
-// Position and heading error along the travelled distance for every run,
-// recorded parameters vs --params (one common scale), then the paths of the
-// first runs: what `evaluate --plot` and its report show.
-std::string PlotSvg(const std::vector<PlotRun>& runs, const std::optional<RobotParams>& params, Integrator integ) {
-  const io::SvgStyle rec{"#c0392b", "", "5,3", 1.2, false}, par{"#1f7a3a", "", "", 1.6, false};
+// Position and heading error along the travelled distance for every run
+// (thin lines; recorded parameters vs --params, one common scale), the
+// kWorstRuns with the largest final position error (with --params when
+// given) drawn bold and numbered; then the paths of those runs, worst
+// first: what `evaluate --plot` and its report show. `total_runs`: all runs
+// evaluated (more than `runs` when the plot kept only the first kPlotRuns).
+std::string PlotSvg(const std::vector<PlotRun>& runs, const std::optional<RobotParams>& params, Integrator integ,
+                    std::size_t total_runs) {
+  const io::SvgStyle rec{"#e3a59c", "", "5,3", 0.8, false}, par{"#9cc7a8", "", "", 0.9, false};
+  const io::SvgStyle rec_bold{"#c0392b", "", "5,3", 1.6, false}, par_bold{"#1f7a3a", "", "", 2.0, false};
   struct Curve {
     std::vector<io::SvgPoint> pos, head;  // (travel m, error mm) and (travel m, error deg)
   };
@@ -114,19 +122,28 @@ std::string PlotSvg(const std::vector<PlotRun>& runs, const std::optional<RobotP
   std::vector<Curve> before, after;
   std::vector<io::SvgPoint> all_pos, all_head;
   for (const auto& [source, run] : runs) {
-    {
-      const Source& src = *source;
-      before.push_back(curve(run, src.path, src.recorded, src.recorded));
-      if (params) after.push_back(curve(run, src.path, *params, src.recorded));
-    }
+    const Source& src = *source;
+    before.push_back(curve(run, src.path, src.recorded, src.recorded));
+    if (params) after.push_back(curve(run, src.path, *params, src.recorded));
   }
   for (const auto* set : {&before, &after})
     for (const auto& c : *set) {
       all_pos.insert(all_pos.end(), c.pos.begin(), c.pos.end());
       all_head.insert(all_head.end(), c.head.begin(), c.head.end());
     }
+  // The worst runs by final position error (with --params when given).
+  const std::vector<Curve>& ranked_set = params ? after : before;
+  std::vector<std::size_t> worst(ranked_set.size());
+  for (std::size_t i = 0; i < worst.size(); ++i) worst[i] = i;
+  auto final_mm = [&](std::size_t i) { return ranked_set[i].pos.empty() ? 0.0 : ranked_set[i].pos.back().y; };
+  std::stable_sort(worst.begin(), worst.end(), [&](std::size_t x, std::size_t y) { return final_mm(x) > final_mm(y); });
+  if (worst.size() > kWorstRuns) worst.resize(kWorstRuns);
+  const std::string which = params ? "--params" : "recorded";
   std::vector<std::string> parts;
-  io::SvgPanel pp(80, 40, 520, 340, fmt::format("Position error along the path (first {} runs)", before.size()));
+  io::SvgPanel pp(80, 40, 520, 340,
+                  runs.size() < total_runs
+                      ? fmt::format("Position error along the path (first {} of {} runs)", runs.size(), total_runs)
+                      : fmt::format("Position error along the path (all {} runs)", runs.size()));
   io::SvgPanel ph(700, 40, 520, 340, "Heading error along the path");
   pp.FitExtent(all_pos, false, true);
   ph.FitExtent(all_head, false, true);
@@ -134,49 +151,61 @@ std::string PlotSvg(const std::vector<PlotRun>& runs, const std::optional<RobotP
   ph.Axes("distance travelled [m]", "heading error [deg]");
   for (const auto& c : before) { pp.Polyline(c.pos, rec); ph.Polyline(c.head, rec); }
   for (const auto& c : after) { pp.Polyline(c.pos, par); ph.Polyline(c.head, par); }
+  // The worst on top, bold, numbered at their end.
+  for (std::size_t r = 0; r < worst.size(); ++r) {
+    const std::size_t i = worst[r];
+    pp.Polyline(before[i].pos, rec_bold);
+    ph.Polyline(before[i].head, rec_bold);
+    if (params) { pp.Polyline(after[i].pos, par_bold); ph.Polyline(after[i].head, par_bold); }
+    if (!ranked_set[i].pos.empty()) pp.Text(ranked_set[i].pos.back(), fmt::format(" {}", r + 1), "#111", 11);
+  }
   std::vector<std::pair<io::SvgStyle, std::string>> legend = {{rec, "odometry with the recorded parameters (one line per run)"}};
   if (params) legend.push_back({par, "odometry with the --params parameters"});
+  legend.push_back({params ? par_bold : rec_bold,
+                    fmt::format("bold, numbered: the {} runs with the largest final error ({})", worst.size(), which)});
   pp.Legend(legend);
-  ph.Legend(legend);
   parts.push_back(pp.Render());
   parts.push_back(ph.Render());
-  double bottom = std::max(pp.Bottom(), ph.Bottom()) + 40;
-  // The paths of the first runs, each on its own scale.
+  double bottom = std::max(pp.Bottom(), ph.Bottom()) + 30;
+  parts.push_back(fmt::format(
+      R"svg(<text class="section-title" x="80" y="{:.0f}" font-size="13" font-weight="bold">{}</text>)svg", bottom,
+      io::SvgEscape(fmt::format("Paths of the {} runs with the largest final position error ({}), worst first", worst.size(),
+                                which))));
+  bottom += 30;
+  // The paths of the worst runs, each on its own scale.
   const io::SvgStyle gt{"#111", "", "", 2.2, false};
   const double size = 250;
-  int shown = 0;
   double row_bottom = bottom;
-  for (const auto& [source, run] : runs) {
-    {
-      const Source& src = *source;
-      if (shown >= 8) break;
-      const double left = 80 + (shown % 4) * (size + 60), top = bottom + (shown / 4) * (size + 90);
-      io::SvgPanel p(left, top, size, size, fmt::format("run {} ({})", run.run, run.direction));
-      const RunTrack b = TrackRun(run, src.path, src.recorded, src.recorded, integ);
-      std::vector<io::SvgPoint> g, o0, o1, all;
-      for (std::size_t i = 0; i < run.size(); ++i) {
-        if (b.has_ground_truth[i]) g.push_back({b.ground_truth[i].x, b.ground_truth[i].y});
-        o0.push_back({b.odometry[i].x, b.odometry[i].y});
-      }
-      if (params) {
-        const RunTrack a = TrackRun(run, src.path, *params, src.recorded, integ);
-        for (const auto& q : a.odometry) o1.push_back({q.x, q.y});
-      }
-      all = g;
-      all.insert(all.end(), o0.begin(), o0.end());
-      p.FitExtent(all, true, true);
-      p.Axes("x [m]", "y [m]");
-      p.Polyline(g, gt);
-      p.Polyline(o0, rec);
-      if (params) p.Polyline(o1, par);
-      row_bottom = std::max(row_bottom, p.Bottom());
-      parts.push_back(p.Render());
-      ++shown;
+  for (std::size_t r = 0; r < worst.size(); ++r) {
+    const auto& [source, run] = runs[worst[r]];
+    const Source& src = *source;
+    const double left = 80 + static_cast<double>(r % 4) * (size + 60), top = bottom + static_cast<double>(r / 4) * (size + 90);
+    io::SvgPanel p(left, top, size, size,
+                   fmt::format("{}: run {} ({}), {:.1f} mm", r + 1, run.run, run.direction, final_mm(worst[r])));
+    const RunTrack b = TrackRun(run, src.path, src.recorded, src.recorded, integ);
+    std::vector<io::SvgPoint> g, o0, o1, all;
+    for (std::size_t i = 0; i < run.size(); ++i) {
+      if (b.has_ground_truth[i]) g.push_back({b.ground_truth[i].x, b.ground_truth[i].y});
+      o0.push_back({b.odometry[i].x, b.odometry[i].y});
     }
+    if (params) {
+      const RunTrack a = TrackRun(run, src.path, *params, src.recorded, integ);
+      for (const auto& q : a.odometry) o1.push_back({q.x, q.y});
+    }
+    all = g;
+    all.insert(all.end(), o0.begin(), o0.end());
+    p.FitExtent(all, true, true);
+    p.Axes("x [m]", "y [m]");
+    p.Polyline(g, gt);
+    p.Polyline(o0, rec_bold);
+    if (params) p.Polyline(o1, par_bold);
+    row_bottom = std::max(row_bottom, p.Bottom());
+    parts.push_back(p.Render());
   }
   io::SvgPanel key(80, row_bottom - 36, 0, 0, "");
-  std::vector<std::pair<io::SvgStyle, std::string>> key_entries = {{gt, "ground truth"}, legend.front()};
-  if (params) key_entries.push_back(legend.back());
+  std::vector<std::pair<io::SvgStyle, std::string>> key_entries = {{gt, "ground truth"},
+                                                                   {rec_bold, "odometry with the recorded parameters"}};
+  if (params) key_entries.push_back({par_bold, "odometry with the --params parameters"});
   key.Legend(key_entries);
   parts.push_back(key.Render());
   return io::SvgDocument(1260, key.Bottom() + 10, parts);
@@ -228,7 +257,9 @@ std::string EvaluateReportHtml(const std::vector<std::string>& inputs, const Eva
              "max heading error [deg]"},
             rows);
   rep.Heading("Plots");
-  rep.Figure(svg, "Error along the travelled distance for every run, then the paths of the first runs.");
+  rep.Figure(svg, fmt::format("Error along the travelled distance for every run (up to {}; the {} largest final errors "
+                              "bold and numbered), then the paths of those runs, worst first.",
+                              kPlotRuns, kWorstRuns));
   return rep.Render();
 }
 
@@ -294,7 +325,7 @@ int RunEvaluate(const EvaluateOptions& o) {
   }
   std::vector<std::string> written;
   std::string svg;
-  if (!o.plot.empty() || !o.report.empty()) svg = PlotSvg(plot_runs, params, integ);
+  if (!o.plot.empty() || !o.report.empty()) svg = PlotSvg(plot_runs, params, integ, base.runs.size());
   if (!o.plot.empty()) {
     outs.Write(o.plot, svg);
     written.push_back(o.plot + " (plot)");

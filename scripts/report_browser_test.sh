@@ -45,6 +45,12 @@ for page in calibrate evaluate fit-noise diagnose summarize; do
   [ -s "$out/$page.png" ] || problems+=("no screenshot")
   # Page-specific elements: what each report must show.
   case $page in
+    calibrate)
+      grep -q 'Paths of all' "$out/$page.dom" || problems+=("not every run's path shown")
+      grep -q 'class="worst-frame"' "$out/$page.dom" || problems+=("worst runs not marked") ;;
+    evaluate)
+      grep -q 'Position error along the path (all' "$out/$page.dom" || problems+=("not every run's error shown")
+      grep -q 'Paths of the' "$out/$page.dom" || problems+=("no paths of the worst runs") ;;
     diagnose)
       grep -q 'data-title="Experiment 1' "$out/$page.dom" || problems+=("no residual panel per experiment")
       grep -q 'data-name="largest"' "$out/$page.dom" || problems+=("largest residuals not marked")

@@ -150,3 +150,44 @@ TEST_CASE("each command's --report writes one page", "[report][cli]") {
   CHECK(c.find("286.72 mm before") != std::string::npos);
   CHECK(c.find("What to do next") != std::string::npos);
 }
+
+TEST_CASE("calibrate and evaluate plots show every run; the worst are marked and named", "[plot][cli]") {
+  const fs::path dir = TempDir("plot-all-runs");
+  REQUIRE(RunCli("calibrate " + Q(kEx / "calibrate.toml") + " --plot " + Q(dir / "cal.svg") + " --json " +
+                 Q(dir / "cal.json")).status == 0);
+  const std::string cal = Slurp((dir / "cal.svg").string());
+  // Two return-error panels, then one path panel per run: all 10 runs.
+  auto count = [](const std::string& text, const std::string& what) {
+    int n = 0;
+    for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+  };
+  auto panels = [&](const std::string& svg) {  // titled panels (the shared legend has no title)
+    return count(svg, "<g class=\"panel\" data-title=\"") - count(svg, "<g class=\"panel\" data-title=\"\"");
+  };
+  CHECK(panels(cal) == 2 + 10);
+  CHECK(count(cal, "class=\"worst-frame\"") == 3);
+  CHECK(cal.find("Paths of all 10 runs") != std::string::npos);
+  // The marked runs are those with the largest final error after correction:
+  // their titles carry the largest numbers.
+  const std::regex title_re(R"re(data-title="(WORST \d: )?[^"]*, ([0-9.]+) mm")re");
+  std::vector<std::pair<bool, double>> titles;
+  for (auto it = std::sregex_iterator(cal.begin(), cal.end(), title_re); it != std::sregex_iterator(); ++it)
+    titles.push_back({(*it)[1].matched, std::stod((*it)[2])});
+  REQUIRE(titles.size() == 10);
+  double min_marked = 1e9, max_unmarked = 0;
+  for (const auto& [marked, mm] : titles) (marked ? min_marked : max_unmarked) = marked ? std::min(min_marked, mm) : std::max(max_unmarked, mm);
+  CHECK(min_marked >= max_unmarked);
+
+  REQUIRE(RunCli("evaluate " + Q(kEx / "calibrate.toml") + " --params " + Q(dir / "cal.json") + " --plot " +
+                 Q(dir / "ev.svg")).status == 0);
+  const std::string ev = Slurp((dir / "ev.svg").string());
+  CHECK(ev.find("Position error along the path (all 10 runs)") != std::string::npos);
+  // Every run drawn as a line in each error panel (before and after), and
+  // the paths of the 8 worst, worst first.
+  CHECK(panels(ev) == 2 + 8);
+  CHECK(ev.find("data-title=\"1: run ") != std::string::npos);
+  CHECK(ev.find("data-title=\"8: run ") != std::string::npos);
+  const auto legend = LegendLabels(ev);
+  CHECK(std::count(legend.begin(), legend.end(), "bold, numbered: the 8 runs with the largest final error (--params)") == 1);
+}
