@@ -14,6 +14,7 @@
 #include "common.hpp"
 #include "core/errors.hpp"
 #include "io/atomic_write.hpp"
+#include "io/csv_writer.hpp"
 #include "io/html_report.hpp"
 #include "io/svg_plot.hpp"
 
@@ -191,16 +192,14 @@ int RunSummarize(const SummarizeOptions& o) {
   if (!o.csv.empty()) {
     std::string csv = "file,wheelbase_m,wheel_diameter_left_m,wheel_diameter_right_m,E_d,E_b,E_max_syst_m,residual_after_m,outlier,reasons\n";
     for (std::size_t i = 0; i < robots.size(); ++i) {
-      std::string row = "\"" + robots[i].fleet.file + "\"";
+      std::string row = io::CsvField(robots[i].fleet.file);
       for (FleetQuantity q : kFleetQuantities) {
         const auto it = robots[i].fleet.values.find(q);
         row += it == robots[i].fleet.values.end() ? "," : fmt::format(",{:.9g}", it->second);
       }
       std::string reasons;
       for (const auto& r : s.robots[i].reasons) reasons += (reasons.empty() ? "" : "; ") + r;
-      for (auto& c : reasons)
-        if (c == '"') c = '\'';
-      row += fmt::format(",{},\"{}\"\n", s.robots[i].outlier ? "true" : "false", reasons);
+      row += fmt::format(",{},{}\n", s.robots[i].outlier ? "true" : "false", io::CsvField(reasons));
       csv += row;
     }
     outs.Write(o.csv, csv);

@@ -10,21 +10,11 @@
 
 #include "core/errors.hpp"
 #include "io/atomic_write.hpp"
+#include "io/csv_writer.hpp"
 
 namespace umbmark::io {
 
 namespace {
-// CSV cell for free text (run ids, directions): the contract has no quoting
-// and its readers refuse a double quote, so commas and line breaks become
-// spaces and double quotes single ones rather than being emitted.
-std::string CleanCell(std::string s) {
-  for (char& c : s) {
-    if (c == ',' || c == '\n' || c == '\r') c = ' ';
-    if (c == '"') c = '\'';
-  }
-  return s;
-}
-
 std::string TomlString(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
@@ -43,7 +33,7 @@ std::string FormatTrajectoryCsv(const TrajectoryData& data, const std::vector<st
                : "run,direction,t_s,dist_left_m,dist_right_m,x_gt_m,y_gt_m,theta_gt_rad\n";
   auto buf = fmt::memory_buffer();
   for (const auto& run : data.runs) {
-    const std::string id = CleanCell(run.run), dir = CleanCell(run.direction);
+    const std::string id = CsvField(run.run), dir = CsvField(run.direction);
     for (std::size_t i = 0; i < run.size(); ++i) {
       fmt::format_to(std::back_inserter(buf), "{},{},{},", id, dir, run.t_s[i]);
       if (ticks)
@@ -89,7 +79,7 @@ std::string FormatEndpointCsv(const EndpointData& data, const std::vector<std::s
   for (const auto& line : comment) out += "# " + line + "\n";
   out += "run,direction,ex_m,ey_m,etheta_rad\n";
   for (const auto& r : data.runs) {
-    out += fmt::format("{},{},{},{},", CleanCell(r.run), CleanCell(r.direction), r.ex_m, r.ey_m);
+    out += fmt::format("{},{},{},{},", CsvField(r.run), CsvField(r.direction), r.ex_m, r.ey_m);
     if (r.etheta_rad) out += fmt::format("{}", *r.etheta_rad);
     out += "\n";
   }

@@ -371,6 +371,111 @@ bool CsvReader::NextContentLine() {
 
 bool CsvReader::HasNoDataRows() { return !SkipToContent(); }
 
+const char* CsvReader::QuotedRowEnd(std::size_t& breaks) {
+  for (;;) {
+    const char* const b = buf_.get() + pos_;
+    const char* const end = buf_.get() + len_;
+    bool quoted = false, cell_start = true, incomplete = false;
+    breaks = 0;
+    const char* open = nullptr;
+    const char* p = b;
+    for (; p < end; ++p) {
+      const char ch = *p;
+      if (quoted) {
+        if (ch == '\n') ++breaks;
+        if (ch != '"') continue;
+        if (p + 1 == end && !eof_) {  // "" or the closing quote: undecided
+          incomplete = true;
+          break;
+        }
+        if (p + 1 < end && p[1] == '"') ++p;
+        else quoted = false;
+      } else if (ch == '\n') {
+        return p;
+      } else if (ch == ',') {
+        cell_start = true;
+      } else if (ch == '"' && cell_start) {
+        quoted = true;
+        open = p;
+      } else if (!IsBlank(ch)) {
+        cell_start = false;  // a quote later in this cell is the tokenizer's error
+      }
+    }
+    if (!eof_ || incomplete) {
+      Fill();  // keeps the row from pos_ on, then scans it again
+      continue;
+    }
+    if (quoted) {
+      // Line and column of the opening quote.
+      std::size_t line = next_line_;
+      const char* row = b;
+      for (const char* q = b; q < open; ++q)
+        if (*q == '\n') ++line, row = q + 1;
+      throw InputError(name_, line, ColumnIn(row, open), "quoted cell has no closing quote");
+    }
+    return p;
+  }
+}
+
+bool CsvReader::NextQuotedRow() {
+  std::size_t breaks = 0;
+  const char* const row_end = QuotedRowEnd(breaks);
+  char* const b = buf_.get() + pos_;
+  char* const end = buf_.get() + (row_end - buf_.get());
+  line_ = next_line_;
+  next_line_ += 1 + breaks;
+  pos_ = static_cast<std::size_t>(end - buf_.get()) + (end < buf_.get() + len_ ? 1 : 0);
+  line_begin_ = b;
+  line_end_ = end > b && end[-1] == '\r' ? end - 1 : end;
+  const std::size_t expected = cells_.size();
+  std::size_t n = 0;
+  char* r = b;  // read position
+  char* w = b;  // write position (unquoted cells are copied down in place)
+  for (;;) {
+    while (r < line_end_ && IsBlank(*r)) ++r;
+    char* const cell_begin = w;
+    const char* const source = r;
+    if (r < line_end_ && *r == '"') {
+      for (++r;; ++r) {
+        if (r >= end) throw InputError(name_, line_, ColumnOf(source), "quoted cell has no closing quote");
+        if (*r == '"') {
+          if (r + 1 < end && r[1] == '"') {
+            *w++ = '"';
+            ++r;
+            continue;
+          }
+          ++r;
+          break;
+        }
+        *w++ = *r;
+      }
+      while (r < line_end_ && IsBlank(*r)) ++r;
+      if (r < line_end_ && *r != ',')
+        throw InputError(name_, line_, ColumnOf(r),
+                         "text after the closing quote of a quoted cell (a quote inside a cell is written \"\")");
+    } else {
+      while (r < line_end_ && *r != ',') {
+        if (*r == '"')
+          throw InputError(name_, line_, ColumnOf(r),
+                           "double quote inside an unquoted cell: quote the whole cell and double the quote "
+                           "(\"a\"\"b\")");
+        *w++ = *r++;
+      }
+      while (w > cell_begin && IsBlank(w[-1])) --w;
+    }
+    if (n < expected) {
+      cells_[n] = std::string_view(cell_begin, static_cast<std::size_t>(w - cell_begin));
+    } else if (n == expected) {
+      extra_ = source;
+    }
+    ++n;
+    if (r >= line_end_) break;
+    ++r;  // the comma
+  }
+  if (n != expected) FailCellCount(n);
+  return true;
+}
+
 void CsvReader::FailLongLine() const {
   const std::string_view rest(buf_.get() + pos_, len_ - pos_);
   const char* what = "not a CSV file of this format?";
@@ -431,11 +536,6 @@ void CsvReader::FailNumber(const ResolvedColumn& c, std::string_view cell, const
 
 void CsvReader::FailEmpty(const ResolvedColumn& c) const {
   FailCell(c.index, fmt::format("{}: empty cell", c.header));
-}
-
-void CsvReader::FailQuoted(const ResolvedColumn& c) const {
-  FailCell(c.index,
-           fmt::format("{}: quoted cells are not supported ({})", c.header, QuoteForMessage(cells_[c.index])));
 }
 
 double CsvReader::ParseNumberSlow(const ResolvedColumn& c, std::string_view s) const {

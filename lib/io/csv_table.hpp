@@ -2,8 +2,11 @@
 // endpoint and trajectory readers. Format (contract): comma separated, one
 // header row, a line whose first non-blank character is `#` is a comment,
 // blank lines are ignored, optional UTF-8 BOM, `\n` or `\r\n` line ends.
-// Cells are trimmed of spaces and tabs; quoting is not part of the format
-// (a `"` in a text cell is rejected rather than half-interpreted).
+// Cells are trimmed of spaces and tabs. A cell may be quoted as RFC 4180
+// says: "..." holding commas, line breaks and doubled quotes ("") for one
+// `"`; blanks around the quotes are ignored, inside them kept. A `"` inside
+// an unquoted cell, text after a closing quote and an unterminated quote
+// are errors. (Data rows only: header names are never quoted.)
 //
 // The reader streams: it read()s the input into one buffer (1 MiB, grown
 // only for a longer line, up to kMaxLineBytes) and hands out one row at a
@@ -117,7 +120,7 @@ class CsvReader {
   /// Returns false (leaving `out` untouched) when the cell is empty.
   inline bool OptionalNumber(const ResolvedColumn& c, double& out) const;
   inline std::int64_t Count(const ResolvedColumn& c) const;
-  /// A non-empty text cell without a double quote.
+  /// A non-empty text cell (unquoted).
   inline std::string_view Text(const ResolvedColumn& c) const;
 
  private:
@@ -134,6 +137,12 @@ class CsvReader {
   bool SkipIfBlankOrComment();
   /// Skips blank and comment lines; false at the end of the input.
   bool SkipToContent();
+  /// Next() for a row holding a '"' (the slow path): reads the whole row,
+  /// line breaks inside quotes included, and unquotes its cells in place.
+  bool NextQuotedRow();
+  /// End of the row at pos_ (its '\n', or the end of the input), reading
+  /// more as needed; counts the line breaks inside quotes into `breaks`.
+  const char* QuotedRowEnd(std::size_t& breaks);
   /// Reads the next content line whole (header): sets line_, line_begin_,
   /// line_end_ (without \r) and advances pos_. False at the end.
   bool NextContentLine();
@@ -145,7 +154,6 @@ class CsvReader {
   std::int64_t ParseCountSlow(const ResolvedColumn& c, std::string_view s) const;
   [[noreturn]] void FailCellCount(std::size_t n) const;
   [[noreturn]] void FailEmpty(const ResolvedColumn& c) const;
-  [[noreturn]] void FailQuoted(const ResolvedColumn& c) const;
   [[noreturn]] void FailHeader(std::size_t i, const std::string& message) const;
   [[noreturn]] void FailNumber(const ResolvedColumn& c, std::string_view cell, const char* what) const;
 
@@ -228,16 +236,17 @@ inline bool ParseSimpleCount(const char* p, const char* end, std::int64_t& out) 
   return true;
 }
 
-/// First ',' or '\n' in [p, end), or end. Reads up to 15 bytes past `end`
+/// First ',', '\n' or '"' in [p, end), or end. Reads up to 15 bytes past `end`
 /// (the reader's buffer is padded for that); what lies there is ignored.
 inline const char* FindDelimiter(const char* p, const char* end) {
 #if defined(__SSE2__)
   const __m128i comma = _mm_set1_epi8(',');
   const __m128i newline = _mm_set1_epi8('\n');
+  const __m128i quote = _mm_set1_epi8('"');
   for (; p < end; p += 16) {
     const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p));
-    const auto mask = static_cast<unsigned>(
-        _mm_movemask_epi8(_mm_or_si128(_mm_cmpeq_epi8(v, comma), _mm_cmpeq_epi8(v, newline))));
+    const auto mask = static_cast<unsigned>(_mm_movemask_epi8(_mm_or_si128(
+        _mm_or_si128(_mm_cmpeq_epi8(v, comma), _mm_cmpeq_epi8(v, newline)), _mm_cmpeq_epi8(v, quote))));
     if (mask != 0) {
       const char* const q = p + __builtin_ctz(mask);
       return q < end ? q : end;
@@ -245,7 +254,7 @@ inline const char* FindDelimiter(const char* p, const char* end) {
   }
   return end;
 #else
-  while (p < end && *p != ',' && *p != '\n') ++p;
+  while (p < end && *p != ',' && *p != '\n' && *p != '"') ++p;
   return p;
 #endif
 }
@@ -268,6 +277,7 @@ inline bool CsvReader::Next() {
     const char* e = b;
     for (;;) {
       e = csv_internal::FindDelimiter(c, end);
+      if (e < end && *e == '"') return NextQuotedRow();
       if (e == end && !eof_) break;  // the line goes on past the buffer
       if (n < expected) {
         cells[n] = std::string_view(c, static_cast<std::size_t>(e - c));
@@ -330,7 +340,6 @@ inline std::int64_t CsvReader::Count(const ResolvedColumn& c) const {
 inline std::string_view CsvReader::Text(const ResolvedColumn& c) const {
   const std::string_view s = cells_[c.index];
   if (s.empty()) FailEmpty(c);
-  if (s.find('"') != std::string_view::npos) FailQuoted(c);
   return s;
 }
 
