@@ -171,7 +171,7 @@ bool Identify(const Shared& x, const std::vector<int>& eparams, Candidate& cd, E
 }
 
 /// A mean effect fitted jointly with E_d, E_b.
-void FitMeanEffect(const Shared& x, sim::EffectKind kind, const std::vector<int>& eparams, Candidate& cd) {
+MeanFit FitMeanEffect(const Shared& x, sim::EffectKind kind, const std::vector<int>& eparams, Candidate& cd) {
   const CampaignData& c = x.c;
   std::vector<int> joint = BaselineParams();
   joint.insert(joint.end(), eparams.begin(), eparams.end());
@@ -206,6 +206,7 @@ void FitMeanEffect(const Shared& x, sim::EffectKind kind, const std::vector<int>
   cd.heldout_loglik_gain = cv.loglik - x.cv_ll_base;
   const double gcv = ComputeGap(c, cv.scores, x.options.gap).score;
   cd.heldout_shrink = Shrink(Gap(gcv, x.null_median), x.gap_cv_before);
+  return mf;
 }
 
 /// correlated_noise or bump_outliers on the baseline's residuals.
@@ -268,6 +269,7 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
   const std::vector<sim::EffectKind>& effects = options.effects;
   out.candidates.resize(effects.size());
   out.projected.resize(effects.size());
+  std::vector<MeanFit> mean_fits(effects.size());
   const auto fit_one = [&](int i) {
     const auto ei = static_cast<std::size_t>(i);
     const sim::EffectKind kind = effects[ei];
@@ -277,7 +279,7 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
     if (!eparams.empty()) {
       cd.parameters = static_cast<int>(eparams.size());
       if (!Identify(x, eparams, cd, out.projected[ei])) return;
-      FitMeanEffect(x, kind, eparams, cd);
+      mean_fits[ei] = FitMeanEffect(x, kind, eparams, cd);
     } else if (IsNoiseEffect(kind)) {
       FitNoiseEffect(x, kind, cd);
     } else {
@@ -293,6 +295,12 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
     fit_one(i);
     progress.Add();
   });
+  for (std::size_t i = 0; i < effects.size(); ++i) {
+    if (mean_fits[i].eps.empty()) continue;
+    std::vector<int> key = BaselineParams();
+    for (int k : EffectParams(effects[i])) key.push_back(k);
+    out.mean_fits.emplace(std::move(key), std::move(mean_fits[i]));
+  }
   return out;
 }
 

@@ -17,6 +17,7 @@
 #include "diagnosis/baseline.hpp"
 #include "diagnosis/cross_validation.hpp"
 #include "diagnosis/gap_stats.hpp"
+#include "diagnosis/mean_fit.hpp"
 #include "diagnosis/piece_noise.hpp"
 #include "simulation/effects.hpp"
 
@@ -88,6 +89,11 @@ struct CandidateFits {
   /// Each mean effect's whitened footprint with what E_d, E_b explain
   /// removed (empty for the noise effects); tells effects apart.
   std::vector<Eigen::MatrixXd> projected;
+  /// The mean effects' joint fits with E_d, E_b (FitMean from the
+  /// baseline's parameters with its weights W), by the fitted parameter
+  /// list (BaselineParams() then the effect's): the stepwise explanation
+  /// starts from them instead of fitting them again.
+  std::map<std::vector<int>, MeanFit> mean_fits;
 };
 
 /// gap_score: G of the baseline; null_median: G0.

@@ -212,7 +212,7 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
     eo.progress = StageProgress(options.progress, 700.0, 1000.0, 1000.0);
     std::vector<sim::EffectKind> first;
     if (const auto k = sim::EffectFromString(out.verdict)) first.push_back(*k);
-    const Explanation ex = Explain(c, model, base, folds, out.candidates, first, out.gap_score,
+    const Explanation ex = Explain(c, model, base, folds, out.candidates, fits.mean_fits, first, out.gap_score,
                                    out.null_median, out.null_quantile_alpha, eo);
     out.explanation = ex.steps;
     out.explanation_stop = ex.stop_reason;

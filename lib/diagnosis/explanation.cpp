@@ -26,16 +26,45 @@ struct SetFit {
   double gap_after = 0.0, heldout_gap = 0.0, cv_loglik = 0.0;
 };
 
-SetFit FitSet(const CampaignData& c, const MeanModel& model, const BaselineFit& b, const Folds& folds,
-              const std::vector<sim::EffectKind>& set, const GapOptions& gap) {
+/// The mean parameters a set of effects fits: E_d, E_b, then each mean
+/// effect's parameters in the set's order.
+std::vector<int> MeanParamsOf(const std::vector<sim::EffectKind>& set) {
   std::vector<int> params = BaselineParams();
   for (sim::EffectKind e : set)
     for (int k : EffectParams(e)) params.push_back(k);
-  const bool bumps = Contains(set, sim::EffectKind::kBumpOutliers);
-  const bool scrub = Contains(set, sim::EffectKind::kTurnScrub);
-  const MeanFit mf = FitMean(model, b.p, params, b.W, MeanFitOptions{12});
+  return params;
+}
+
+/// The mean part of a set's fit. It depends only on the mean parameters
+/// (always weighted by the baseline's W), so every set with the same mean
+/// parameters -- the chosen set plus one noise effect, say -- shares it:
+/// Explain computes it once per distinct parameter list (the same call, so
+/// the same numbers).
+struct MeanPart {
+  MeanFit mf;
+  bool scrub = false;
+  std::vector<PieceBases> scrub_bases;  ///< turn_scrub: the bases follow the fit
+};
+
+MeanPart MeanPartFrom(const CampaignData& c, const MeanModel& model, MeanFit mf, const std::vector<int>& params) {
+  MeanPart m;
+  m.mf = std::move(mf);
   // turn_scrub changes the spot turns' noise bases too (candidates.cpp).
-  const std::vector<PieceBases> bases = scrub ? ComputeBases(c, model, mf.p) : b.bases;
+  m.scrub = std::find(params.begin(), params.end(), kParamScrub) != params.end();
+  if (m.scrub) m.scrub_bases = ComputeBases(c, model, m.mf.p);
+  return m;
+}
+
+MeanPart FitMeanPart(const CampaignData& c, const MeanModel& model, const BaselineFit& b,
+                     const std::vector<int>& params) {
+  return MeanPartFrom(c, model, FitMean(model, b.p, params, b.W, MeanFitOptions{12}), params);
+}
+
+SetFit FitSet(const CampaignData& c, const BaselineFit& b, const Folds& folds, const std::vector<sim::EffectKind>& set,
+              const MeanPart& mean, const GapOptions& gap) {
+  const bool bumps = Contains(set, sim::EffectKind::kBumpOutliers);
+  const MeanFit& mf = mean.mf;
+  const std::vector<PieceBases>& bases = mean.scrub ? mean.scrub_bases : b.bases;
   PieceNoiseFitOptions nf = b.noise_fit;
   for (sim::EffectKind e : set) EnableNoiseEffect(e, nf);
   SetFit out;
@@ -57,6 +86,42 @@ SetFit FitSet(const CampaignData& c, const MeanModel& model, const BaselineFit& 
   out.heldout_gap = ComputeGap(c, cv.scores, gap).score;
   return out;
 }
+
+/// Mean parts by parameter list (see MeanPart).
+class MeanPartCache {
+ public:
+  MeanPartCache(const CampaignData& c, const MeanModel& model, const BaselineFit& b, int threads,
+                const std::map<std::vector<int>, MeanFit>& known)
+      : c_(c), model_(model), b_(b), threads_(threads), known_(known) {}
+  /// Fits the mean parts of `sets` not fitted yet (in parallel).
+  void Prepare(const std::vector<std::vector<sim::EffectKind>>& sets) {
+    std::vector<std::vector<int>> missing;
+    for (const auto& set : sets) {
+      std::vector<int> key = MeanParamsOf(set);
+      if (parts_.count(key) || std::find(missing.begin(), missing.end(), key) != missing.end()) continue;
+      if (const auto it = known_.find(key); it != known_.end()) {
+        parts_.emplace(key, MeanPartFrom(c_, model_, it->second, key));
+        continue;
+      }
+      missing.push_back(std::move(key));
+    }
+    std::vector<MeanPart> fitted(missing.size());
+    ParallelFor(threads_, static_cast<int>(missing.size()), [&](int i) {
+      fitted[static_cast<std::size_t>(i)] = FitMeanPart(c_, model_, b_, missing[static_cast<std::size_t>(i)]);
+    });
+    for (std::size_t i = 0; i < missing.size(); ++i) parts_.emplace(std::move(missing[i]), std::move(fitted[i]));
+  }
+  /// The mean part of `set` (Prepare'd before).
+  const MeanPart& Get(const std::vector<sim::EffectKind>& set) const { return parts_.at(MeanParamsOf(set)); }
+
+ private:
+  const CampaignData& c_;
+  const MeanModel& model_;
+  const BaselineFit& b_;
+  int threads_;
+  const std::map<std::vector<int>, MeanFit>& known_;
+  std::map<std::vector<int>, MeanPart> parts_;
+};
 
 std::map<std::string, double> ParamsOf(sim::EffectKind e, const SetFit& f) {
   if (IsNoiseEffect(e)) return NoiseEffectParams(e, f.noise);
@@ -167,11 +232,13 @@ void Size(const CampaignData& c, const MeanModel& model, const std::vector<Piece
 }  // namespace
 
 Explanation Explain(const CampaignData& c, const MeanModel& model, const BaselineFit& b, const Folds& folds,
-                    const std::vector<Candidate>& candidates,
+                    const std::vector<Candidate>& candidates, const std::map<std::vector<int>, MeanFit>& known,
                     const std::vector<sim::EffectKind>& first, double gap_score, double null_median,
                     double null_quantile, const ExplanationOptions& options) {
   Explanation ex;
-  const SetFit base = FitSet(c, model, b, folds, {}, options.gap);
+  MeanPartCache means(c, model, b, options.threads, known);
+  means.Prepare({{}});
+  const SetFit base = FitSet(c, b, folds, {}, means.Get({}), options.gap);
   const double gap_before = Gap(gap_score, null_median), gap_cv_before = Gap(base.heldout_gap, null_median);
   std::vector<sim::EffectKind> chosen;
   std::vector<SetFit> fits;
@@ -193,7 +260,8 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
   for (sim::EffectKind e : first) {
     std::vector<sim::EffectKind> set = chosen;
     set.push_back(e);
-    add(e, FitSet(c, model, b, folds, set, options.gap));
+    means.Prepare({set});
+    add(e, FitSet(c, b, folds, set, means.Get(set), options.gap));
     progress.Add();
   }
   // Candidates worth trying: identifiable ones that gained held out alone.
@@ -213,11 +281,13 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
       ex.stop_reason = "no candidate left that gains held-out evidence on its own";
       break;
     }
+    std::vector<std::vector<sim::EffectKind>> sets(remaining.size(), chosen);
+    for (std::size_t i = 0; i < remaining.size(); ++i) sets[i].push_back(remaining[i]);
+    means.Prepare(sets);
     std::vector<SetFit> trial(remaining.size());
     ParallelFor(options.threads, static_cast<int>(remaining.size()), [&](int i) {
-      std::vector<sim::EffectKind> set = chosen;
-      set.push_back(remaining[static_cast<std::size_t>(i)]);
-      trial[static_cast<std::size_t>(i)] = FitSet(c, model, b, folds, set, options.gap);
+      const auto& set = sets[static_cast<std::size_t>(i)];
+      trial[static_cast<std::size_t>(i)] = FitSet(c, b, folds, set, means.Get(set), options.gap);
       progress.Add();
     });
     std::size_t best = 0;

@@ -68,12 +68,13 @@ struct Explanation {
   std::string stop_reason;
 };
 
-/// `first`: the effect to start with (the single-effect verdict), or none
+/// `known`: mean fits already made (FitCandidates' mean_fits: the same
+/// fits, so not repeated). `first`: the effect to start with (the single-effect verdict), or none
 /// (empty) to select from scratch. gap_score, null_median, null_quantile:
 /// the baseline's G, the null's median G0 and 1 - alpha quantile.
 Explanation Explain(const CampaignData& c, const MeanModel& model, const BaselineFit& baseline,
                     const Folds& folds, const std::vector<Candidate>& candidates,
-                    const std::vector<sim::EffectKind>& first, double gap_score, double null_median,
+                    const std::map<std::vector<int>, MeanFit>& known, const std::vector<sim::EffectKind>& first, double gap_score, double null_median,
                     double null_quantile, const ExplanationOptions& options);
 
 }  // namespace umbmark::diag
