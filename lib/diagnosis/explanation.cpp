@@ -273,10 +273,15 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
   // correct mean effect can LOSE likelihood there: it narrows the refitted
   // noise, and the outliers then cost more than the mean gains (castor_kick
   // beside bump_outliers, fitted within 5 % of the truth, lost 117 nats
-  // alone). Once the chosen set models that noise it gains.
+  // alone). Once the chosen set models that noise it gains. A weakly
+  // identifiable effect (mostly absorbed by E_d, E_b; candidates.hpp) joins
+  // only on its own evidence, as in the verdict: jointly with others it
+  // bends into whatever misfit is left (turn_scrub at k = -19 % on real
+  // squares).
   std::vector<sim::EffectKind> pool;
   for (const Candidate& cd : candidates)
-    if (cd.identifiable && !Contains(chosen, cd.effect)) pool.push_back(cd.effect);
+    if (cd.identifiable && (!cd.weak || cd.heldout_loglik_gain > 0.0) && !Contains(chosen, cd.effect))
+      pool.push_back(cd.effect);
   ex.stop_reason = "the largest explanation considered";
   while (static_cast<int>(chosen.size()) < options.max_effects) {
     if (current.gap_after <= null_quantile) {
