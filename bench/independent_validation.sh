@@ -1,0 +1,116 @@
+#!/usr/bin/env bash
+# Blind validation of `umbmark diagnose` on campaigns from an INDEPENDENT
+# generator (bench/indep_campaign.cpp: its own physics, a closed-loop
+# controller on the odometry with acceleration limits and heading hold, no
+# code shared with lib/simulation or lib/model), with the design varied per
+# campaign, reported per class and per design.
+#
+# Per campaign (uniform unless stated, drawn by awk from SEED):
+#   robot    wheelbase 0.3-0.5 m, wheel diameter 0.08-0.15 m, E_d = 1 +- 0-0.5 %,
+#            E_b = 1 +- 0-2 %, k_L, k_R log-uniform 5e-4-2e-3 m^1/2,
+#            ground truth 0.2-0.5 mm, 1-2 mrad (stated in the manifest)
+#   motion   squares 2-3 m (10 cw + 10 ccw), back-and-forth 2-4 m (20 runs),
+#            0.2-0.4 m/s, spot turns 0.6-1.2 rad/s
+#   design   sample rate 10 / 20 / 50 Hz; encoder 500 / 4096 / 20000 ticks
+#            per revolution; pauses between motions 0 or 1 s;
+#   controller  acceleration limit none or 0.3-1 m/s^2 (and rad/s^2);
+#            heading hold in the legs none or K = 1-3 1/s
+#   classes  none; negligible (500 ticks/rev and one of: marker offset
+#            0.1-0.8 mm, time offset 1-2 ms, scale error 0.5-2e-4; target
+#            `none`); single effects at f = 3-5 times the noise of one
+#            piece in what they move (scale_error: s = f sd_along / side;
+#            castor_kick: kappa = f sd_heading of a <= 1 m piece;
+#            gt_offset: |d| = f sigma_xy; time_offset: tau = f sqrt(2)
+#            sigma_xy / v; direction_asymmetry: a = f sd_along(D) / D);
+#            outside effects (gt_yaw_misalignment 5-20 mrad, floor_slope
+#            0.2-1 %; target `unexplained`).
+#
+# Usage: bench/independent_validation.sh [BUILD_DIR] [N] [SEED]
+#   N campaigns per single/outside class, 2N clean and 2N negligible.
+set -euo pipefail
+
+BUILD=${1:-build}
+N=${2:-3}
+SEED=${3:-4242}
+UMBMARK="$BUILD/umbmark"
+GEN="$BUILD/indep_campaign"
+for exe in "$UMBMARK" "$GEN"; do
+  [[ -x "$exe" ]] || { echo "missing $exe (build the umbmark and indep_campaign targets)" >&2; exit 2; }
+done
+OUT=$(mktemp -d "${TMPDIR:-/tmp}/umbmark-indep.XXXXXX")
+echo "seed $SEED, $N per class; campaigns in $OUT"
+
+# One line per campaign: case class design generator-arguments.
+awk -v n="$N" -v seed="$SEED" '
+function U(a, b) { return a + (b - a) * rand() }
+function S() { return rand() < 0.5 ? -1 : 1 }
+function LU(a, b) { return exp(U(log(a), log(b))) }
+BEGIN {
+  srand(seed); pi = 3.141592653589793
+  split("none negligible scale_error castor_kick gt_offset time_offset direction_asymmetry gt_yaw_misalignment floor_slope", cls, " ")
+  id = 0
+  for (c = 1; c <= 9; ++c) {
+    count = (cls[c] == "none" || cls[c] == "negligible") ? 2 * n : n
+    for (i = 0; i < count; ++i) {
+      b = U(0.3, 0.5); d = U(0.08, 0.15); kl = LU(5e-4, 2e-3); kr = LU(5e-4, 2e-3)
+      gxy = U(2e-4, 5e-4); gth = U(1e-3, 2e-3); side = U(2, 3); dist = U(2, 4); v = U(0.2, 0.4); w = U(0.6, 1.2)
+      rates[1] = 10; rates[2] = 20; rates[3] = 50; rate = rates[int(rand() * 3) + 1]
+      tk[1] = 500; tk[2] = 4096; tk[3] = 20000; ticks = tk[int(rand() * 3) + 1]
+      pause = rand() < 0.5 ? 0 : 1
+      accel = rand() < 0.5 ? 0 : U(0.3, 1.0)
+      hold = rand() < 0.5 ? 0 : U(1, 3)
+      ed = 1 + S() * U(0, 0.005); eb = 1 + S() * U(0, 0.02)
+      f = U(3, 5); k2 = (kl * kl + kr * kr) / 2
+      eff = ""
+      if (cls[c] == "negligible") {
+        ticks = 500; pick = int(rand() * 3)
+        if (pick == 0) { r = U(1e-4, 8e-4); a = U(0, 2 * pi); eff = sprintf("gt_offset:dx=%.6g,dy=%.6g", r * cos(a), r * sin(a)) }
+        else if (pick == 1) eff = sprintf("time_offset:tau=%.6g", S() * U(0.001, 0.002))
+        else eff = sprintf("scale_error:s=%.6g", S() * U(5e-5, 2e-4))
+      }
+      if (cls[c] == "scale_error") eff = sprintf("scale_error:s=%.6g", S() * f * sqrt(k2 * side / 2) / side)
+      if (cls[c] == "castor_kick") eff = sprintf("castor_kick:kappa=%.6g", S() * f * sqrt(2 * k2 * (side < 1 ? side : 1)) / b)
+      if (cls[c] == "gt_offset") { a = U(0, 2 * pi); eff = sprintf("gt_offset:dx=%.6g,dy=%.6g", f * gxy * cos(a), f * gxy * sin(a)) }
+      if (cls[c] == "time_offset") eff = sprintf("time_offset:tau=%.6g", S() * f * sqrt(2) * gxy / v)
+      if (cls[c] == "direction_asymmetry") eff = sprintf("direction_asymmetry:a=%.6g", S() * f * sqrt(k2 * dist / 2) / dist)
+      if (cls[c] == "gt_yaw_misalignment") eff = sprintf("gt_yaw_misalignment:delta=%.6g", S() * U(0.005, 0.02))
+      if (cls[c] == "floor_slope") eff = sprintf("floor_slope:g=%.6g,dir=%.6g", U(0.002, 0.01), U(0, 2 * pi))
+      design = sprintf("%dHz/%dticks/%s/%s/%s", rate, ticks, pause ? "pauses" : "no-pauses", accel > 0 ? "accel" : "no-accel", hold > 0 ? "hold" : "no-hold")
+      printf "%03d %s %s --seed %d --wheelbase %.6g --diameter %.6g --kl %.6g --kr %.6g --gt-sigma-xy %.6g --gt-sigma-theta %.6g --side %.6g --distance %.6g --speed %.6g --turn-rate %.6g --rate %d --ticks %d --pause %d --accel %.6g --heading-hold %.6g --E-d %.8g --E-b %.8g%s\n", \
+        id, cls[c], design, seed * 1000 + id, b, d, kl, kr, gxy, gth, side, dist, v, w, rate, ticks, pause, accel, hold, ed, eb, eff == "" ? "" : " --effect " eff
+      ++id
+    }
+  }
+}' > "$OUT/cases.txt"
+
+declare -A total right dtotal dright
+start=$(date +%s.%N)
+while read -r id cls design args; do
+  dir="$OUT/${id}_$cls"
+  # shellcheck disable=SC2086
+  "$GEN" --out "$dir/campaign" $args
+  "$UMBMARK" diagnose "$dir/campaign/campaign.toml" --json "$dir/diagnosis.json" > "$dir/report.txt"
+  verdict=$(tr -d '\n ' < "$dir/diagnosis.json" | sed -n 's/.*"verdict":{"effect":"\([a-z_]*\)".*/\1/p')
+  expected=$cls
+  [[ $cls == negligible ]] && expected=none
+  [[ $cls == gt_yaw_misalignment || $cls == floor_slope ]] && expected=unexplained
+  ok=0; [[ "$verdict" == "$expected" ]] && ok=1
+  total[$cls]=$(( ${total[$cls]:-0} + 1 )); right[$cls]=$(( ${right[$cls]:-0} + ok ))
+  for part in ${design//\// }; do
+    dtotal[$part]=$(( ${dtotal[$part]:-0} + 1 )); dright[$part]=$(( ${dright[$part]:-0} + ok ))
+  done
+  printf '%s %-20s %-40s -> %-20s %s\n' "$id" "$cls" "$design" "$verdict" "$([[ $ok == 1 ]] && echo ok || echo WRONG)"
+done < "$OUT/cases.txt"
+end=$(date +%s.%N)
+
+echo
+echo "per class (right = verdict none / the effect / unexplained for outside effects):"
+for c in none negligible scale_error castor_kick gt_offset time_offset direction_asymmetry gt_yaw_misalignment floor_slope; do
+  [[ -n "${total[$c]:-}" ]] && printf '  %-20s %d/%d\n' "$c" "${right[$c]}" "${total[$c]}"
+done
+echo "per design factor (all classes):"
+for p in $(printf '%s\n' "${!dtotal[@]}" | sort); do
+  printf '  %-12s %d/%d\n' "$p" "${dright[$p]}" "${dtotal[$p]}"
+done
+n_all=$(wc -l < "$OUT/cases.txt")
+echo "time per campaign (generate + diagnose): $(awk -v s="$start" -v e="$end" -v n="$n_all" 'BEGIN { printf "%.2f s", (e - s) / n }')"
