@@ -9,6 +9,7 @@
 //    a systematic mean per experiment and direction.
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <optional>
 #include <tuple>
@@ -41,7 +42,8 @@ struct FitNoiseOptions {
   std::optional<double> distance_m;
   std::vector<double> meas_sigma;  // [sigma_xy_m] or [sigma_xy_m, sigma_theta_rad]
   bool first_order = false;
-  bool reml = false;
+  bool reml = false;                  // --reml: accepted, REML is the default
+  bool ml = false;                    // --ml: plain maximum likelihood
   std::string plot;
   std::string ros2;
   std::string controller = "diff_drive_controller";
@@ -49,7 +51,8 @@ struct FitNoiseOptions {
   std::string report;
   JsonFlag json;
   std::string params_json;            // --params CAL.json: the calibrated robot
-  std::string systematic = "none";    // none | estimate
+  std::string systematic = "estimate";  // estimate | none (ignored with --params)
+  bool systematic_given = false;
 };
 
 /// The calibrated robot of a `calibrate --json` file: what --ros2 used
@@ -114,12 +117,20 @@ NoiseFitInputOptions InputOptions(const FitNoiseOptions& o, const std::optional<
 }
 
 /// Every run of a trajectory file with ground truth at its start and end.
+/// Appends runs of the file that becomes the next entry of out.sources.
+void AppendRuns(std::vector<WheelNoiseFitRun> runs, Loaded& out) {
+  const int source = static_cast<int>(out.sources.size());
+  for (WheelNoiseFitRun& r : runs) {
+    r.source = source;
+    out.runs.push_back(std::move(r));
+  }
+}
+
 void AppendTrajectoryRuns(const TrajectoryData& t, const RobotParams& robot, const std::string& prefix,
                           const NoiseFitInputOptions& in, Loaded& out) {
   int skipped = 0;
-  auto runs = NoiseRunsFromTrajectories(t, robot, prefix, in, &skipped);
+  AppendRuns(NoiseRunsFromTrajectories(t, robot, prefix, in, &skipped), out);
   out.skipped += skipped;
-  out.runs.insert(out.runs.end(), runs.begin(), runs.end());
 }
 
 void AppendManifest(const std::string& path, const FitNoiseOptions& o, const SystematicErrors& sys, Loaded& out) {
@@ -141,8 +152,7 @@ void AppendManifest(const std::string& path, const FitNoiseOptions& o, const Sys
     } else {
       const auto& ep = std::get<EndpointData>(rf);
       if (e.kind == ExperimentKind::kBackAndForth) {
-        auto runs = NoiseRunsFromEndpoints(ep, BackAndForthPath(e.distance_m), robot.wheelbase_m, prefix, in);
-        out.runs.insert(out.runs.end(), runs.begin(), runs.end());
+        AppendRuns(NoiseRunsFromEndpoints(ep, BackAndForthPath(e.distance_m), robot.wheelbase_m, prefix, in), out);
       } else if (e.kind == ExperimentKind::kSquare) {
         for (const bool cw : {true, false}) {  // one path per direction
           EndpointData part{ep.path, {}};
@@ -151,8 +161,7 @@ void AppendManifest(const std::string& path, const FitNoiseOptions& o, const Sys
               throw InputError(ep.path, r.line, 0, fmt::format("square run direction '{}' must be cw or ccw", r.direction));
             if ((r.direction == "cw") == cw) part.runs.push_back(r);
           }
-          auto runs = NoiseRunsFromEndpoints(part, SquarePath(e.side_m, cw), robot.wheelbase_m, prefix, in);
-          out.runs.insert(out.runs.end(), runs.begin(), runs.end());
+          AppendRuns(NoiseRunsFromEndpoints(part, SquarePath(e.side_m, cw), robot.wheelbase_m, prefix, in), out);
         }
       } else {
         throw InputError(e.resolved_file, "a 'free' experiment needs a trajectory CSV (its path comes from the ticks)");
@@ -183,9 +192,9 @@ Loaded Load(const FitNoiseOptions& o, const SystematicErrors& sys = {}) {
     } else {
       if (!o.distance_m)
         throw InvalidOptions(path + " holds endpoint errors: give --distance D (each run drove D forward, then D back)");
-      auto runs = NoiseRunsFromEndpoints(std::get<EndpointData>(rf), BackAndForthPath(*o.distance_m),
-                                         robot.wheelbase_m, prefix, in);
-      out.runs.insert(out.runs.end(), runs.begin(), runs.end());
+      AppendRuns(NoiseRunsFromEndpoints(std::get<EndpointData>(rf), BackAndForthPath(*o.distance_m),
+                                        robot.wheelbase_m, prefix, in),
+                 out);
     }
     out.sources.push_back(path);
   }
@@ -307,56 +316,66 @@ std::string FitNoiseReportHtml(const std::vector<std::string>& inputs, const Whe
   return rep.Render();
 }
 
-// Long (~165 lines): the command's steps in order (read, systematic errors,
-// fit, gate, print, JSON, --ros2, --plot, --report). Splitting it is
-// listed as follow-up work (issue 11).
-int RunFitNoise(const FitNoiseOptions& o) {
-  io::OutputSet& outs = CommandOutputs();
-  RegisterInputs(o.inputs, &o.robot);
-  if (!o.params_json.empty()) outs.AddInput(o.params_json);
-  outs.AddOutput("--json", o.json.path);
-  outs.AddOutput("--plot", o.plot);
-  outs.AddOutput("--report", o.report);
-  outs.AddOutput("--ros2", o.ros2);
-  outs.Check();
-  if (!o.params_json.empty() && o.systematic == "estimate")
-    throw InvalidOptions("--params and --systematic estimate contradict each other (give one)");
-  Loaded data = Load(o);
-  if (data.runs.empty()) throw InputError(o.inputs.front(), "no run with ground truth at its start and end");
-  WheelNoiseFitOptions fo;
-  fo.restricted = o.reml;
+/// The fit and the systematic errors it used.
+struct FitResult {
   WheelNoiseFitSummary s;
-  std::optional<SystematicErrors> estimated;
-  try {
-    if (o.systematic == "estimate") {
-      SystematicErrors e;
-      s = FitWheelNoiseWithSystematics([&](const SystematicErrors& x) { return Load(o, x).runs; }, fo, &e);
-      estimated = e;
-    } else {
-      Progress progress(fmt::format("fitting k_L, k_R to {} runs", data.runs.size()));
-      fo.progress = progress.Callback();
-      s = FitWheelNoise(data.runs, fo);
-    }
-  } catch (const InputError& e) {
-    throw InputError(o.inputs.front(), e.message());
+  SystematicErrors systematic;
+  std::string source;                      ///< "estimated", "params" or "none"
+  std::optional<SystematicEstimate> estimate;  ///< when estimated
+  bool kL_determined = true, kR_determined = true;
+};
+
+/// Step 2: k_L, k_R with the systematic errors estimated jointly (default),
+/// given by --params, or none (a calibrated robot).
+FitResult Fit(const FitNoiseOptions& o, const Loaded& data) {
+  WheelNoiseFitOptions fo;
+  fo.restricted = !o.ml;
+  fo.sources = data.sources;
+  FitResult f;
+  if (!o.params_json.empty()) {
+    f.source = "params";
+  } else {
+    f.source = o.systematic == "none" ? "none" : "estimated";
+  }
+  f.systematic = data.systematic;
+  Progress progress(fmt::format("fitting k_L, k_R to {} runs", data.runs.size()));
+  fo.progress = progress.Callback();
+  if (f.source == "estimated") {
+    SystematicEstimate e;
+    f.s = FitWheelNoiseWithSystematics([&](const SystematicErrors& x) { return Load(o, x).runs; }, fo, &e);
+    f.estimate = e;
+    f.systematic = e.value;
+  } else {
+    f.s = FitWheelNoise(data.runs, fo);
   }
   // k at its boundary 0: the data bound it from above only.
   auto determined = [](double k, const std::array<double, 2>& ci) { return !(ci[0] <= 0.0 && k < 0.01 * ci[1]); };
-  const bool kL_det = determined(s.k_L, s.k_L_ci), kR_det = determined(s.k_R, s.k_R_ci);
+  f.kL_determined = determined(f.s.k_L, f.s.k_L_ci);
+  f.kR_determined = determined(f.s.k_R, f.s.k_R_ci);
+  return f;
+}
+
+std::vector<std::string> Warnings(const Loaded& data, const FitResult& f) {
   std::vector<std::string> warnings;
   if (data.ground_truth && data.sigma_xy == 0.0 && data.sigma_theta == 0.0) {
     warnings.push_back(
         "the reference noise is 0 although the return errors come from a ground-truth system: its noise is then read "
         "as wheel noise and k comes out high; give --meas-sigma SXY,STHETA (or the manifest's [ground_truth])");
   }
-  for (const auto& [name, det, ci] : {std::tuple{"k_L", kL_det, s.k_L_ci}, std::tuple{"k_R", kR_det, s.k_R_ci}}) {
+  for (const auto& [name, det, ci] :
+       {std::tuple{"k_L", f.kL_determined, f.s.k_L_ci}, std::tuple{"k_R", f.kR_determined, f.s.k_R_ci}}) {
     if (!det) {
       warnings.push_back(fmt::format("{} is not determined: the data put it at the boundary 0 and bound it above by "
                                      "{:.3g} m^1/2 (95 %); more or longer runs would determine it",
                                      name, ci[1]));
     }
   }
+  return warnings;
+}
 
+/// The JSON document (contract keys first).
+nlohmann::json ResultJson(const FitNoiseOptions& o, const Loaded& data, const FitResult& f) {
+  const WheelNoiseFitSummary& s = f.s;
   nlohmann::json gof = nlohmann::json::array();
   for (const auto& g : s.goodness_of_fit)
     gof.push_back({{"element", g.element},
@@ -365,84 +384,96 @@ int RunFitNoise(const FitNoiseOptions& o) {
                    {"standard_error", g.standard_error},
                    {"z", g.z},
                    {"runs", g.runs}});
+  std::map<std::string, int> per_group;
+  for (const auto& r : data.runs) ++per_group[r.group];
   nlohmann::json groups = nlohmann::json::array();
   for (std::size_t g = 0; g < s.groups.size(); ++g) {
-    int n = 0;
-    for (const auto& r : data.runs) n += r.group == s.groups[g];
     groups.push_back({{"group", s.groups[g]},
-                      {"runs", n},
+                      {"runs", per_group[s.groups[g]]},
                       {"systematic_mean", {s.group_means[g](0), s.group_means[g](1), s.group_means[g](2)}}});
   }
-  // diff_drive_controller covariance diagonals from the fitted noise.
-  std::optional<OdometryCovariance> cov;
-  if (!o.ros2.empty()) {
-    if (!data.wheelbase_m) throw InvalidOptions("--ros2 needs the robot's wheelbase (--robot or --wheelbase)");
-    cov = OdometryCovarianceFromWheelNoise(s.k_L, s.k_R, *data.wheelbase_m, o.covariance);
-  }
   nlohmann::json j = {{"k_L", s.k_L},
-                            {"k_R", s.k_R},
-                            {"k_L_ci95", {JsonNumber(s.k_L_ci[0]), JsonNumber(s.k_L_ci[1])}},
-                            {"k_R_ci95", {JsonNumber(s.k_R_ci[0]), JsonNumber(s.k_R_ci[1])}},
-                            {"runs", s.runs},
-                            {"skipped_runs", data.skipped},
-                            {"groups", groups},
-                            {"meas_sigma", {data.sigma_xy, data.sigma_theta}},
-                            {"second_order", !o.first_order},
-                            {"restricted", o.reml},
-                            {"neg_log_likelihood", s.neg_log_likelihood},
-                            {"goodness_of_fit", gof},
-                            {"observed_covariance", JsonMatrix(s.observed_covariance)},
-                            {"predicted_covariance", JsonMatrix(s.predicted_covariance)},
-                            {"inputs", data.sources}};
-  j["k_L_determined"] = kL_det;
-  j["k_R_determined"] = kR_det;
+                      {"k_R", s.k_R},
+                      {"k_L_ci95", {JsonNumber(s.k_L_ci[0]), JsonNumber(s.k_L_ci[1])}},
+                      {"k_R_ci95", {JsonNumber(s.k_R_ci[0]), JsonNumber(s.k_R_ci[1])}},
+                      {"runs", s.runs},
+                      {"skipped_runs", data.skipped},
+                      {"groups", groups},
+                      {"meas_sigma", {data.sigma_xy, data.sigma_theta}},
+                      {"second_order", !o.first_order},
+                      {"restricted", !o.ml},
+                      {"neg_log_likelihood", s.neg_log_likelihood},
+                      {"goodness_of_fit", gof},
+                      {"observed_covariance", JsonMatrix(s.observed_covariance)},
+                      {"predicted_covariance", JsonMatrix(s.predicted_covariance)},
+                      {"inputs", data.sources}};
+  j["k_L_determined"] = f.kL_determined;
+  j["k_R_determined"] = f.kR_determined;
   j["k_L_upper95"] = JsonNumber(s.k_L_ci[1]);
   j["k_R_upper95"] = JsonNumber(s.k_R_ci[1]);
-  const SystematicErrors used = estimated ? *estimated : data.systematic;
-  j["systematic_errors"] = {{"source", estimated ? "estimated" : (o.params_json.empty() ? "none" : "params")},
-                             {"E_b", used.E_b},
-                             {"c_L", used.c_L},
-                             {"c_R", used.c_R},
-                             {"E_d", used.c_R / used.c_L}};
-  j["warnings"] = warnings;
-  if (o.json.PrintText()) {
-    fmt::print("fit-noise: {} runs in {} group(s){}\n", s.runs, s.groups.size(),
-               data.skipped ? fmt::format(" ({} runs without ground truth at both ends skipped)", data.skipped) : "");
-    for (const auto& [name, k, det, ci] :
-         {std::tuple{"k_L", s.k_L, kL_det, s.k_L_ci}, std::tuple{"k_R", s.k_R, kR_det, s.k_R_ci}}) {
-      if (det) {
-        fmt::print("  {} = {:.4g} m^1/2   95% interval [{:.4g}, {:.4g}]\n", name, k, ci[0], ci[1]);
-      } else {
-        fmt::print("  {} not determined (at the boundary 0); 95% upper bound {:.4g} m^1/2\n", name, ci[1]);
-      }
-    }
-    if (estimated) {
-      fmt::print("  systematic errors estimated jointly: E_b = {:.5f}, E_d = {:.5f} (c_L {:.5f}, c_R {:.5f})\n",
-                 estimated->E_b, estimated->c_R / estimated->c_L, estimated->c_L, estimated->c_R);
-    } else if (!o.params_json.empty()) {
-      fmt::print("  systematic errors from {}\n", o.params_json);
-    }
-    fmt::print("  reference noise per pose: {:.3g} m, {:.3g} rad; model: {} order{}\n", data.sigma_xy,
-               data.sigma_theta, o.first_order ? "first" : "second", o.reml ? ", REML" : "");
-    fmt::print("Systematic mean per group (ex [mm], ey [mm], etheta [mrad]):\n");
-    for (std::size_t g = 0; g < s.groups.size(); ++g)
-      fmt::print("  {:<40} {:>9.3f} {:>9.3f} {:>9.3f}\n", s.groups[g], 1e3 * s.group_means[g](0),
-                 1e3 * s.group_means[g](1), 1e3 * s.group_means[g](2));
-    fmt::print("Goodness of fit (residual covariance, observed vs model):\n");
-    fmt::print("  {:<6} {:>13} {:>13} {:>13} {:>7} {:>5}\n", "elem", "observed", "predicted", "std.error", "z",
-               "runs");
-    bool flagged = false;
-    for (const auto& g : s.goodness_of_fit) {
-      const bool bad = std::abs(g.z) > 3.0;
-      flagged |= bad;
-      fmt::print("  {:<6} {:>13.4e} {:>13.4e} {:>13.4e} {:>7.2f} {:>5}{}\n", g.element, g.observed, g.predicted,
-                 g.standard_error, g.z, g.runs, bad ? "  <- not explained by the model" : "");
-    }
-    if (flagged) fmt::print("  |z| > 3: the wheel noise model cannot explain that element (see docs/noise-model.md)\n");
-    for (const auto& w : warnings) fmt::print("  WARNING: {}\n", w);
-  } else {
-    for (const auto& w : warnings) fmt::print(stderr, "fit-noise: warning: {}\n", w);
+  const SystematicErrors& used = f.systematic;
+  j["systematic_errors"] = {{"source", f.source},
+                            {"E_b", used.E_b},
+                            {"c_L", used.c_L},
+                            {"c_R", used.c_R},
+                            {"E_d", used.c_R / used.c_L}};
+  if (f.estimate) {
+    j["systematic_errors"]["E_d_se"] = f.estimate->E_d_se;
+    j["systematic_errors"]["E_b_se"] = f.estimate->E_b_se;
+    j["systematic_errors"]["E_b_determined"] = f.estimate->E_b_determined;
   }
+  j["likelihood_passes"] = s.likelihood_passes;
+  j["warnings"] = Warnings(data, f);
+  return j;
+}
+
+void PrintText(const FitNoiseOptions& o, const Loaded& data, const FitResult& f, const nlohmann::json& j) {
+  const WheelNoiseFitSummary& s = f.s;
+  fmt::print("fit-noise: {} runs in {} group(s){}\n", s.runs, s.groups.size(),
+             data.skipped ? fmt::format(" ({} runs without ground truth at both ends skipped)", data.skipped) : "");
+  for (const auto& [name, k, det, ci] :
+       {std::tuple{"k_L", s.k_L, f.kL_determined, s.k_L_ci}, std::tuple{"k_R", s.k_R, f.kR_determined, s.k_R_ci}}) {
+    if (det) {
+      fmt::print("  {} = {:.4g} m^1/2   95% interval [{:.4g}, {:.4g}]\n", name, k, ci[0], ci[1]);
+    } else {
+      fmt::print("  {} not determined (at the boundary 0); 95% upper bound {:.4g} m^1/2\n", name, ci[1]);
+    }
+  }
+  if (f.estimate) {
+    const SystematicErrors& e = f.systematic;
+    fmt::print("  systematic errors estimated jointly: E_d = {:.5f} +- {:.5f} (from the scatter), E_b = {:.5f}{}\n",
+               e.c_R / e.c_L, f.estimate->E_d_se, e.E_b,
+               f.estimate->E_b_determined ? fmt::format(" +- {:.5f} (from the means)", f.estimate->E_b_se) : "");
+    if (!f.estimate->E_b_determined)
+      fmt::print("  note: this design (no turns) does not show E_b; k is relative to the recorded wheelbase "
+                 "(a wheelbase off by x % moves k by up to x %): give --params CAL.json from `umbmark calibrate`\n");
+  } else if (f.source == "params") {
+    fmt::print("  systematic errors from {}\n", o.params_json);
+  } else {
+    fmt::print("  systematic errors: none assumed (--systematic none: the robot is calibrated)\n");
+  }
+  fmt::print("  reference noise per pose: {:.3g} m, {:.3g} rad; model: {} order, {}\n", data.sigma_xy,
+             data.sigma_theta, o.first_order ? "first" : "second", o.ml ? "ML" : "REML");
+  fmt::print("Systematic mean per group (ex [mm], ey [mm], etheta [mrad]):\n");
+  for (std::size_t g = 0; g < s.groups.size(); ++g)
+    fmt::print("  {:<40} {:>9.3f} {:>9.3f} {:>9.3f}\n", s.groups[g], 1e3 * s.group_means[g](0),
+               1e3 * s.group_means[g](1), 1e3 * s.group_means[g](2));
+  fmt::print("Goodness of fit (residual covariance, observed vs model):\n");
+  fmt::print("  {:<6} {:>13} {:>13} {:>13} {:>7} {:>5}\n", "elem", "observed", "predicted", "std.error", "z", "runs");
+  bool flagged = false;
+  for (const auto& g : s.goodness_of_fit) {
+    const bool bad = std::abs(g.z) > 3.0;
+    flagged |= bad;
+    fmt::print("  {:<6} {:>13.4e} {:>13.4e} {:>13.4e} {:>7.2f} {:>5}{}\n", g.element, g.observed, g.predicted,
+               g.standard_error, g.z, g.runs, bad ? "  <- not explained by the model" : "");
+  }
+  if (flagged) fmt::print("  |z| > 3: the wheel noise model cannot explain that element (see docs/noise-model.md)\n");
+  for (const auto& w : j["warnings"]) fmt::print("  WARNING: {}\n", w.get<std::string>());
+}
+
+/// --plot, --report, --ros2; returns what was written.
+std::vector<std::string> WriteOutputs(const FitNoiseOptions& o, const Loaded& data, const WheelNoiseFitSummary& s,
+                                      nlohmann::json& j) {
   std::vector<std::string> written;
   std::string svg;
   if (!o.plot.empty() || !o.report.empty()) svg = PlotSvg(s, data.runs);
@@ -454,26 +485,56 @@ int RunFitNoise(const FitNoiseOptions& o) {
     CommandOutputs().Write(o.report, FitNoiseReportHtml(o.inputs, s, svg));
     written.push_back(o.report + " (HTML report)");
   }
-  if (cov) {
-    CommandOutputs().Write(
-        o.ros2,
-        io::FormatDiffDriveCovariance(
-            o.controller, cov->pose, cov->twist,
-            {fmt::format("ros2_control diff_drive_controller covariance from umbmark fit-noise: k_L = {:.4g}, k_R = {:.4g} "
-                         "m^1/2, wheelbase {} m", s.k_L, s.k_R, *data.wheelbase_m),
-             fmt::format("stated for {} m/s at {} Hz updates (variances scale with speed; derivation: docs/ros2.md)",
-                         o.covariance.speed_mps, o.covariance.rate_hz),
-             fmt::format("{} = not measured by planar odometry (z, roll, pitch and rates); {} = lateral velocity "
-                         "(non-holonomic constraint)", kUnmeasuredVariance, kConstraintVariance)}));
-    j["ros2"] = {{"file", o.ros2},
-                 {"controller", o.controller},
-                 {"rate_hz", o.covariance.rate_hz},
-                 {"speed_mps", o.covariance.speed_mps},
-                 {"pose_covariance_diagonal", cov->pose},
-                 {"twist_covariance_diagonal", cov->twist}};
-    if (o.json.PrintText()) fmt::print("  wrote {} (diff_drive_controller covariance at {} m/s, {} Hz)\n", o.ros2,
-                                       o.covariance.speed_mps, o.covariance.rate_hz);
+  if (o.ros2.empty()) return written;
+  // diff_drive_controller covariance diagonals from the fitted noise.
+  const OdometryCovariance cov = OdometryCovarianceFromWheelNoise(s.k_L, s.k_R, *data.wheelbase_m, o.covariance);
+  CommandOutputs().Write(
+      o.ros2,
+      io::FormatDiffDriveCovariance(
+          o.controller, cov.pose, cov.twist,
+          {fmt::format("ros2_control diff_drive_controller covariance from umbmark fit-noise: k_L = {:.4g}, k_R = {:.4g} "
+                       "m^1/2, wheelbase {} m", s.k_L, s.k_R, *data.wheelbase_m),
+           fmt::format("stated for {} m/s at {} Hz updates (variances scale with speed; derivation: docs/ros2.md)",
+                       o.covariance.speed_mps, o.covariance.rate_hz),
+           fmt::format("{} = not measured by planar odometry (z, roll, pitch and rates); {} = lateral velocity "
+                       "(non-holonomic constraint)", kUnmeasuredVariance, kConstraintVariance)}));
+  j["ros2"] = {{"file", o.ros2},
+               {"controller", o.controller},
+               {"rate_hz", o.covariance.rate_hz},
+               {"speed_mps", o.covariance.speed_mps},
+               {"pose_covariance_diagonal", cov.pose},
+               {"twist_covariance_diagonal", cov.twist}};
+  if (o.json.PrintText())
+    fmt::print("  wrote {} (diff_drive_controller covariance at {} m/s, {} Hz)\n", o.ros2, o.covariance.speed_mps,
+               o.covariance.rate_hz);
+  return written;
+}
+
+// The command's steps: register files, read, fit, JSON, text, outputs.
+int RunFitNoise(const FitNoiseOptions& o) {
+  io::OutputSet& outs = CommandOutputs();
+  RegisterInputs(o.inputs, &o.robot);
+  if (!o.params_json.empty()) outs.AddInput(o.params_json);
+  outs.AddOutput("--json", o.json.path);
+  outs.AddOutput("--plot", o.plot);
+  outs.AddOutput("--report", o.report);
+  outs.AddOutput("--ros2", o.ros2);
+  outs.Check();
+  if (!o.params_json.empty() && o.systematic == "estimate" && o.systematic_given)
+    throw InvalidOptions("--params and --systematic estimate contradict each other (give one)");
+  if (o.ml && o.reml) throw InvalidOptions("--ml and --reml contradict each other (give one)");
+  const Loaded data = Load(o);
+  if (data.runs.empty()) throw InputError(o.inputs.front(), "no run with ground truth at its start and end");
+  if (!o.ros2.empty() && !data.wheelbase_m)
+    throw InvalidOptions("--ros2 needs the robot's wheelbase (--robot or --wheelbase)");
+  const FitResult f = Fit(o, data);
+  nlohmann::json j = ResultJson(o, data, f);
+  if (o.json.PrintText()) {
+    PrintText(o, data, f, j);
+  } else {
+    for (const auto& w : j["warnings"]) fmt::print(stderr, "fit-noise: warning: {}\n", w.get<std::string>());
   }
+  std::vector<std::string> written = WriteOutputs(o, data, f.s, j);
   o.json.Emit(j);
   if (!o.json.path.empty() && !o.json.ToStdout()) written.push_back(o.json.path + " (JSON)");
   PrintWritten(written, o.json.PrintText());
@@ -495,7 +556,9 @@ Command SetupFitNoise(CLI::App& parent) {
                   "manifest's [ground_truth], else 0)")
       ->delimiter(',');
   app->add_flag("--first-order", opts->first_order, "Fit the first-order model only (no heading-squared term)");
-  app->add_flag("--reml", opts->reml, "Restricted maximum likelihood (allow for the fitted systematic means)");
+  app->add_flag("--reml", opts->reml,
+                "Restricted maximum likelihood, allowing for the fitted systematic means (the default)");
+  app->add_flag("--ml", opts->ml, "Plain maximum likelihood instead of REML (k about 1 % low with 60 runs)");
   app->add_option("--plot", opts->plot,
                   "Write an SVG: per group the runs with observed and fitted 95% ellipses about the group mean");
   app->add_option("--report", opts->report, "Write a self-contained HTML report (k_L, k_R with intervals, checks, plots)");
@@ -513,9 +576,11 @@ Command SetupFitNoise(CLI::App& parent) {
                   "calibrated robot really drove, so uncorrected systematic errors do not bias k")
       ->check(CLI::ExistingFile);
   app->add_option("--systematic", opts->systematic,
-                  "none: the robot is calibrated (the odometry's path); estimate: estimate E_b, E_d jointly with k")
+                  "estimate: estimate E_d (from the scatter) and E_b (from the means) jointly with k, so k is unbiased "
+                  "on an uncalibrated robot; none: assume a calibrated robot (the odometry's path). Ignored with --params")
       ->check(CLI::IsMember({"none", "estimate"}))
-      ->capture_default_str();
+      ->capture_default_str()
+      ->each([opts](const std::string&) { opts->systematic_given = true; });
   opts->json.Bind(*app);
   return {app, [opts] { return RunFitNoise(*opts); }};
 }

@@ -110,7 +110,7 @@ TEST_CASE("fit-noise CLI: endpoint, trajectory and manifest inputs agree; contra
   std::ifstream f(svg);
   const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
   CHECK(text.find("<svg") != std::string::npos);
-  CHECK(text.find("etheta [mrad]") != std::string::npos);
+  CHECK(text.find("e_theta [mrad]") != std::string::npos);
 
   // Same runs as a trajectory CSV: the path comes from the wheel travel.
   // First order: Kelly's form along the samples equals the closed form.
@@ -163,6 +163,16 @@ TEST_CASE("fit-noise CLI exit codes", "[fit_noise_cli]") {
   const fs::path few = c.dir / "few.csv";
   Write(few, "run,direction,ex_m,ey_m,etheta_rad\n1,fwd_back,0.001,0.01,0.001\n2,fwd_back,0.0,0.0,0.0\n");
   CHECK(Run(fmt::format("fit-noise {} --robot {} --distance 10", few.string(), c.robot.string())).status == 1);
+  // A group with a single run, in the second of two files: the message
+  // names that file and the run's line (not "<input>" or the first file).
+  const fs::path lone = c.dir / "lone.csv";
+  Write(lone, "run,direction,ex_m,ey_m,etheta_rad\n1,a,0.001,0.01,0.001\n2,a,0.0,0.0,0.0\n3,a,0.002,0.01,0.002\n"
+              "4,b,0.0,0.0,0.0\n");
+  const auto single = Run(fmt::format("fit-noise {} {} --robot {} --distance 10", c.endpoint.string(), lone.string(),
+                                      c.robot.string()));
+  CHECK(single.status == 1);
+  CHECK(single.err.find(lone.string() + ":5: run 4 is the only run of group") != std::string::npos);
+  CHECK(single.err.find("<input>") == std::string::npos);
   // Runs without any scatter and no measurement noise: every wheel-noise
   // covariance is singular, so the fit cannot start -- the quality gate
   // (exit 3), not a number.

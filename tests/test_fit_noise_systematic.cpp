@@ -5,14 +5,11 @@
 // [0.99, 1.01] and E_b in [0.97, 1.03]: 60 runs of 10 m forward and back
 // (Chong & Kleeman section 6.3, k_L = 0.0004, k_R = 0.00058 m^1/2), the
 // reference measuring start and end with 0.5 mm / 0.1 deg noise.
-// Measured (docs/noise-model.md): ignoring the systematic errors, coverage
-// k_L 0.335, k_R 0.380 and bias +55 %, +22 %; estimated jointly 0.895,
-// 0.920 and -0.8 %, -1.8 %; given (--params) 0.920, 0.930 and -1.8 %,
-// -0.6 %. Tolerances: bias under 3 % (the issue's); coverage 0.88-0.98 (the
-// issue asks 93-97 %; the joint estimate reaches 0.895 for k_L, and 200
-// campaigns give coverage a standard error of 1.5 points).
+// Measured over 1000 campaigns by bench/fit_noise_coverage.sh (table in
+// docs/noise-model.md); here 400 with a binomial tolerance (below).
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -88,34 +85,34 @@ struct Tally {
 
 }  // namespace
 
-TEST_CASE("fit-noise is unbiased with uncorrected systematic errors (200 campaigns)", "[fit_noise][systematic]") {
+TEST_CASE("fit-noise is unbiased with uncorrected systematic errors (400 campaigns)", "[fit_noise][systematic]") {
   const auto path = BackAndForthPath(10.0);
   NoiseFitInputOptions in;
   in.sigma_xy_m = 0.0005;
   in.sigma_theta_rad = Deg2Rad(0.1);
+  WheelNoiseFitOptions reml;  // fit-noise's default
+  reml.restricted = true;
   Tally ignored, estimated, given;
   std::mt19937_64 draw(2024);
   std::uniform_real_distribution<double> Ed(0.99, 1.01), Eb(0.97, 1.03);
-  const int campaigns = 200;
+  const int campaigns = 400;
   for (int c = 0; c < campaigns; ++c) {
     const double E_d = Ed(draw), E_b = Eb(draw);
     const EndpointData data = Simulate(path, E_d, E_b, 60, 5000 + static_cast<std::uint64_t>(c), "fwd_back");
     // As fit-noise did before: the covariance along the odometry's path.
-    const auto runs0 = NoiseRunsFromEndpoints(data, path, kB, "", in);
-    const WheelNoiseFitSummary s0 = FitWheelNoise(runs0);
-    ignored.Add(s0);
-    // Estimated jointly (fit-noise without --params).
+    ignored.Add(FitWheelNoise(NoiseRunsFromEndpoints(data, path, kB, "", in), reml));
+    // Estimated jointly (fit-noise's default).
     estimated.Add(FitWheelNoiseWithSystematics(
         [&](const SystematicErrors& e) {
           NoiseFitInputOptions with = in;
           with.systematic = e;
           return NoiseRunsFromEndpoints(data, path, kB, "", with);
         },
-        {}, nullptr));
+        reml, nullptr));
     // Given (fit-noise --params CAL.json): the true factors.
     NoiseFitInputOptions known = in;
     known.systematic = {E_b, 2.0 / (E_d + 1.0), 2.0 * E_d / (E_d + 1.0)};
-    given.Add(FitWheelNoise(NoiseRunsFromEndpoints(data, path, kB, "", known)));
+    given.Add(FitWheelNoise(NoiseRunsFromEndpoints(data, path, kB, "", known), reml));
   }
   auto report = [](const char* name, const Tally& t) {
     return fmt::format("{}: coverage k_L {:.3f}, k_R {:.3f}; bias k_L {:+.4f}, k_R {:+.4f}", name, t.CoverL(),
@@ -127,14 +124,53 @@ TEST_CASE("fit-noise is unbiased with uncorrected systematic errors (200 campaig
   // Ignoring them is what the joint estimate fixes: far outside.
   CHECK(ignored.BiasL() > 0.2);
   CHECK(ignored.CoverL() < 0.6);
+  // Binomial tolerances. fit-noise's default (estimated jointly): a true
+  // coverage of 0.95 over 400 campaigns has a standard deviation of
+  // sqrt(0.95 * 0.05 / 400) = 0.0109; the check is 0.95 +- 3 of them,
+  // [0.917, 0.983] (a correct method fails it with probability 0.3 %). The
+  // previous delta-method widening (0.895 for k_L over 4000 campaigns)
+  // fails it. --params (the true factors): the issue's band 93-97 % widened
+  // by 3 binomial standard deviations at its ends, [0.892, 0.996] (these
+  // 400 campaigns give 0.912 for k_L; 1000 give 0.93-0.95, see
+  // docs/noise-model.md). Bias: under 3 % (the issue's); its standard error
+  // over 400 campaigns is about 0.5 %.
+  const double sd95 = std::sqrt(0.95 * 0.05 / campaigns);
+  const double lo = 0.93 - 3.0 * std::sqrt(0.93 * 0.07 / campaigns), hi = 0.97 + 3.0 * std::sqrt(0.97 * 0.03 / campaigns);
+  CHECK(std::abs(estimated.CoverL() - 0.95) <= 3.0 * sd95);
+  CHECK(std::abs(estimated.CoverR() - 0.95) <= 3.0 * sd95);
+  CHECK(given.CoverL() >= lo);
+  CHECK(given.CoverL() <= hi);
+  CHECK(given.CoverR() >= lo);
+  CHECK(given.CoverR() <= hi);
   for (const Tally* t : {&estimated, &given}) {
-    CHECK(t->CoverL() >= 0.88);
-    CHECK(t->CoverL() <= 0.98);
-    CHECK(t->CoverR() >= 0.88);
-    CHECK(t->CoverR() <= 0.98);
     CHECK(std::abs(t->BiasL()) < 0.03);
     CHECK(std::abs(t->BiasR()) < 0.03);
   }
+}
+
+TEST_CASE("fit-noise's joint E_d: few likelihood passes, E_d recovered", "[fit_noise][systematic]") {
+  // One campaign with E_d = 0.993: the joint fit finds E_d within 3 of its
+  // standard errors, and the whole fit with both intervals takes far fewer
+  // likelihood passes than the old Brent-in-bisection search (~2,500).
+  const auto path = BackAndForthPath(10.0);
+  NoiseFitInputOptions in;
+  in.sigma_xy_m = 0.0005;
+  in.sigma_theta_rad = Deg2Rad(0.1);
+  const EndpointData data = Simulate(path, 0.993, 1.0, 120, 77, "fwd_back");
+  SystematicEstimate e;
+  const WheelNoiseFitSummary s = FitWheelNoiseWithSystematics(
+      [&](const SystematicErrors& x) {
+        NoiseFitInputOptions with = in;
+        with.systematic = x;
+        return NoiseRunsFromEndpoints(data, path, kB, "", with);
+      },
+      {}, &e);
+  INFO(s.BriefReport() << "; E_d " << e.value.c_R / e.value.c_L << " +- " << e.E_d_se << "; passes "
+                       << s.likelihood_passes);
+  CHECK(e.E_d_se > 0.0);
+  CHECK(std::abs(e.value.c_R / e.value.c_L - 0.993) < 3.0 * e.E_d_se);
+  CHECK_FALSE(e.E_b_determined);  // no turn: the means do not show E_b
+  CHECK(s.likelihood_passes < 250);
 }
 
 TEST_CASE("fit-noise CLI: k at the boundary is 'not determined'; --params and --systematic estimate", "[fit_noise][cli]") {
@@ -157,12 +193,15 @@ TEST_CASE("fit-noise CLI: k at the boundary is 'not determined'; --params and --
                                       0.371 * 1.02, 0.1 * cL, 0.1 * cR));
   const std::string base = fmt::format("fit-noise {} --robot {} --distance 10 --meas-sigma 0.0005,0.001745 --json -",
                                        (dir / "fb.csv").string(), (dir / "robot.toml").string());
-  const auto plain = testing::RunCli(base);
+  const auto plain = testing::RunCli(base + " --systematic none");
+  const auto deflt = testing::RunCli(base);
   const auto given = testing::RunCli(base + " --params " + (dir / "cal.json").string());
   const auto est = testing::RunCli(base + " --systematic estimate");
   REQUIRE(plain.status == 0);
   REQUIRE(given.status == 0);
   REQUIRE(est.status == 0);
+  REQUIRE(deflt.status == 0);
+  CHECK(nlohmann::json::parse(deflt.out)["systematic_errors"]["source"] == "estimated");  // the default
   const auto jp = nlohmann::json::parse(plain.out), jg = nlohmann::json::parse(given.out),
              je = nlohmann::json::parse(est.out);
   CHECK(jg["systematic_errors"]["source"] == "params");
@@ -210,7 +249,7 @@ TEST_CASE("fit-noise CLI: k at the boundary is 'not determined'; --params and --
     }
     REQUIRE(!z.empty());
     write(dir / "zero.csv", z);
-    const auto r = testing::RunCli(fmt::format("fit-noise {} --robot {} --distance 10 --json -", (dir / "zero.csv").string(),
+    const auto r = testing::RunCli(fmt::format("fit-noise {} --robot {} --distance 10 --systematic none --ml --json -", (dir / "zero.csv").string(),
                                                (dir / "robot.toml").string()));
     REQUIRE(r.status == 0);
     const auto j = nlohmann::json::parse(r.out);
@@ -219,7 +258,7 @@ TEST_CASE("fit-noise CLI: k at the boundary is 'not determined'; --params and --
     CHECK(j["k_L_upper95"].get<double>() > 0.0);
     CHECK(j["k_L_upper95"].get<double>() < kTrueKR);
     CHECK(j["k_R_determined"] == true);
-    const auto text = testing::RunCli(fmt::format("fit-noise {} --robot {} --distance 10", (dir / "zero.csv").string(),
+    const auto text = testing::RunCli(fmt::format("fit-noise {} --robot {} --distance 10 --systematic none --ml", (dir / "zero.csv").string(),
                                                   (dir / "robot.toml").string()));
     CHECK(text.out.find("k_L not determined (at the boundary 0); 95% upper bound") != std::string::npos);
   }

@@ -5,18 +5,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 
-#include <ceres/first_order_function.h>
-#include <ceres/jet.h>
-#include <ceres/gradient_problem.h>
-#include <ceres/gradient_problem_solver.h>
 #include <Eigen/Dense>
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
 #include "stats/distributions.hpp"
-#include "stats/optimize.hpp"
+#include "error_models/wheel_noise_likelihood.hpp"
 
 namespace umbmark {
 
@@ -32,214 +27,48 @@ PoseCovariance MeasurementCovariance(double sigma_xy_m, double sigma_theta_rad, 
 std::string WheelNoiseFitOptions::Check() const {
   if (!(confidence > 0.0 && confidence < 1.0)) return fmt::format("confidence = {} must be in (0, 1)", confidence);
   if (max_iterations < 10) return fmt::format("max_iterations = {} must be >= 10", max_iterations);
+  if (!(E_d_prior_sigma > 0.0) || !std::isfinite(E_d_prior_sigma))
+    return fmt::format("E_d_prior_sigma = {} must be positive and finite", E_d_prior_sigma);
+  if (!std::isfinite(E_d_prior_centre)) return fmt::format("E_d_prior_centre = {} must be finite", E_d_prior_centre);
   return {};
 }
 
 namespace {
 
-/// Group index of every run, in first-seen order.
-struct Grouping {
-  std::vector<int> of_run;
-  std::vector<std::string> names;
-  std::vector<int> count, count_theta;
-  /// Plain mean error of each group (etheta over the runs that have it), a
-  /// centre that keeps ProfiledNll's one-pass sums free of cancellation.
-  std::vector<Eigen::Vector3d> centre;
-};
+using noise_fit::Grouping;
+using noise_fit::LikelihoodModel;
+using noise_fit::Optimum;
 
-Grouping MakeGroups(const std::vector<WheelNoiseFitRun>& runs) {
-  Grouping g;
-  std::map<std::string, int> index;
-  for (const WheelNoiseFitRun& r : runs) {
-    auto [it, inserted] = index.emplace(r.group, static_cast<int>(g.names.size()));
-    if (inserted) {
-      g.names.push_back(r.group);
-      g.count.push_back(0);
-      g.count_theta.push_back(0);
-    }
-    g.of_run.push_back(it->second);
-    ++g.count[static_cast<std::size_t>(it->second)];
-    if (r.has_theta) ++g.count_theta[static_cast<std::size_t>(it->second)];
-  }
-  g.centre.assign(g.names.size(), Eigen::Vector3d::Zero());
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    const auto k = static_cast<std::size_t>(g.of_run[i]);
-    g.centre[k].head<2>() += runs[i].error.head<2>() / g.count[k];
-    if (runs[i].has_theta) g.centre[k](2) += runs[i].error(2) / g.count_theta[k];
-  }
-  return g;
-}
-
-/// Profiled negative log-likelihood (group means by GLS) for k_L^2 = qL,
-/// k_R^2 = qR. Returns false when some S_i is not positive definite.
-/// One pass over the runs, storing nothing per run (a fit evaluates this a
-/// few thousand times, so with 10^6 runs its memory traffic is the cost):
-/// with d_i = e_i - c_g (c_g the group's centre) and b_g = sum S_i^-1 d_i,
-///   sum_i (d_i - m_g)^T S_i^-1 (d_i - m_g) = sum_i d_i^T S_i^-1 d_i - b_g^T m_g
-/// at the GLS mean m_g = W_g^-1 b_g, W_g = sum S_i^-1.
-template <typename T>
-bool ProfiledNll(const std::vector<WheelNoiseFitRun>& runs, const Grouping& grp, const T& qL, const T& qR, T* nll,
-                 std::vector<Eigen::Matrix<T, 3, 1>>* means = nullptr, bool restricted = false) {
-  using M3 = Eigen::Matrix<T, 3, 3>;
-  using V3 = Eigen::Matrix<T, 3, 1>;
+/// Throws InputError, naming the run's file and line, when the data cannot
+/// identify the model.
+void CheckIdentifiable(const std::vector<WheelNoiseFitRun>& runs, const Grouping& grp,
+                       const std::vector<std::string>& sources) {
+  auto file = [&](int source) {
+    return source >= 0 && static_cast<std::size_t>(source) < sources.size() ? sources[static_cast<std::size_t>(source)]
+                                                                          : std::string();
+  };
   const std::size_t n = runs.size(), G = grp.names.size();
-  std::vector<M3> W(G, M3::Zero());
-  std::vector<V3> b(G, V3::Zero());
-  T total(0.0);
+  if (n < G + 2)
+    throw InputError(runs.empty() ? std::string() : file(runs.front().source),
+                     fmt::format("{} runs in {} groups: fit-noise needs at least groups + 2 runs", n, G));
   for (std::size_t i = 0; i < n; ++i) {
     const WheelNoiseFitRun& r = runs[i];
-    const SecondOrderBasis& q2 = r.second_order;
-    const M3 S = qL * r.basis.A_L.cast<T>() + qR * r.basis.A_R.cast<T>() + (qL * qL) * q2.LL.cast<T>() +
-                 (qL * qR) * q2.LR.cast<T>() + (qR * qR) * q2.RR.cast<T>() + r.measurement.cast<T>();
-    // Positive definiteness by leading principal minors (Sylvester).
-    const T m1 = S(0, 0), m2 = S(0, 0) * S(1, 1) - S(0, 1) * S(1, 0);
-    if (!(m1 > T(0.0)) || !(m2 > T(0.0))) return false;
-    M3 Si = M3::Zero();
-    T logdet;
-    if (r.has_theta) {
-      const T det = S.determinant();
-      if (!(det > T(0.0))) return false;
-      Si = S.inverse();
-      logdet = log(det);
-    } else {
-      const Eigen::Matrix<T, 2, 2> S2 = S.template topLeftCorner<2, 2>();
-      Si.template topLeftCorner<2, 2>() = S2.inverse();
-      logdet = log(m2);
-    }
-    const auto g = static_cast<std::size_t>(grp.of_run[i]);
-    const V3 d = (r.error - grp.centre[g]).cast<T>();  // d(2) meets only zeros of Si without etheta
-    const V3 Sd = Si * d;
-    W[g] += Si;
-    b[g] += Sd;
-    total += T(0.5) * (d.dot(Sd) + logdet);
-  }
-  std::vector<V3> mu(G, V3::Zero());
-  for (std::size_t g = 0; g < G; ++g) {
-    V3 m = V3::Zero();
-    if (grp.count_theta[g] > 0) {
-      m = W[g].inverse() * b[g];
-      if (restricted) total += T(0.5) * log(W[g].determinant());
-    } else {
-      const Eigen::Matrix<T, 2, 2> W2 = W[g].template topLeftCorner<2, 2>();
-      const Eigen::Matrix<T, 2, 1> m2 = W2.inverse() * b[g].template head<2>();
-      m << m2(0), m2(1), T(0.0);
-      if (restricted) total += T(0.5) * log(W2.determinant());
-    }
-    total -= T(0.5) * b[g].dot(m);
-    mu[g] = m + grp.centre[g].cast<T>();  // centre(2) is 0 in a group without etheta
-  }
-  *nll = total;
-  if (means) *means = mu;
-  return true;
-}
-
-/// NLL as a function of (log k_L, log k_R).
-struct NllCost {
-  const std::vector<WheelNoiseFitRun>* runs;
-  const Grouping* grp;
-  bool restricted = false;  ///< REML (see WheelNoiseFitOptions::restricted)
-
-  template <typename T>
-  bool operator()(const T* p, T* cost) const {
-    const T qL = exp(T(2.0) * p[0]), qR = exp(T(2.0) * p[1]);
-    return ProfiledNll<T>(*runs, *grp, qL, qR, cost, nullptr, restricted);
-  }
-};
-
-/// Automatic first derivatives of NllCost (a minimal stand-in for
-/// ceres::AutoDiffFirstOrderFunction that keeps the Jets on the stack).
-class NllFunction final : public ceres::FirstOrderFunction {
- public:
-  explicit NllFunction(const NllCost& cost) : cost_(cost) {}
-  bool Evaluate(const double* parameters, double* cost, double* gradient) const override {
-    if (gradient == nullptr) return cost_(parameters, cost);
-    using J = ceres::Jet<double, 2>;
-    const J p[2] = {J(parameters[0], 0), J(parameters[1], 1)};
-    J out(0.0);
-    if (!cost_(p, &out)) return false;
-    *cost = out.a;
-    gradient[0] = out.v[0];
-    gradient[1] = out.v[1];
-    return true;
-  }
-  int NumParameters() const override { return 2; }
-
- private:
-  NllCost cost_;
-};
-
-struct Minimum {
-  bool ok = false;
-  double nll = std::numeric_limits<double>::infinity();
-  std::vector<double> params;
-  int iterations = 0;
-  std::string message;
-};
-
-ceres::GradientProblemSolver::Options SolverOptions(int max_iterations) {
-  ceres::GradientProblemSolver::Options o;
-  o.line_search_direction_type = ceres::LBFGS;
-  o.max_num_iterations = max_iterations;
-  o.function_tolerance = 1e-13;
-  o.gradient_tolerance = 1e-9;
-  o.parameter_tolerance = 1e-12;
-  o.logging_type = ceres::SILENT;
-  return o;
-}
-
-Minimum Minimise(const NllCost& cost, std::vector<double> start, int max_iterations) {
-  Minimum m;
-  ceres::GradientProblemSolver::Summary summary;
-  ceres::GradientProblem problem(new NllFunction(cost));
-  ceres::Solve(SolverOptions(max_iterations), problem, start.data(), &summary);
-  m.ok = summary.termination_type == ceres::CONVERGENCE && std::isfinite(summary.final_cost);
-  m.nll = summary.final_cost;
-  m.params = start;
-  m.iterations = static_cast<int>(summary.iterations.size());
-  m.message = summary.message;
-  return m;
-}
-
-}  // namespace
-
-double WheelNoiseNegLogLikelihood(const std::vector<WheelNoiseFitRun>& runs, double k_L, double k_R) {
-  const Grouping grp = MakeGroups(runs);
-  double nll = 0.0;
-  if (!ProfiledNll(runs, grp, k_L * k_L, k_R * k_R, &nll)) return std::numeric_limits<double>::infinity();
-  return nll;
-}
-
-std::string WheelNoiseFitSummary::BriefReport() const {
-  return fmt::format("k_L = {:.4g} m^1/2 [{:.4g}, {:.4g}], k_R = {:.4g} m^1/2 [{:.4g}, {:.4g}] ({:.0f}% profile "
-                     "likelihood), {} runs in {} groups",
-                     k_L, k_L_ci[0], k_L_ci[1], k_R, k_R_ci[0], k_R_ci[1], 100 * confidence, runs, groups.size());
-}
-
-// ~150 lines: grouping, the maximum-likelihood fit, both profile-likelihood
-// intervals and the goodness-of-fit table share one set of per-group sums;
-// splitting it into stages is follow-up work (issue 11).
-WheelNoiseFitSummary FitWheelNoise(const std::vector<WheelNoiseFitRun>& runs, const WheelNoiseFitOptions& options) {
-  if (auto e = options.Check(); !e.empty()) throw InvalidOptions(e);
-  // 1. Check the data can identify the model.
-  const Grouping grp = MakeGroups(runs);
-  const std::size_t n = runs.size(), G = grp.names.size();
-  if (n < G + 2) throw InputError("", fmt::format("{} runs in {} groups: fit-noise needs at least groups + 2 runs", n, G));
-  for (std::size_t g = 0; g < G; ++g)
-    if (grp.count[g] < 2)
-      throw InputError("", fmt::format("group '{}' has a single run; its systematic mean would absorb it", grp.names[g]));
-  for (const WheelNoiseFitRun& r : runs) {
+    if (grp.count[static_cast<std::size_t>(grp.of_run[i])] < 2)
+      throw InputError(file(r.source), r.line, 0,
+                       fmt::format("run {} is the only run of group '{}'; its systematic mean would absorb it (give "
+                                   "every direction at least 2 runs)",
+                                   r.run, r.group));
     if (!r.error.head<2>().allFinite() || (r.has_theta && !std::isfinite(r.error(2))))
-      throw InputError("", fmt::format("run {}: return error is not finite", r.run));
+      throw InputError(file(r.source), r.line, 0, fmt::format("run {}: return error is not finite", r.run));
   }
+}
 
-  // 2. Starting point: method of moments on the pooled residual covariance.
-  Eigen::Vector3d mean_all = Eigen::Vector3d::Zero();
-  std::vector<Eigen::Vector3d> gm(G, Eigen::Vector3d::Zero());
-  for (std::size_t i = 0; i < n; ++i) gm[static_cast<std::size_t>(grp.of_run[i])] += runs[i].error;
-  for (std::size_t g = 0; g < G; ++g) gm[g] /= grp.count[g];
+/// Starting point (log k_L, log k_R): method of moments on the pooled
+/// residual covariance about the plain group means.
+Eigen::Vector2d StartingPoint(const std::vector<WheelNoiseFitRun>& runs, const Grouping& grp) {
   PoseCovariance So = PoseCovariance::Zero(), SL = So, SR = So, SM = So;
-  for (std::size_t i = 0; i < n; ++i) {
-    Eigen::Vector3d r = runs[i].error - gm[static_cast<std::size_t>(grp.of_run[i])];
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    Eigen::Vector3d r = runs[i].error - grp.centre[static_cast<std::size_t>(grp.of_run[i])];
     if (!runs[i].has_theta) r(2) = 0.0;
     So += r * r.transpose();
     SL += runs[i].basis.A_L;
@@ -259,100 +88,38 @@ WheelNoiseFitSummary FitWheelNoise(const std::vector<WheelNoiseFitRun>& runs, co
   Eigen::Vector2d q = A.colPivHouseholderQr().solve(y);
   const double qmax = std::max({q(0), q(1), 1e-16});
   q = q.cwiseMax(0.01 * qmax);
-  std::vector<double> start{0.5 * std::log(q(0)), 0.5 * std::log(q(1))};
-  (void)mean_all;
+  return {0.5 * std::log(q(0)), 0.5 * std::log(q(1))};
+}
 
-  // 3. Maximum likelihood over (log k_L, log k_R).
-  NllCost cost{&runs, &grp, options.restricted};
-  double nll0 = 0.0;
-  if (!ProfiledNll(runs, grp, q(0), q(1), &nll0))
-    throw QualityGateError("fit-noise: the starting point has a singular run covariance");
-  ProgressCounter progress(options.progress, options.intervals ? 3.0 : 1.0);
-  const Minimum best = Minimise(cost, start, options.max_iterations);
-  progress.Add();
-  if (!best.ok)
-    throw QualityGateError(fmt::format("fit-noise: the maximum-likelihood solver did not converge ({})", best.message));
-
-  WheelNoiseFitSummary out;
-  out.k_L = std::exp(best.params[0]);
-  out.k_R = std::exp(best.params[1]);
-  out.neg_log_likelihood = best.nll;
-  out.iterations = best.iterations;
-  out.solver_message = best.message;
-  out.confidence = options.confidence;
-  out.runs = static_cast<int>(n);
-  out.groups = grp.names;
-
-  // 4. Profile-likelihood intervals.
-  const double delta = 0.5 * ChiSquareQuantile(options.confidence, 1.0);
-  // Profile NLL: with one k fixed, minimise over the other by Brent's method
-  // in log k (one-dimensional and robust where the likelihood is flat, e.g.
-  // when the other k is at its boundary 0), also trying the other k = 0.
-  auto nll_at = [&](int which, double k_fixed, double k_other) {
-    double v = 0.0;
-    const double qf = k_fixed * k_fixed, qo = k_other * k_other;
-    const bool ok = which == 0 ? ProfiledNll<double>(runs, grp, qf, qo, &v, nullptr, options.restricted)
-                               : ProfiledNll<double>(runs, grp, qo, qf, &v, nullptr, options.restricted);
-    return ok ? v : std::numeric_limits<double>::infinity();
-  };
-  auto profile = [&](int which, double k, double other_log_start) {
-    // 28 bits: |log k| <= ~15, so ~1e-7 in log k, as precise as the NLL is flat.
-    const ScalarMinimum m = MinimizeBrent([&](double u) { return nll_at(which, k, std::exp(u)); },
-                                          other_log_start - 15.0, other_log_start + 5.0, 28);
-    return std::min(m.f, nll_at(which, k, 0.0));
-  };
-  auto interval = [&](int which) -> std::array<double, 2> {
-    const double khat = which == 0 ? out.k_L : out.k_R;
-    const double other = which == 0 ? best.params[1] : best.params[0];
-    auto g = [&](double k) { return profile(which, k, other) - best.nll - delta; };
-    // Root of g between khat (g <= 0, the optimum) and b (g > 0).
-    auto bisect = [&](double a, double b) { return FindRoot(g, a, b, 1e-6 * khat); };
-    std::array<double, 2> ci{0.0, std::numeric_limits<double>::infinity()};
-    if (g(0.0) > 0.0) ci[0] = bisect(khat, 0.0);
-    double hi = khat * 1.25 + 1e-12;
-    for (int it = 0; it < 60; ++it, hi *= 2.0) {
-      if (g(hi) > 0.0) {
-        ci[1] = bisect(khat, hi);
-        break;
-      }
-    }
-    return ci;
-  };
-  if (options.intervals) {
-    out.k_L_ci = interval(0);
-    progress.Add();
-    out.k_R_ci = interval(1);
-    progress.Add();
-  } else {
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    out.k_L_ci = out.k_R_ci = {nan, nan};
-  }
-
-  // 5. Residuals and goodness of fit at the optimum.
-  std::vector<Eigen::Vector3d> mu;
-  double nll_check = 0.0;
-  ProfiledNll(runs, grp, out.k_L * out.k_L, out.k_R * out.k_R, &nll_check, &mu);
-  out.group_means = mu;
-  const WheelNoise fitted{out.k_L, out.k_R};
+/// Each of the six covariance elements of the residuals at the fit (pooled
+/// over runs, N - G degrees of freedom) against the model's average S_i;
+/// also fills the residuals and S_i per run.
+void GoodnessOfFit(const LikelihoodModel& model, const Eigen::Vector3d& theta, WheelNoiseFitSummary& out) {
+  const std::vector<WheelNoiseFitRun>& runs = *model.runs;
+  const Grouping& grp = *model.groups;
+  const double qL = std::exp(2.0 * theta(0)), qR = std::exp(2.0 * theta(1));
+  const double eps = model.Dimension() == 3 ? theta(2) : 0.0;
   const char* names[6] = {"xx", "yy", "thth", "xy", "xth", "yth"};
   const int ia[6] = {0, 1, 2, 0, 0, 1}, ib[6] = {0, 1, 2, 1, 2, 2};
   std::array<double, 6> obs{}, pred{}, var{};
   std::array<int, 6> cnt{};
   std::array<std::vector<int>, 6> groups_seen;
-  for (std::size_t i = 0; i < n; ++i) {
+  const std::vector<Eigen::Vector3d>& mu = out.group_means;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
     const WheelNoiseFitRun& r = runs[i];
-    const PoseCovariance S = r.basis.Evaluate(fitted) + r.second_order.Covariance(fitted) + r.measurement;
+    const PoseCovariance S = noise_fit::RunCovariance(model, i, qL, qR, eps);
     Eigen::Vector3d res = r.error - mu[static_cast<std::size_t>(grp.of_run[i])];
     if (!r.has_theta) res(2) = std::numeric_limits<double>::quiet_NaN();
     out.residuals.push_back(res);
     out.predicted_run_covariance.push_back(S);
     for (int e = 0; e < 6; ++e) {
       if (!r.has_theta && (ia[e] == 2 || ib[e] == 2)) continue;
-      obs[static_cast<std::size_t>(e)] += res(ia[e]) * res(ib[e]);
-      pred[static_cast<std::size_t>(e)] += S(ia[e], ib[e]);
-      var[static_cast<std::size_t>(e)] += S(ia[e], ia[e]) * S(ib[e], ib[e]) + S(ia[e], ib[e]) * S(ia[e], ib[e]);
-      ++cnt[static_cast<std::size_t>(e)];
-      auto& seen = groups_seen[static_cast<std::size_t>(e)];
+      const auto k = static_cast<std::size_t>(e);
+      obs[k] += res(ia[e]) * res(ib[e]);
+      pred[k] += S(ia[e], ib[e]);
+      var[k] += S(ia[e], ia[e]) * S(ib[e], ib[e]) + S(ia[e], ib[e]) * S(ia[e], ib[e]);
+      ++cnt[k];
+      auto& seen = groups_seen[k];
       if (std::find(seen.begin(), seen.end(), grp.of_run[i]) == seen.end()) seen.push_back(grp.of_run[i]);
     }
   }
@@ -372,6 +139,76 @@ WheelNoiseFitSummary FitWheelNoise(const std::vector<WheelNoiseFitRun>& runs, co
     out.observed_covariance(ia[e], ib[e]) = out.observed_covariance(ib[e], ia[e]) = c.observed;
     out.predicted_covariance(ia[e], ib[e]) = out.predicted_covariance(ib[e], ia[e]) = c.predicted;
   }
+}
+
+}  // namespace
+
+double WheelNoiseNegLogLikelihood(const std::vector<WheelNoiseFitRun>& runs, double k_L, double k_R) {
+  const Grouping grp = noise_fit::MakeGroups(runs);
+  const LikelihoodModel model{&runs, &grp};
+  const noise_fit::Evaluation e = noise_fit::Evaluate(model, Eigen::Vector3d(std::log(k_L), std::log(k_R), 0.0));
+  return e.ok ? e.nll : std::numeric_limits<double>::infinity();
+}
+
+std::string WheelNoiseFitSummary::BriefReport() const {
+  return fmt::format("k_L = {:.4g} m^1/2 [{:.4g}, {:.4g}], k_R = {:.4g} m^1/2 [{:.4g}, {:.4g}] ({:.0f}% profile "
+                     "likelihood), {} runs in {} groups",
+                     k_L, k_L_ci[0], k_L_ci[1], k_R, k_R_ci[0], k_R_ci[1], 100 * confidence, runs, groups.size());
+}
+
+WheelNoiseFitSummary FitWheelNoise(const std::vector<WheelNoiseFitRun>& runs, const WheelNoiseFitOptions& options,
+                                   const std::vector<WheelNoiseRunSensitivity>* E_d_sensitivity) {
+  if (auto e = options.Check(); !e.empty()) throw InvalidOptions(e);
+  if (E_d_sensitivity && E_d_sensitivity->size() != runs.size())
+    throw InvalidOptions(fmt::format("E_d_sensitivity has {} entries for {} runs", E_d_sensitivity->size(), runs.size()));
+  // 1. Groups; check the data can identify the model.
+  const Grouping grp = noise_fit::MakeGroups(runs);
+  CheckIdentifiable(runs, grp, options.sources);
+  LikelihoodModel model{&runs, &grp, E_d_sensitivity, options.restricted, options.E_d_prior_centre,
+                        options.E_d_prior_sigma};
+  // 2. Maximum likelihood from the method-of-moments start.
+  const Eigen::Vector2d start = StartingPoint(runs, grp);
+  Eigen::Vector3d theta0(start(0), start(1), 0.0);  // eps = 0: the value the bases were built at
+  if (!noise_fit::Evaluate(model, theta0).ok)
+    throw QualityGateError("fit-noise: the starting point has a singular run covariance");
+  ProgressCounter progress(options.progress, options.intervals ? 3.0 : 1.0);
+  const Optimum best = noise_fit::Minimise(model, theta0, {true, true, true}, options.max_iterations);
+  progress.Add();
+  if (!best.ok || !std::isfinite(best.at.nll))
+    throw QualityGateError("fit-noise: the maximum-likelihood search failed (a run covariance became singular)");
+  WheelNoiseFitSummary out;
+  out.k_L = std::exp(best.theta(0));
+  out.k_R = std::exp(best.theta(1));
+  out.neg_log_likelihood = best.at.nll;
+  out.iterations = best.iterations;
+  out.solver_message = "Fisher scoring";
+  out.confidence = options.confidence;
+  out.runs = static_cast<int>(runs.size());
+  out.groups = grp.names;
+  if (E_d_sensitivity) {
+    out.E_d_offset = best.theta(2);
+    const Eigen::Matrix3d Iinv = best.at.information.inverse();
+    out.E_d_offset_se = std::sqrt(std::max(Iinv(2, 2), 0.0));
+  }
+  // 3. Profile-likelihood intervals (k_L, then k_R; below, then above).
+  if (options.intervals) {
+    const double dof = static_cast<double>(runs.size()) - static_cast<double>(grp.names.size()) - model.Dimension();
+    const double t = StudentTQuantile(0.5 + 0.5 * options.confidence, std::max(dof, 1.0));
+    const double delta = options.small_sample ? 0.5 * t * t : 0.5 * ChiSquareQuantile(options.confidence, 1.0);
+    for (int j = 0; j < 2; ++j) {
+      std::array<double, 2>& ci = j == 0 ? out.k_L_ci : out.k_R_ci;
+      ci = {noise_fit::IntervalEnd(model, best, j, -1, delta, options.max_iterations),
+            noise_fit::IntervalEnd(model, best, j, +1, delta, options.max_iterations)};
+      progress.Add();
+    }
+  } else {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    out.k_L_ci = out.k_R_ci = {nan, nan};
+  }
+  // 4. Group means, residuals and goodness of fit at the optimum.
+  noise_fit::Evaluate(model, best.theta, &out.group_means);
+  GoodnessOfFit(model, best.theta, out);
+  out.likelihood_passes = model.passes;
   return out;
 }
 

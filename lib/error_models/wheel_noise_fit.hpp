@@ -16,12 +16,17 @@
 // (experiment and direction) -- residual systematic errors (UMBmark leaves
 // some) must not be read as noise. Runs without a heading error use the x-y
 // block. The group means are profiled out in closed form (generalised least
-// squares) and the likelihood is maximised over (log k_L, log k_R) with
-// Ceres' gradient solver (L-BFGS, automatic derivatives).
+// squares) and the likelihood is maximised over (log k_L, log k_R) by
+// Fisher scoring (wheel_noise_likelihood.hpp).
+//
+// Joint fit (uncalibrated robot): with per-run sensitivities of the bases
+// to the diameter ratio E_d (WheelNoiseRunSensitivity), eps = E_d - E_d0 is
+// a third likelihood parameter, with a weak Gaussian prior; it is profiled
+// out in the intervals like the other k.
 //
 // 95% intervals: profile likelihood, {k : 2 (min NLL(k, .) - NLL_min) <=
-// 3.8415} (chi^2_1), found by bracketing and root finding; a bound that the
-// data cannot close is +inf.
+// 3.8415} (chi^2_1), the minimum over the other k (and eps); the searches
+// are in wheel_noise_likelihood.hpp. A bound the data cannot close is +inf.
 //
 // Goodness of fit: each of the six covariance elements of the residuals
 // (pooled over runs, N - G degrees of freedom) against the model's average
@@ -48,6 +53,10 @@ namespace umbmark {
 struct WheelNoiseFitRun {
   std::string group;  ///< systematic-mean group (e.g. "fwd_back" or "exp2:cw")
   std::string run;    ///< run id (for reports)
+  /// Where the run came from, for messages: index into
+  /// WheelNoiseFitOptions::sources (-1: unknown) and its 1-based line (0: unknown).
+  int source = -1;
+  std::size_t line = 0;
   Eigen::Vector3d error = Eigen::Vector3d::Zero();  ///< [ex, ey, etheta] (etheta wrapped)
   bool has_theta = true;                            ///< false: etheta not measured
   CovarianceBasis basis;                            ///< motion covariance per unit k^2
@@ -70,21 +79,46 @@ struct WheelNoiseFitRun {
 ///   M = diag(2 s_xy^2, 2 s_xy^2, s_th^2) + s_th^2 u u^T,  u = [y, -x, -1].
 PoseCovariance MeasurementCovariance(double sigma_xy_m, double sigma_theta_rad, const Pose2& relative);
 
+/// How run i's bases move with the diameter ratio E_d about the value E_d0
+/// they were built at: basis(E_d0 + eps) = basis + eps d1 + eps^2 d2 (and
+/// the same for the second-order terms); central differences of three
+/// builds (FitWheelNoiseWithSystematics).
+struct WheelNoiseRunSensitivity {
+  CovarianceBasis d1, d2;
+  SecondOrderBasis q1, q2;
+};
+
 struct WheelNoiseFitOptions {
   /// Confidence level of the profile-likelihood intervals, in (0, 1).
   double confidence = 0.95;
-  /// L-BFGS iteration limit of each optimisation (>= 10).
+  /// Fisher-scoring iteration limit of each optimisation (>= 10).
   int max_iterations = 200;
   /// Restricted maximum likelihood (REML): adds 1/2 sum_g log det(sum_i
   /// S_i^-1) so the noise estimate allows for the degrees of freedom the
   /// group means use (ML underestimates k^2 by about groups / runs).
   bool restricted = false;
+  /// Small-sample threshold of the profile intervals: 2 dNLL <= t^2 of
+  /// Student's t with N - G - P degrees of freedom (runs, groups, likelihood
+  /// parameters; Bates & Watts' profile-t) instead of chi^2_1. With 60 runs
+  /// chi^2_1 (3.84) covers the truth in about 94 % of simulated campaigns;
+  /// t^2 (4.01) allows for the estimated means and parameters.
+  bool small_sample = true;
   /// Compute the profile-likelihood intervals (the costly part). false:
   /// k_L_ci, k_R_ci are left NaN (inner fits of a joint estimate).
   bool intervals = true;
   /// Progress in stages (core/progress.hpp): the maximum-likelihood fit,
   /// then each of the two profile intervals. Default: none.
   ProgressCallback progress;
+  /// Joint fit only: the weak Gaussian prior on eps = E_d - E_d0, centre
+  /// (relative to the build value E_d0) and sigma (> 0). Default 0, 0.02:
+  /// an uncalibrated robot's E_d is within a few percent of 1, and a design
+  /// whose scatter says nothing about E_d keeps it near the value its
+  /// means give.
+  double E_d_prior_centre = 0.0;
+  double E_d_prior_sigma = 0.02;
+  /// File names that WheelNoiseFitRun::source indexes; an InputError about
+  /// a run names its file and line.
+  std::vector<std::string> sources;
   /// Empty when valid, else a message naming the bad field.
   std::string Check() const;
 };
@@ -115,15 +149,23 @@ struct WheelNoiseFitSummary {
   PoseCovariance predicted_covariance = PoseCovariance::Zero();
   int iterations = 0;
   std::string solver_message;
+  /// Joint fit: the fitted eps = E_d - E_d0 and its standard error (Fisher
+  /// information); 0 otherwise.
+  double E_d_offset = 0.0, E_d_offset_se = 0.0;
+  /// Likelihood passes over the runs (the cost with many runs).
+  int likelihood_passes = 0;
 
   std::string BriefReport() const;
 };
 
-/// Fits k_L, k_R. Throws InvalidOptions for bad options, InputError (file
-/// "") when the data cannot identify the model (fewer than groups + 2 runs,
+/// Fits k_L, k_R. Throws InvalidOptions for bad options, InputError (the
+/// run's file and line from `sources`) when the data cannot identify the model (fewer than groups + 2 runs,
 /// a group with a single run, non-finite errors), and QualityGateError when
 /// the solver fails to converge or the likelihood is not finite at the fit.
-WheelNoiseFitSummary FitWheelNoise(const std::vector<WheelNoiseFitRun>& runs, const WheelNoiseFitOptions& options = {});
+/// With `E_d_sensitivity` (one per run), E_d is fitted jointly (see above);
+/// InvalidOptions when its size differs from the runs'.
+WheelNoiseFitSummary FitWheelNoise(const std::vector<WheelNoiseFitRun>& runs, const WheelNoiseFitOptions& options = {},
+                                   const std::vector<WheelNoiseRunSensitivity>* E_d_sensitivity = nullptr);
 
 /// Negative log-likelihood (constants dropped) at given k with the group
 /// means profiled out; +inf when some S_i is not positive definite.

@@ -13,12 +13,9 @@
 #include "kinematics/diff_drive.hpp"
 #include "kinematics/odometry.hpp"
 
-#include <Eigen/Cholesky>
-#include <boost/math/distributions/normal.hpp>
-#include <boost/math/tools/minima.hpp>
-#include <optional>
-#include <limits>
 #include <stdexcept>
+
+#include <Eigen/Cholesky>
 #include <Eigen/LU>
 
 namespace umbmark {
@@ -42,6 +39,7 @@ std::vector<WheelNoiseFitRun> NoiseRunsFromEndpoints(const EndpointData& data, c
     WheelNoiseFitRun f;
     f.group = group_prefix + r.direction;
     f.run = r.run;
+    f.line = r.line;
     f.has_theta = r.etheta_rad.has_value();
     f.error = Eigen::Vector3d(r.ex_m, r.ey_m, f.has_theta ? WrapAngle(*r.etheta_rad) : 0.0);
     f.basis = pc.motion;
@@ -90,6 +88,7 @@ std::vector<WheelNoiseFitRun> NoiseRunsFromTrajectories(const TrajectoryData& da
       f.group += odo.theta < 0.0 ? ":cw" : ":ccw";
     }
     f.run = run.run;
+    f.line = run.lines.empty() ? 0 : run.lines.front();
     f.error = Eigen::Vector3d(gt.x - odo.x, gt.y - odo.y, WrapAngle(gt.theta - odo.theta));
     f.basis = kelly.motion;
     if (options.second_order) f.second_order = SecondOrderHeadingBasis(true_travel, true_wheelbase);
@@ -122,6 +121,11 @@ Eigen::Vector3d SystematicReturnError(const std::vector<WheelSegment>& travel, d
 
 SystematicErrors EstimateSystematicErrors(const std::vector<WheelNoiseFitRun>& runs,
                                           const WheelNoiseFitSummary& fit) {
+  return EstimateSystematicErrorsWithSe(runs, fit).value;
+}
+
+SystematicEstimate EstimateSystematicErrorsWithSe(const std::vector<WheelNoiseFitRun>& runs,
+                                                  const WheelNoiseFitSummary& fit) {
   // Per group: its fitted mean, the information of that mean (sum of the
   // runs' inverse covariances; heading dropped for runs without it) and the
   // runs that can predict it.
@@ -154,7 +158,13 @@ SystematicErrors EstimateSystematicErrors(const std::vector<WheelNoiseFitRun>& r
   Eigen::Vector3d x(1.0, 1.0, 1.0);
   bool any = false;
   for (std::size_t g = 0; g < G; ++g) any = any || !members[g].empty();
-  if (!any) return {};
+  SystematicEstimate out;
+  if (!any) {
+    out.E_b_se = kPriorSigma;
+    out.E_b_determined = false;
+    return out;
+  }
+  Eigen::Matrix3d H_last = Eigen::Matrix3d::Identity() / (kPriorSigma * kPriorSigma);
   for (int it = 0; it < 20; ++it) {
     Eigen::Matrix3d H = Eigen::Matrix3d::Identity() / (kPriorSigma * kPriorSigma);
     Eigen::Vector3d grad = (x - Eigen::Vector3d::Ones()) / (kPriorSigma * kPriorSigma);
@@ -174,64 +184,94 @@ SystematicErrors EstimateSystematicErrors(const std::vector<WheelNoiseFitRun>& r
     }
     const Eigen::Vector3d step = H.ldlt().solve(grad);
     x -= step;
+    H_last = H;
     if (!x.allFinite()) return {};
     if (step.norm() < 1e-10) break;
   }
-  return {x(0), x(1), x(2)};
+  out.value = {x(0), x(1), x(2)};
+  // Posterior standard deviation of E_b: near the prior's, the means do not see it.
+  out.E_b_se = std::sqrt(std::max(H_last.inverse()(0, 0), 0.0));
+  out.E_b_determined = out.E_b_se < 0.5 * kPriorSigma;
+  return out;
 }
 
+namespace {
+
+/// Per-run sensitivities of the bases to E_d (WheelNoiseRunSensitivity) by
+/// central differences of builds at E0 - h and E0 + h about `centre` (built
+/// at E0); one extra build is alive at a time.
+std::vector<WheelNoiseRunSensitivity> Sensitivities(const std::vector<WheelNoiseFitRun>& centre,
+                                                    const std::function<std::vector<WheelNoiseFitRun>(double)>& at,
+                                                    double E0, double h) {
+  std::vector<WheelNoiseRunSensitivity> s(centre.size());
+  for (const double sign : {-1.0, 1.0}) {
+    const std::vector<WheelNoiseFitRun> side = at(E0 + sign * h);
+    if (side.size() != centre.size()) throw std::logic_error("fit-noise: builds differ in their runs");
+    for (std::size_t i = 0; i < side.size(); ++i) {
+      const WheelNoiseFitRun &c = centre[i], &r = side[i];
+      WheelNoiseRunSensitivity& d = s[i];
+      auto add = [&](PoseCovariance& d1, PoseCovariance& d2, const PoseCovariance& v, const PoseCovariance& v0) {
+        d1 += sign / (2.0 * h) * v;                        // (f+ - f-) / 2h
+        d2 += (v - v0) / (2.0 * h * h);                    // (f+ - 2 f0 + f-) / 2h^2
+      };
+      add(d.d1.A_L, d.d2.A_L, r.basis.A_L, c.basis.A_L);
+      add(d.d1.A_R, d.d2.A_R, r.basis.A_R, c.basis.A_R);
+      add(d.q1.LL, d.q2.LL, r.second_order.LL, c.second_order.LL);
+      add(d.q1.LR, d.q2.LR, r.second_order.LR, c.second_order.LR);
+      add(d.q1.RR, d.q2.RR, r.second_order.RR, c.second_order.RR);
+    }
+  }
+  return s;
+}
+
+}  // namespace
+
+// Steps: (1) E_b and the scale from the group means (EstimateSystematicErrors);
+// (2) the bases at E_d0 and their sensitivities, E_d fitted jointly with k
+// by Fisher scoring; recentred at the fitted E_d until the offset is under a
+// quarter of the difference step (the quadratic expansion is then exact to
+// far below the noise); (3) the final fit with E_d profiled in the intervals.
 WheelNoiseFitSummary FitWheelNoiseWithSystematics(
     const std::function<std::vector<WheelNoiseFitRun>(const SystematicErrors&)>& build,
-    const WheelNoiseFitOptions& options, SystematicErrors* estimated) {
+    const WheelNoiseFitOptions& options, SystematicEstimate* estimated) {
   WheelNoiseFitOptions quick = options;
   quick.intervals = false;
   quick.progress = nullptr;  // only the final fit reports (its stages are the long part)
-  const std::vector<WheelNoiseFitRun> runs0 = build(SystematicErrors{});
-  const SystematicErrors from_means = EstimateSystematicErrors(runs0, FitWheelNoise(runs0, quick));
-  // E_d by profile likelihood, the mean diameter factor and E_b kept.
-  const double scale = 0.5 * (from_means.c_L + from_means.c_R);
+  SystematicEstimate from_means;
+  {
+    const std::vector<WheelNoiseFitRun> runs0 = build(SystematicErrors{});
+    from_means = EstimateSystematicErrorsWithSe(runs0, FitWheelNoise(runs0, quick));
+  }
+  const SystematicErrors& m = from_means.value;
+  const double scale = 0.5 * (m.c_L + m.c_R), E_means = m.c_R / m.c_L;
   auto with_ed = [&](double E_d) {
-    return SystematicErrors{from_means.E_b, 2.0 * scale / (E_d + 1.0), 2.0 * scale * E_d / (E_d + 1.0)};
+    return SystematicErrors{m.E_b, 2.0 * scale / (E_d + 1.0), 2.0 * scale * E_d / (E_d + 1.0)};
   };
-  auto quick_fit = [&](double E_d) -> std::optional<WheelNoiseFitSummary> {
-    try {
-      return FitWheelNoise(build(with_ed(E_d)), quick);
-    } catch (const std::runtime_error&) {  // a fit that fails is not the optimum
-      return std::nullopt;
+  auto at = [&](double E_d) { return build(with_ed(E_d)); };
+  constexpr double kStep = 0.004;  // difference step in E_d
+  double E0 = E_means;
+  WheelNoiseFitSummary out;
+  for (int pass = 0;; ++pass) {
+    const std::vector<WheelNoiseFitRun> runs = at(E0);
+    const std::vector<WheelNoiseRunSensitivity> sens = Sensitivities(runs, at, E0, kStep);
+    WheelNoiseFitOptions o = quick;
+    o.E_d_prior_centre = E_means - E0;
+    const WheelNoiseFitSummary f = FitWheelNoise(runs, o, &sens);
+    if (std::abs(f.E_d_offset) > 0.25 * kStep && pass < 4) {
+      E0 += f.E_d_offset;
+      continue;
     }
-  };
-  auto nll = [&](double E_d) {
-    const auto f = quick_fit(E_d);
-    return f ? f->neg_log_likelihood : std::numeric_limits<double>::infinity();
-  };
-  const double ed0 = from_means.c_R / from_means.c_L;
-  std::uintmax_t iterations = 30;
-  const auto best = boost::math::tools::brent_find_minima(nll, ed0 - 0.03, ed0 + 0.03, 20, iterations);
-  const SystematicErrors chosen = with_ed(best.first);
-  if (estimated) *estimated = chosen;
-  WheelNoiseFitSummary out = FitWheelNoise(build(chosen), options);
-  if (!options.intervals) return out;
-  // The intervals above hold E_d at its estimate. Its uncertainty (from the
-  // curvature of the profile likelihood in E_d) moves k by dk/dE_d; each
-  // interval end is widened by the delta method,
-  //   half width * sqrt(1 + (dk/dE_d sigma_E_d / sigma_k)^2),
-  // sigma_k the interval's own width / (2 z).
-  const double h = 0.002;
-  const auto lo = quick_fit(best.first - h), hi = quick_fit(best.first + h);
-  if (!lo || !hi) return out;
-  const double curvature = (lo->neg_log_likelihood + hi->neg_log_likelihood - 2.0 * best.second) / (h * h);
-  if (!(curvature > 0.0)) return out;
-  const double sigma_ed = 1.0 / std::sqrt(curvature);
-  const double z = boost::math::quantile(boost::math::normal(), 0.5 + 0.5 * options.confidence);
-  auto widen = [&](double k, std::array<double, 2>& ci, double dk) {
-    if (!std::isfinite(ci[0]) || !std::isfinite(ci[1]) || !(ci[1] > ci[0])) return;
-    const double sigma_k = (ci[1] - ci[0]) / (2.0 * z);
-    const double factor = std::sqrt(1.0 + std::pow(dk * sigma_ed / sigma_k, 2));
-    ci[0] = std::max(0.0, k - (k - ci[0]) * factor);
-    ci[1] = k + (ci[1] - k) * factor;
-  };
-  widen(out.k_L, out.k_L_ci, (hi->k_L - lo->k_L) / (2.0 * h));
-  widen(out.k_R, out.k_R_ci, (hi->k_R - lo->k_R) / (2.0 * h));
+    o.intervals = options.intervals;
+    o.progress = options.progress;
+    out = options.intervals ? FitWheelNoise(runs, o, &sens) : f;
+    out.likelihood_passes += options.intervals ? f.likelihood_passes : 0;
+    break;
+  }
+  if (estimated) {
+    *estimated = from_means;
+    estimated->value = with_ed(E0 + out.E_d_offset);
+    estimated->E_d_se = out.E_d_offset_se;
+  }
   return out;
 }
 

@@ -57,18 +57,36 @@ struct NoiseFitInputOptions {
 SystematicErrors EstimateSystematicErrors(const std::vector<WheelNoiseFitRun>& runs,
                                           const WheelNoiseFitSummary& fit);
 
+/// Systematic errors with what the data say about them.
+struct SystematicEstimate {
+  SystematicErrors value;
+  /// Standard error of E_d (joint fit: the scatter's Fisher information,
+  /// with the prior) and of E_b (from the group means and the prior).
+  double E_d_se = 0.0, E_b_se = 0.0;
+  /// false: the groups' means do not show E_b (no turn in the design, e.g.
+  /// straight forward and back): E_b stays at the prior's 1 and k is
+  /// relative to the recorded wheelbase (give the calibration to fix it).
+  bool E_b_determined = true;
+};
+
+/// EstimateSystematicErrors with the standard error of E_b.
+SystematicEstimate EstimateSystematicErrorsWithSe(const std::vector<WheelNoiseFitRun>& runs,
+                                                  const WheelNoiseFitSummary& fit);
+
 /// k_L, k_R with the systematic errors estimated jointly: the means give
-/// (E_b, c_L, c_R) (EstimateSystematicErrors), then E_d = c_R / c_L is
-/// refined by maximising the likelihood of the run scatter (profiled over
-/// k_L, k_R and the group means; Brent within +-0.03 of the means' value):
-/// a path that retraces itself (forward and back) hides E_d from the mean
-/// return error, but its curvature still shapes the covariance. `build`
-/// turns systematic errors into fit runs (NoiseRunsFromEndpoints /
-/// NoiseRunsFromTrajectories with NoiseFitInputOptions::systematic).
-/// *estimated receives the errors used for the returned fit.
+/// (E_b, c_L, c_R) (EstimateSystematicErrors); E_d = c_R / c_L is then a
+/// third likelihood parameter of the run scatter (the bases' quadratic
+/// expansion in E_d from builds at E_d0 and E_d0 +- 0.004, recentred at the
+/// fit), with a weak prior (WheelNoiseFitOptions::E_d_prior_sigma) at the
+/// means' value, and profiled out in the intervals: a path that retraces
+/// itself (forward and back) hides E_d from the mean return error, but its
+/// curvature still shapes the covariance. `build` turns systematic errors
+/// into fit runs (NoiseRunsFromEndpoints / NoiseRunsFromTrajectories with
+/// NoiseFitInputOptions::systematic) and must give the same runs in the
+/// same order each time. *estimated receives the errors of the returned fit.
 WheelNoiseFitSummary FitWheelNoiseWithSystematics(
     const std::function<std::vector<WheelNoiseFitRun>(const SystematicErrors&)>& build,
-    const WheelNoiseFitOptions& options, SystematicErrors* estimated);
+    const WheelNoiseFitOptions& options, SystematicEstimate* estimated);
 
 /// One run per endpoint row; `path` is what every run drove (wheelbase_m
 /// resolves turn segments). Rows without etheta use the x-y block.
