@@ -15,11 +15,25 @@
 namespace umbmark::io {
 
 namespace {
+// TOML basic string: quotes, backslashes and control characters escaped
+// (TOML 1.0, "String").
 std::string TomlString(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\b': out += "\\b"; break;
+      case '\t': out += "\\t"; break;
+      case '\n': out += "\\n"; break;
+      case '\f': out += "\\f"; break;
+      case '\r': out += "\\r"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7F)
+          out += fmt::format("\\u{:04X}", static_cast<unsigned>(static_cast<unsigned char>(c)));
+        else
+          out += c;
+    }
   }
   return out + "\"";
 }
@@ -50,6 +64,14 @@ std::string FormatTrajectoryCsv(const TrajectoryData& data, const std::vector<st
   return out;
 }
 
+// Written by hand rather than through toml++ (linked, used by the reader):
+// toml++ 3.3 built with GCC prints doubles through a stream with 17
+// significant digits (0.2 -> 0.20000000000000001, 2796.8 ->
+// 2796.8000000000002; TOML_FLOAT_CHARCONV is 0 for GCC), its
+// relaxed_float_precision flag prints 6 (0.08404612345678 -> 0.0840461: no
+// round trip), it sorts keys (an experiment would start with `file`, not
+// `kind`) and it writes no comments. fmt's {} gives the shortest digits
+// that read back bit for bit (test_io_manifest_writer).
 std::string FormatManifest(const Manifest& manifest, const std::vector<std::string>& comment) {
   std::string out;
   for (const auto& line : comment) out += "# " + line + "\n";
