@@ -119,7 +119,9 @@ double ResidualPanels(const nlohmann::json& j, double top, std::vector<std::stri
     for (int k = 0; k < 3; ++k) p.Points(comp[k], styles[k], 2.6, kComponentNames[k]);
     const io::SvgStyle mark_style{"#b02020", "circle", "", 1.5, false};
     p.Points(marks, mark_style, 8.0, "largest");
-    for (const auto& [pt, r] : mark_labels) p.Text({pt.x, pt.y}, fmt::format("  {}", r), "#b02020", 12);
+    // Numbers beside the rings, kept inside the panel for values at its edge.
+    for (const auto& [pt, r] : mark_labels)
+      p.Text({pt.x, std::clamp(pt.y, -0.9 * limit, 0.85 * limit)}, fmt::format("  {}", r), "#b02020", 12);
     std::vector<std::pair<io::SvgStyle, std::string>> legend = {
         {{"#777", "square", "", 1.5, true},
          fmt::format("95% band of the baseline (|z| <= 1.96): {:.1f}% of the values lie outside (5% expected)",

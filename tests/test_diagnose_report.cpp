@@ -118,6 +118,10 @@ TEST_CASE("report text: units, p-values, evidence in words, impossible fits", "[
   // Impossible values are symptoms; plausible ones are not flagged.
   CHECK(UnphysicalFit("turn_scrub", {{"k", -0.2}}, 20).find("negative turn scrub") != std::string::npos);
   CHECK(UnphysicalFit("turn_scrub", {{"k", 0.05}}, 20).empty());
+  // Slightly negative: impossible only when its standard error says it is
+  // below 0 (the real June OptiOdom campaign: k = -0.0062, se 0.001).
+  CHECK_FALSE(UnphysicalFit("turn_scrub", {{"k", -0.0062}}, 20, {{"k", 0.001}}).empty());
+  CHECK(UnphysicalFit("turn_scrub", {{"k", -0.0062}}, 20, {{"k", 0.005}}).empty());
   CHECK_FALSE(UnphysicalFit("castor_kick", {{"kappa", -0.2}}, 20).empty());
   CHECK(UnphysicalFit("castor_kick", {{"kappa", 0.004}}, 20).empty());
   CHECK_FALSE(UnphysicalFit("correlated_noise", {{"rho", 0.99}}, 20).empty());

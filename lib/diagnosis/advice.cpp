@@ -49,12 +49,16 @@ std::string EvidenceInWords(double gain, double evidence, double heldout_shrink)
                      grade, 100.0 * std::max(heldout_shrink, 0.0), odds, gain, evidence);
 }
 
-std::string UnphysicalFit(const std::string& effect, const std::map<std::string, double>& params, int runs) {
+std::string UnphysicalFit(const std::string& effect, const std::map<std::string, double>& params, int runs,
+                          const std::map<std::string, double>& se) {
   auto get = [&](const char* k) {
     const auto it = params.find(k);
     return it == params.end() ? 0.0 : it->second;
   };
-  if (effect == "turn_scrub" && get("k") < -0.01)
+  const auto k_se = se.find("k");
+  const bool scrub_negative =
+      get("k") < -0.01 || (k_se != se.end() && std::isfinite(k_se->second) && get("k") + 2.0 * k_se->second < 0.0);
+  if (effect == "turn_scrub" && scrub_negative)
     return fmt::format("a negative turn scrub (k = {:.3g}): scrubbing can only lose rotation, never add it", get("k"));
   if (effect == "turn_scrub" && get("k") >= 1.0)
     return fmt::format("a turn scrub of k = {:.3g}: the robot would not turn at all", get("k"));
@@ -128,7 +132,7 @@ std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSu
   std::vector<std::string> symptoms;
   for (const auto& cand : s.candidates) {
     const std::string name = sim::EffectToString(cand.effect);
-    if (const std::string why = UnphysicalFit(name, cand.params, s.baseline.runs); !why.empty())
+    if (const std::string why = UnphysicalFit(name, cand.params, s.baseline.runs, cand.param_se); !why.empty())
       symptoms.push_back(fmt::format("{} ({})", name, why));
   }
   if (s.verdict != "unexplained") {

@@ -40,9 +40,12 @@ std::string EvidenceInWords(double heldout_gain_nats, double evidence_nats, doub
 /// diameter off by more than 10 %, a castor kick over 50 mrad (3 deg), a
 /// ground-truth marker more than 0.3 m off the axle, a right wheel
 /// drifting by more than 5 % over the campaign (`runs`), noise of more
-/// than 50 mm per event, run time offsets over 1 s. Such a fit is a
-/// symptom: the effect soaked up something else.
-std::string UnphysicalFit(const std::string& effect, const std::map<std::string, double>& params, int runs);
+/// than 50 mm per event, run time offsets over 1 s. A turn scrub counts as
+/// negative below -0.01, or below 0 by more than 2 of its standard errors
+/// (`se`, when given). Such a fit is a symptom: the effect soaked up
+/// something else.
+std::string UnphysicalFit(const std::string& effect, const std::map<std::string, double>& params, int runs,
+                          const std::map<std::string, double>& se = {});
 
 /// What to do next, in order: for `none`, use the model; for a named
 /// verdict, model the effects; for `unexplained`, the largest discrepancy

@@ -97,7 +97,7 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
                      {"E_b", Num(c.E_b)},
                      {"gap_after_by_statistic", ByKind(c.gap_by_kind)},
                      {"note", c.note},
-                     {"unphysical", UnphysicalFit(sim::EffectToString(c.effect), c.params, s.baseline.runs)}});
+                     {"unphysical", UnphysicalFit(sim::EffectToString(c.effect), c.params, s.baseline.runs, c.param_se)}});
   }
   const BaselineSummary& b = s.baseline;
   nlohmann::json returns = nlohmann::json::array();
@@ -234,7 +234,7 @@ std::string DiagnoseReport(const DiagnoseSummary& s) {
       params += FormatEffectParam(k, v, se != c.param_se.end() ? se->second : NAN) + "  ";
     }
     if (!c.note.empty()) params += "(" + c.note + ")";
-    if (const auto why = UnphysicalFit(sim::EffectToString(c.effect), c.params, b.runs); !why.empty())
+    if (const auto why = UnphysicalFit(sim::EffectToString(c.effect), c.params, b.runs, c.param_se); !why.empty())
       params += " IMPOSSIBLE VALUE, a symptom (the gap is something else): " + why;
     line(fmt::format("    {:<20} {:>8.3f} {:>9.3f} {:>9.1f} n {:>10}  {}", sim::EffectToString(c.effect), c.shrink,
                      c.heldout_shrink, c.evidence, c.tested ? FormatP(c.lr_p_value) : std::string("-"),
