@@ -268,13 +268,13 @@ void CandidateTable(io::HtmlReport& rep, const nlohmann::json& j) {
                 "log-likelihood gain minus a penalty per parameter, graded on Kass & Raftery's scale for Bayes factors (none, weak, positive, strong, very strong). "
                 "LR p: likelihood-ratio test against the baseline.");
   std::vector<std::vector<std::string>> rows;
-  std::vector<std::string> symptoms;
+  std::vector<std::vector<std::string>> symptoms;
   for (const auto& c : j.value("candidates", nlohmann::json::array())) {
     const double gain = Number(c, "heldout_loglik_gain_nats"), ev = Number(c, "evidence_nats");
     const std::string words = diag::EvidenceInWords(gain, ev, Number(c, "heldout_shrink"));
     const std::string unphysical = c.value("unphysical", "");
     const std::string effect = c.value("effect", "?");
-    if (!unphysical.empty()) symptoms.push_back(effect + ": " + unphysical);
+    if (!unphysical.empty()) symptoms.push_back({effect, ParamsText(c.value("params", nlohmann::json::object()), nlohmann::json::object()), unphysical});
     rows.push_back({effect, ParamsText(c.value("params", nlohmann::json::object()), c.value("params_se", nlohmann::json::object())),
                     Percent(Number(c, "heldout_shrink")), Percent(Number(c, "shrink")),
                     words.substr(0, words.find(':')) + (std::isfinite(ev) ? fmt::format(" ({:+.1f} nats)", ev) : ""),
@@ -287,7 +287,7 @@ void CandidateTable(io::HtmlReport& rep, const nlohmann::json& j) {
     rep.Heading("Impossible fits: symptoms, not causes");
     rep.Paragraph("These effects fitted values no robot can have. The effect is not the cause: it bent itself to imitate "
                   "something else in the runs, so the gap is something else.");
-    rep.Warnings(symptoms);
+    rep.Table({"effect", "fitted", "why no robot can have it"}, symptoms, 3);
   }
 }
 
