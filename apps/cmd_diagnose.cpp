@@ -3,6 +3,7 @@
 // far it shrinks once that effect is modelled (lib/diagnosis/diagnose.hpp).
 // Readable report on stdout, contract JSON with --json, gap bars with --plot.
 #include <memory>
+#include <variant>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -14,6 +15,7 @@
 #include "progress.hpp"
 #include "common.hpp"
 #include "core/errors.hpp"
+#include "evaluation/data_warnings.hpp"
 #include "diagnosis/pieces.hpp"
 #include "diagnosis/diagnose.hpp"
 #include "io/atomic_write.hpp"
@@ -50,14 +52,33 @@ int RunDiagnose(DiagnoseCliOptions o) {
     throw InputError(o.manifest, why);
   }
   const diag::CampaignData campaign = diag::LoadCampaign(o.manifest, o.diag.pieces);
+  // Degenerate trajectory data (evaluation/data_warnings.hpp), per file.
+  std::vector<std::string> warnings;
+  for (const auto& file : campaign.files) {
+    const auto* t = std::get_if<TrajectoryData>(&file);
+    if (t == nullptr) continue;
+    TrajectoryDataCheck check(campaign.robot);
+    for (const auto& run : t->runs) check.Add(run);
+    for (auto& w : check.Warnings(t->path)) warnings.push_back(std::move(w));
+  }
   const diag::DiagnoseSummary s = [&] {
     Progress progress(fmt::format("diagnosing {} ({} null simulations)", o.manifest, o.diag.null_simulations));
     diag::DiagnoseOptions d = o.diag;
     d.progress = progress.Callback();
     return diag::Diagnose(campaign, d);
   }();
-  if (o.json.PrintText()) fmt::print("{}", diag::DiagnoseReport(s));
+  if (o.json.PrintText()) {
+    fmt::print("{}", diag::DiagnoseReport(s));
+    for (const auto& w : warnings) fmt::print("WARNING: {}\n", w);
+  } else {
+    for (const auto& w : warnings) fmt::print(stderr, "warning: {}\n", w);
+  }
   nlohmann::json j = diag::DiagnoseToJson(s);
+  if (!warnings.empty()) {
+    nlohmann::json all = j.value("warnings", nlohmann::json::array());
+    for (const auto& w : warnings) all.push_back(w);
+    j["warnings"] = all;
+  }
   j["manifest"] = o.manifest;
   std::vector<std::string> written;
   if (!o.plot.empty()) {

@@ -15,6 +15,7 @@
 #include "common.hpp"
 #include "core/angles.hpp"
 #include "core/errors.hpp"
+#include "evaluation/data_warnings.hpp"
 #include "evaluation/run_track.hpp"
 #include "io/atomic_write.hpp"
 #include "io/html_report.hpp"
@@ -281,6 +282,7 @@ int RunEvaluate(const EvaluateOptions& o) {
   std::vector<RunEvaluation> base_runs, param_runs;
   std::vector<PlotRun> plot_runs;
   std::set<std::string> manifests_with_trajectories;
+  std::vector<std::string> warnings;  // degenerate data (evaluation/data_warnings.hpp)
   for (const auto& src : sources) {
     io::OpenedRunFile file = io::OpenRunFile(src.path);
     auto* reader = std::get_if<io::TrajectoryReader>(&file);
@@ -289,12 +291,15 @@ int RunEvaluate(const EvaluateOptions& o) {
       throw InputError(src.path, "evaluate needs a trajectory CSV (ticks or wheel travel with ground truth)");
     }
     manifests_with_trajectories.insert(src.manifest);
+    TrajectoryDataCheck check(src.recorded);
     TrajectoryRun run;
     while (reader->NextRun(run)) {
+      check.Add(run);
       base_runs.push_back(EvaluateRun(run, src.path, src.label, src.recorded, src.recorded, integ));
       if (params) param_runs.push_back(EvaluateRun(run, src.path, src.label, *params, src.recorded, integ));
       if ((!o.plot.empty() || !o.report.empty()) && plot_runs.size() < kPlotRuns) plot_runs.push_back({&src, run});
     }
+    for (auto& w : check.Warnings(src.path)) warnings.push_back(std::move(w));
   }
   for (const auto& src : sources) {
     if (!src.manifest.empty() && manifests_with_trajectories.count(src.manifest) == 0) {
@@ -313,11 +318,15 @@ int RunEvaluate(const EvaluateOptions& o) {
     } else {
       PrintSummary("Recorded parameters", base);
     }
+    for (const auto& w : warnings) fmt::print("  WARNING: {}\n", w);
+  } else {
+    for (const auto& w : warnings) fmt::print(stderr, "warning: {}\n", w);
   }
   nlohmann::json j = {{"integrator", o.integrator},
                       {"parameters", JsonParams(params ? *params : sources.front().recorded)},
                       {"runs", JsonEvaluationRuns(main)},
-                      {"summary", JsonEvaluationSummary(main)}};
+                      {"summary", JsonEvaluationSummary(main)},
+                      {"warnings", warnings}};
   if (params) {
     j["recorded"] = {{"parameters", JsonParams(sources.front().recorded)},
                      {"runs", JsonEvaluationRuns(base)},

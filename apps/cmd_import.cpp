@@ -12,6 +12,7 @@
 #include "common.hpp"
 #include "core/angles.hpp"
 #include "core/errors.hpp"
+#include "evaluation/data_warnings.hpp"
 #include "io/atomic_write.hpp"
 #include "io/campaign_writer.hpp"
 #include "io/optiodom.hpp"
@@ -79,10 +80,13 @@ int RunImportOptiOdom(const ImportOptions& o) {
 
   std::size_t samples = 0;
   nlohmann::json runs = nlohmann::json::array();
+  TrajectoryDataCheck check(ds.robot);
   for (const auto& r : ds.runs.runs) {
+    check.Add(r);
     samples += r.size();
     runs.push_back({{"run", r.run}, {"direction", r.direction}, {"samples", r.size()}});
   }
+  const std::vector<std::string> warnings = check.Warnings(runs_path);
   if (o.json.PrintText()) {
     fmt::print("Imported OptiOdom dataset {} ({}): {} runs, {} samples\n", ds.id, ds.category, ds.runs.runs.size(),
                samples);
@@ -90,7 +94,10 @@ int RunImportOptiOdom(const ImportOptions& o) {
                ds.robot.wheel_diameter_left_m, ds.robot.wheel_diameter_right_m, *ds.robot.ticks_per_rev);
     if (ds.experiment.kind == ExperimentKind::kSquare) fmt::print("  experiment: square, side {} m\n", ds.experiment.side_m);
     for (const auto& r : ds.runs.runs) fmt::print("  run {:>3}  {:<9} {} samples\n", r.run, r.direction, r.size());
+    for (const auto& w : warnings) fmt::print("warning: {}\n", w);
     fmt::print("  wrote {}\n  wrote {}\n", manifest_path, runs_path);
+  } else {
+    for (const auto& w : warnings) fmt::print(stderr, "warning: {}\n", w);
   }
   o.json.Emit({{"dataset", ds.id},
                {"category", ds.category},
@@ -98,7 +105,8 @@ int RunImportOptiOdom(const ImportOptions& o) {
                {"runs_csv", runs_path},
                {"robot", JsonParams(ds.robot)},
                {"experiment", {{"kind", ExperimentKindToString(ds.experiment.kind)}, {"side_m", ds.experiment.side_m}}},
-               {"runs", runs}});
+               {"runs", runs},
+               {"warnings", warnings}});
   return 0;
 }
 
@@ -201,6 +209,13 @@ int RunRosbag2(Rosbag2Options o) {
                           {"left_joint", r.left_joint},
                           {"right_joint", r.right_joint},
                           {"duration_s", JsonNumber(r.duration_s)}});
+  // Degenerate data (evaluation/data_warnings.hpp) join the importer's own warnings.
+  std::vector<std::string> warnings = result.warnings;
+  {
+    TrajectoryDataCheck check(robot);
+    for (const auto& r : result.runs.runs) check.Add(r);
+    for (auto& w : check.Warnings(runs_path)) warnings.push_back(std::move(w));
+  }
   nlohmann::json runs = nlohmann::json::array();
   for (const auto& r : result.runs.runs) {
     std::size_t with_gt = 0;
@@ -223,7 +238,7 @@ int RunRosbag2(Rosbag2Options o) {
     for (const auto& r : result.runs.runs)
       fmt::print("  run {:>3}  {:<14} {:>6} samples  t {:8.2f} .. {:8.2f} s  travel L {:7.3f} m  R {:7.3f} m\n", r.run,
                  r.direction, r.size(), r.t_s.front(), r.t_s.back(), r.dist_left_m.back(), r.dist_right_m.back());
-    for (const auto& w : result.warnings) fmt::print("warning: {}\n", w);
+    for (const auto& w : warnings) fmt::print("warning: {}\n", w);
     fmt::print("  wrote {}\n  wrote {}\nNext: umbmark calibrate {} (squares) or umbmark fit-noise {}\n", manifest_path,
                runs_path, manifest_path, manifest_path);
   }
@@ -233,7 +248,7 @@ int RunRosbag2(Rosbag2Options o) {
                {"experiment", o.experiment},
                {"recordings", recordings},
                {"runs", runs},
-               {"warnings", result.warnings}});
+               {"warnings", warnings}});
   return 0;
 }
 

@@ -9,6 +9,8 @@
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include <Eigen/Eigenvalues>
 #include <fmt/format.h>
@@ -126,6 +128,9 @@ MonteCarloErrors StandardErrors(const PoseCovariance& C, std::int64_t n) {
   return e;
 }
 
+/// Fewer Monte Carlo runs than this: a warning (covariance SE above 14 %).
+constexpr std::int64_t kFewMonteCarloRuns = 100;
+
 // Just over 100 lines: closed form, optional Monte Carlo, gates and output
 // in order; each step is a call, the length is the printing.
 int RunPredict(const PredictOptions& o) {
@@ -229,6 +234,30 @@ int RunPredict(const PredictOptions& o) {
   if (!finite) {
     throw QualityGateError("the predicted mean or covariance is not finite (a path or noise constant too large for "
                            "double precision); shorten the path or check --kl/--kr");
+  }
+  // Degenerate requests: a result, but one that says little.
+  std::vector<std::string> warnings;
+  const bool moves = std::any_of(path.begin(), path.end(), [](const WheelSegment& w) {
+    return w.left_m != 0.0 || w.right_m != 0.0;
+  });
+  if (!moves) warnings.push_back("the path does not move (every segment has zero wheel travel): the prediction is P0");
+  if (o.k_L == 0.0 && o.k_R == 0.0) {
+    warnings.push_back(P0.isZero() ? "no noise at all (k_L = k_R = 0 and P0 = 0): the covariance is zero; take k_L, "
+                                     "k_R from `umbmark fit-noise`"
+                                   : "no wheel noise (k_L = k_R = 0): the covariance is P0 carried along the path; "
+                                     "take k_L, k_R from `umbmark fit-noise`");
+  }
+  if (o.mc_runs && *o.mc_runs < kFewMonteCarloRuns) {
+    warnings.push_back(fmt::format("Monte Carlo with {} runs: its covariance has a relative standard error of about "
+                                   "sqrt(2/N) = {:.0f} % (see covariance_se); use {} runs or more",
+                                   *o.mc_runs, 100.0 * std::sqrt(2.0 / static_cast<double>(*o.mc_runs)),
+                                   kFewMonteCarloRuns));
+  }
+  j["warnings"] = warnings;
+  if (o.json.PrintText()) {
+    for (const auto& w : warnings) fmt::print("  WARNING: {}\n", w);
+  } else {
+    for (const auto& w : warnings) fmt::print(stderr, "warning: {}\n", w);
   }
   o.json.Emit(j);
   return 0;

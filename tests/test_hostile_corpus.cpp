@@ -92,6 +92,23 @@ std::string ScaledEndpoints(double k) {
   return out;
 }
 
+/// A trajectory CSV (wheel travel, ground truth) of `runs` straight 1 m
+/// runs of 11 samples; `moves`: the wheels and the truth advance; `gt_moves`:
+/// the truth advances; `gt_every`: ground truth at every k-th sample (and
+/// the last); `same`: every run identical (else each ends 1 mm further).
+std::string Trajectories(int runs, bool moves, bool gt_moves, int gt_every, bool same) {
+  std::string out = "run,direction,t_s,dist_left_m,dist_right_m,x_gt_m,y_gt_m,theta_gt_rad\n";
+  for (int r = 0; r < runs; ++r) {
+    for (int i = 0; i <= 10; ++i) {
+      const double s = moves ? 0.1 * i : 0.0;
+      const double x = gt_moves ? 0.1 * i * (same ? 1.0 : 1.0 + 0.001 * r) : 0.0;
+      out += fmt::format("{},fwd,{},{},{},", r + 1, 0.1 * i, s, s);
+      out += (i % gt_every == 0 || i == 10) ? fmt::format("{},0,0\n", x) : ",,\n";
+    }
+  }
+  return out;
+}
+
 std::string Repeated(const std::string& cw, const std::string& ccw, int n) {
   std::string out = "run,direction,ex_m,ey_m,etheta_rad\n";
   for (int i = 0; i < n; ++i) out += std::to_string(2 * i + 1) + ",cw," + cw + "\n" + std::to_string(2 * i + 2) + ",ccw," + ccw + "\n";
@@ -272,6 +289,50 @@ std::vector<Case> Corpus() {
                  Put(d / "robot.toml", kRobot);
                },
                cal, 3, "correction larger than UMBmark can support"});
+  // Degenerate data: warnings in the JSON (and the text) of evaluate, predict, diagnose, import.
+  const auto traj = [](int runs, bool moves, bool gt_moves, int gt_every, bool same) {
+    return [=](const fs::path& d) {
+      Put(d / "robot.toml", kRobot);
+      Put(d / "tr.csv", Trajectories(runs, moves, gt_moves, gt_every, same));
+    };
+  };
+  const std::string ev = "evaluate tr.csv --robot robot.toml --json -";
+  c.push_back({"evaluate: runs that never move", traj(3, false, false, 1, false), ev, 0,
+               "tr.csv: 3 of 3 runs never move"});
+  c.push_back({"evaluate: wheels turn, ground truth still", traj(3, true, false, 1, false), ev, 0,
+               "the wheels turn but the ground truth stays at the start (run 1, 2, 3)"});
+  c.push_back({"evaluate: ground truth missing for most samples", traj(3, true, true, 10, false), ev, 0,
+               "ground truth at only 6 of 33 samples (18 %)"});
+  c.push_back({"evaluate: one run", traj(1, true, true, 1, false), ev, 0, "a single run"});
+  c.push_back({"evaluate: identical runs (zero scatter)", traj(4, true, true, 1, true), ev, 0,
+               "all 4 runs end at exactly the same ground-truth pose (zero scatter)"});
+  const std::string pr = "predict --robot robot.toml --path line:1 --json - ";
+  c.push_back({"predict: no noise at all", Examples, pr + "--kl 0 --kr 0", 0, "no noise at all"});
+  c.push_back({"predict: a path that does not move", Examples, "predict --robot robot.toml --path line:0 --kl 0.001 --kr 0.001 --json -", 0,
+               "the path does not move"});
+  c.push_back({"predict: Monte Carlo with 10 runs", Examples, pr + "--kl 0.001 --kr 0.001 --monte-carlo 10", 0,
+               "Monte Carlo with 10 runs"});
+  c.push_back({"diagnose: one run per direction",
+               [](const fs::path& d) {
+                 Put(d / "m.toml", kManifest);
+                 REQUIRE(std::system(("cd '" + d.string() + "' && '" + UMBMARK_EXE +
+                                      "' simulate m.toml --out sim --square-runs 1 --seed 1 >/dev/null 2>&1").c_str()) == 0);
+               },
+               "diagnose sim/campaign.toml --null-sims 20 --json -", 0, "only 1 cw run"});
+  c.push_back({"import optiodom: a single run",
+               [](const fs::path& d) {
+                 const fs::path src = kSource / "data/optiodom-2020-06/square/230620202042";
+                 const fs::path dst = d / "square" / "230620202042";
+                 fs::create_directories(dst);
+                 fs::copy_file(src / "230620202042_run-01.csv", dst / "230620202042_run-01.csv");
+                 std::string meta = Slurp((src / "230620202042_metadata.csv").string());
+                 const auto at = meta.find("\nN,6,");
+                 REQUIRE(at != std::string::npos);
+                 meta.replace(at, 5, "\nN,1,");
+                 Put(dst / "230620202042_metadata.csv", meta);
+               },
+               "import optiodom square/230620202042 --out imp --json -", 0,
+               "imp/runs.csv: a single run: nothing shows how runs scatter", {"imp/runs.csv", "imp/campaign.toml"}});
   // 3. Crashes.
   c.push_back({"non-UTF-8 byte in run id and direction", [](const fs::path& d) {
                  Examples(d);
