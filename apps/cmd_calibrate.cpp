@@ -56,6 +56,7 @@ struct CalibrateOptions {
   double heading_weight = 4.0;
   std::string use = "recommended";
   bool per_experiment = false;
+  bool no_heldout = false;  // --no-heldout: skip the leave-one-run-out comparison
 };
 
 // The parameters --ros2 and --plot use: --use classic | refined |
@@ -77,6 +78,16 @@ Chosen WithRatios(Chosen c, const RobotParams& recorded) {
   return c;
 }
 
+/// HeldoutComparison::scheme when --no-heldout skipped the comparison.
+constexpr const char* kHeldoutSkipped = "skipped";
+
+HeldoutComparison SkippedHeldout() {
+  HeldoutComparison h;
+  h.scheme = kHeldoutSkipped;
+  h.notes.push_back("--no-heldout: the leave-one-run-out comparison of the methods was not run");
+  return h;
+}
+
 Chosen ChooseParameters(const CalibrateJobResult& r, const HeldoutComparison& h, const std::string& use) {
   const UmbmarkSummary& s = r.umbmark;
   const std::string classic_name = fmt::format("umbmark_{}", UmbmarkEstimatorToString(s.estimator));
@@ -95,6 +106,8 @@ Chosen ChooseParameters(const CalibrateJobResult& r, const HeldoutComparison& h,
   if (const MethodHeldout* m = h.recommended.empty() ? nullptr : h.Find(h.recommended)) {
     return WithRatios({m->method, m->parameters, why}, s.recorded);
   }
+  if (h.scheme == kHeldoutSkipped)
+    return classic("the held-out comparison was skipped (--no-heldout): the classic result");
   return classic("no recommendation could be formed (too few runs): the classic result");
 }
 
@@ -211,7 +224,9 @@ nlohmann::json JsonResult(const CalibrateInput& in, const CalibrateJobResult& r,
                                     {"runs", JsonEvaluationRuns(*r.refined_evaluation)}};
     }
   }
-  j["heldout_error"] = JsonHeldout(h);
+  // --no-heldout: both keys say so instead of naming a method.
+  const bool skipped = h.scheme == kHeldoutSkipped;
+  j["heldout_error"] = skipped ? nlohmann::json(kHeldoutSkipped) : JsonHeldout(h);
   j["heldout"] = {{"scheme", h.scheme},
                   {"measure", h.measure},
                   {"left_out", h.left_out},
@@ -221,7 +236,9 @@ nlohmann::json JsonResult(const CalibrateInput& in, const CalibrateJobResult& r,
                   {"runner_up_difference_sem_m", h.runner_up.empty() ? nlohmann::json(nullptr)
                                                                        : JsonNumber(h.runner_up_difference_sem_m)},
                   {"notes", h.notes}};
-  j["recommended"] = h.recommended.empty() ? nlohmann::json(nullptr) : nlohmann::json(h.recommended);
+  j["recommended"] = skipped              ? nlohmann::json(kHeldoutSkipped)
+                     : h.recommended.empty() ? nlohmann::json(nullptr)
+                                             : nlohmann::json(h.recommended);
   if (r.refined && h.Find("refined")) j["refined"]["heldout_error"] = JsonHeldout(h)["refined"];
   j["model_check"] = check.available ? nlohmann::json{{"reduced_chi2", check.reduced_chi2},
                                                       {"dof", check.dof},
@@ -251,8 +268,8 @@ void PrintEvaluation(const char* title, const EvaluationSummary& e) {
              Rad2Deg(e.max_max_heading_error_rad), Rad2Deg(e.max_final_heading_error_rad));
 }
 
-void PrintHeldout(const HeldoutComparison& h, const Chosen& chosen, const std::vector<std::string>& warnings,
-                  const CalibrateOptions& o) {
+/// The held-out table: each method's prediction error and the recommendation.
+void PrintHeldoutTable(const HeldoutComparison& h) {
   fmt::print("Which calibration to trust: {} prediction error ({} folds, {})\n",
              h.scheme == "leave_one_run_out" ? "leave-one-run-out" : "10-fold (over runs)",
              h.methods.empty() ? 0 : h.methods.front().folds,
@@ -276,6 +293,16 @@ void PrintHeldout(const HeldoutComparison& h, const Chosen& chosen, const std::v
                      ? "; the difference is within 2 SE, either is as good"
                      : "");
     }
+  }
+}
+
+void PrintHeldout(const HeldoutComparison& h, const Chosen& chosen, const std::vector<std::string>& warnings,
+                  const CalibrateOptions& o) {
+  if (h.scheme == kHeldoutSkipped) {
+    fmt::print("Which calibration to trust: not compared (--no-heldout); run without it for the leave-one-run-out "
+               "prediction error of each method\n");
+  } else {
+    PrintHeldoutTable(h);
   }
   if (!o.ros2.empty() || !o.plot.empty()) {
     fmt::print("  --ros2/--plot use {} ({})\n", chosen.method, chosen.why);
@@ -567,7 +594,7 @@ int RunCalibrate(const CalibrateOptions& o) {
         record_failure(in.label, e.what(), 1);
         continue;
       }
-      const HeldoutComparison heldout = CompareMethodsHeldout(in, jo, r);
+      const HeldoutComparison heldout = o.no_heldout ? SkippedHeldout() : CompareMethodsHeldout(in, jo, r);
       const Chosen chosen = ChooseParameters(r, heldout, o.use);
       const ModelCheck check = CheckCentresAgainstModel(in, r.umbmark.runs, r.refined ? r.refined->refined : r.umbmark.corrected,
                                                         jo.refine ? jo.refine->final_turn : true);
@@ -684,6 +711,10 @@ Command SetupCalibrate(CLI::App& parent) {
   app->add_option("--plot", opts->plot,
                   "Write an SVG: return errors before/after (the --use calibration) on one scale, centres of gravity "
                   "with SEM ellipses, E_max,syst, and each run's path");
+  app->add_flag("--no-heldout", opts->no_heldout,
+                "Skip the leave-one-run-out comparison of the methods (it calibrates every method once per run; "
+                "JSON `recommended` and `heldout_error` say \"skipped\", and --use recommended takes the classic "
+                "result). Default: compare");
   app->add_option("--use", opts->use,
                   "Calibration --ros2 and --plot use: the recommended one (lowest leave-one-run-out error), classic "
                   "UMBmark, or refined (needs --refine)")

@@ -362,6 +362,13 @@ std::vector<std::string> Warnings(const Loaded& data, const FitResult& f) {
         "the reference noise is 0 although the return errors come from a ground-truth system: its noise is then read "
         "as wheel noise and k comes out high; give --meas-sigma SXY,STHETA (or the manifest's [ground_truth])");
   }
+  if (f.estimate && !f.estimate->E_d_determined) {
+    warnings.push_back(fmt::format(
+        "the scatter pulled E_d more than {} from the value the group means give, so E_d was kept at {:.5f}: the "
+        "noise model does not fit these runs well (see the goodness of fit) or the design does not show E_d; give "
+        "--params CAL.json from `umbmark calibrate` (or --systematic none for a calibrated robot)",
+        kMaxJointEdShift, f.systematic.c_R / f.systematic.c_L));
+  }
   for (const auto& [name, det, ci] :
        {std::tuple{"k_L", f.kL_determined, f.s.k_L_ci}, std::tuple{"k_R", f.kR_determined, f.s.k_R_ci}}) {
     if (!det) {
@@ -421,6 +428,7 @@ nlohmann::json ResultJson(const FitNoiseOptions& o, const Loaded& data, const Fi
     j["systematic_errors"]["E_d_se"] = f.estimate->E_d_se;
     j["systematic_errors"]["E_b_se"] = f.estimate->E_b_se;
     j["systematic_errors"]["E_b_determined"] = f.estimate->E_b_determined;
+    j["systematic_errors"]["E_d_determined"] = f.estimate->E_d_determined;
   }
   j["likelihood_passes"] = s.likelihood_passes;
   j["warnings"] = Warnings(data, f);
@@ -441,8 +449,10 @@ void PrintText(const FitNoiseOptions& o, const Loaded& data, const FitResult& f,
   }
   if (f.estimate) {
     const SystematicErrors& e = f.systematic;
-    fmt::print("  systematic errors estimated jointly: E_d = {:.5f} +- {:.5f} (from the scatter), E_b = {:.5f}{}\n",
-               e.c_R / e.c_L, f.estimate->E_d_se, e.E_b,
+    fmt::print("  systematic errors estimated jointly: E_d = {:.5f}{}, E_b = {:.5f}{}\n", e.c_R / e.c_L,
+               f.estimate->E_d_determined ? fmt::format(" +- {:.5f} (from the scatter)", f.estimate->E_d_se)
+                                          : std::string(" (from the means; see the warning)"),
+               e.E_b,
                f.estimate->E_b_determined ? fmt::format(" +- {:.5f} (from the means)", f.estimate->E_b_se) : "");
     if (!f.estimate->E_b_determined)
       fmt::print("  note: this design (no turns) does not show E_b; k is relative to the recorded wheelbase "

@@ -200,5 +200,20 @@ TEST_CASE("calibrate recommends a method and --ros2 follows --use", "[heldout][c
                                                data, data, (dir / "bad.yaml").string()));
   CHECK(bad.status == 2);  // usage error
   CHECK(bad.err.find("--use refined needs --refine") != std::string::npos);
+  // --no-heldout: no comparison; the keys say "skipped", the refined and
+  // classic results are the same as with it, and --ros2 takes the classic one.
+  const auto skip = testing::RunCli(base + " --no-heldout --json - --ros2 " + (dir / "skip.yaml").string());
+  REQUIRE(skip.status == 0);
+  const auto js = nlohmann::json::parse(skip.out);
+  CHECK(js["recommended"] == "skipped");
+  CHECK(js["heldout_error"] == "skipped");
+  CHECK(js["heldout"]["scheme"] == "skipped");
+  CHECK(js["outputs_use"]["method"] == "umbmark_mean");
+  CHECK(js["E_b"].get<double>() == j["E_b"].get<double>());
+  CHECK(js["refined"]["E_b"].get<double>() == j["refined"]["E_b"].get<double>());
+  CHECK_FALSE(js["refined"].contains("heldout_error"));
+  CHECK_THAT(multiplier(dir / "skip.yaml"), WithinAbs(j["E_b"].get<double>(), 1e-12));
+  const auto skip_text = testing::RunCli(base + " --no-heldout");
+  CHECK(skip_text.out.find("not compared (--no-heldout)") != std::string::npos);
   fs::remove_all(dir);
 }

@@ -251,12 +251,18 @@ WheelNoiseFitSummary FitWheelNoiseWithSystematics(
   constexpr double kStep = 0.004;  // difference step in E_d
   double E0 = E_means;
   WheelNoiseFitSummary out;
+  bool determined = true;
   for (int pass = 0;; ++pass) {
     const std::vector<WheelNoiseFitRun> runs = at(E0);
     const std::vector<WheelNoiseRunSensitivity> sens = Sensitivities(runs, at, E0, kStep);
     WheelNoiseFitOptions o = quick;
     o.E_d_prior_centre = E_means - E0;
     const WheelNoiseFitSummary f = FitWheelNoise(runs, o, &sens);
+    if (std::abs(E0 + f.E_d_offset - E_means) > kMaxJointEdShift) {
+      determined = false;  // keep the means' E_d (see SystematicEstimate::E_d_determined)
+      E0 = E_means;
+      break;
+    }
     if (std::abs(f.E_d_offset) > 0.25 * kStep && pass < 4) {
       E0 += f.E_d_offset;
       continue;
@@ -267,10 +273,12 @@ WheelNoiseFitSummary FitWheelNoiseWithSystematics(
     out.likelihood_passes += options.intervals ? f.likelihood_passes : 0;
     break;
   }
+  if (!determined) out = FitWheelNoise(at(E_means), options);
   if (estimated) {
     *estimated = from_means;
     estimated->value = with_ed(E0 + out.E_d_offset);
     estimated->E_d_se = out.E_d_offset_se;
+    estimated->E_d_determined = determined;
   }
   return out;
 }

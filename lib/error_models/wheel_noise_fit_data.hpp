@@ -67,7 +67,15 @@ struct SystematicEstimate {
   /// straight forward and back): E_b stays at the prior's 1 and k is
   /// relative to the recorded wheelbase (give the calibration to fix it).
   bool E_b_determined = true;
+  /// false: the scatter pulled E_d further than kMaxJointEdShift from the
+  /// means' value (the model does not fit the scatter, or the design says
+  /// nothing about E_d); the fit then keeps the means' E_d.
+  bool E_d_determined = true;
 };
+
+/// Largest shift of E_d the scatter may make from the value the group means
+/// give (an uncalibrated robot's E_d is within a few percent of 1).
+inline constexpr double kMaxJointEdShift = 0.05;
 
 /// EstimateSystematicErrors with the standard error of E_b.
 SystematicEstimate EstimateSystematicErrorsWithSe(const std::vector<WheelNoiseFitRun>& runs,
