@@ -190,17 +190,17 @@ RefineInterval Interval(double value, const Eigen::Vector3d& gradient, const Eig
 
 [[noreturn]] void Fail(const std::string& what, RefineSummary* summary) { throw RefineError(what, *summary); }
 
-}  // namespace
+using BlockJacobian = Eigen::Matrix<double, Eigen::Dynamic, kNumRefineParameters, Eigen::RowMajor>;
 
-void SolveAndAssess(FitProblem& fit, const RefineOptions& options, CovarianceKind kind, std::optional<double> dof,
-                    RefineSummary* summary) {
+/// Step 1: solves the problem (E_s held by a subset manifold unless free),
+/// fills the solver report, E_b, E_d, E_s and the free / fixed names; fails
+/// when the solution is not usable.
+ceres::Solver::Summary Solve(FitProblem& fit, const RefineOptions& options, RefineSummary* summary) {
   ceres::Problem& problem = *fit.problem;
   summary->scale_free = fit.scale_free;
   // Gauge: without E_s free, the overall scale is held at its start value
   // (1 = the reference mean diameter factor) by a subset manifold.
   if (!fit.scale_free) problem.SetManifold(fit.theta, new ceres::SubsetManifold(kNumRefineParameters, {kIndexEs}));
-
-  // ---- step 1: solve ----
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
   so.max_num_iterations = options.max_num_iterations;
@@ -248,48 +248,59 @@ void SolveAndAssess(FitProblem& fit, const RefineOptions& options, CovarianceKin
     }
     Fail(fmt::format("refine: the solver failed ({}): {}", sr.termination_type, why), summary);
   }
+  return cs;
+}
 
-  // ---- step 2: weighted Jacobian and residuals at the solution ----
+/// Step 2: the weighted Jacobian and residuals at the solution, per block
+/// and stacked, and sum J_i^T Omega_i J_i.
+struct SolutionJacobian {
+  Eigen::MatrixXd J;
+  std::vector<BlockJacobian> block_jacobians;
+  std::vector<Eigen::VectorXd> block_residuals;
+  Eigen::Matrix3d omega_meat = Eigen::Matrix3d::Zero();
+  bool any_omega = false;
+};
+
+SolutionJacobian EvaluateAtSolution(const FitProblem& fit, RefineSummary* summary) {
+  SolutionJacobian out;
   int m = 0;
   for (const auto* cost : fit.blocks) m += cost->num_residuals();
   summary->residuals = m;
-  Eigen::MatrixXd J(m, kNumRefineParameters);
-  using BlockJacobian = Eigen::Matrix<double, Eigen::Dynamic, kNumRefineParameters, Eigen::RowMajor>;
-  std::vector<BlockJacobian> block_jacobians;
-  std::vector<Eigen::VectorXd> block_residuals;
-  Eigen::Matrix3d omega_meat = Eigen::Matrix3d::Zero();  // sum J_i^T Omega_i J_i
-  bool any_omega = false;
-  {
-    int row = 0;
-    const double* params[] = {fit.theta};
-    for (const auto* cost : fit.blocks) {
-      const int nb = cost->num_residuals();
-      BlockJacobian jb(nb, kNumRefineParameters);
-      Eigen::VectorXd rb(nb);
-      double* jacobians[] = {jb.data()};
-      if (!cost->Evaluate(params, rb.data(), jacobians)) {
-        Fail("refine: a residual could not be evaluated at the solution", summary);
-      }
-      J.middleRows(row, nb) = jb;
-      const std::size_t bi = block_jacobians.size();
-      if (bi < fit.block_residual_covariance.size() && fit.block_residual_covariance[bi]) {
-        omega_meat += jb.transpose() * (*fit.block_residual_covariance[bi]) * jb;
-        any_omega = true;
-      } else {
-        omega_meat += jb.transpose() * jb;
-      }
-      block_jacobians.push_back(std::move(jb));
-      block_residuals.push_back(std::move(rb));
-      row += nb;
+  out.J.resize(m, kNumRefineParameters);
+  int row = 0;
+  const double* params[] = {fit.theta};
+  for (const auto* cost : fit.blocks) {
+    const int nb = cost->num_residuals();
+    BlockJacobian jb(nb, kNumRefineParameters);
+    Eigen::VectorXd rb(nb);
+    double* jacobians[] = {jb.data()};
+    if (!cost->Evaluate(params, rb.data(), jacobians)) {
+      Fail("refine: a residual could not be evaluated at the solution", summary);
     }
+    out.J.middleRows(row, nb) = jb;
+    const std::size_t bi = out.block_jacobians.size();
+    if (bi < fit.block_residual_covariance.size() && fit.block_residual_covariance[bi]) {
+      out.omega_meat += jb.transpose() * (*fit.block_residual_covariance[bi]) * jb;
+      out.any_omega = true;
+    } else {
+      out.omega_meat += jb.transpose() * jb;
+    }
+    out.block_jacobians.push_back(std::move(jb));
+    out.block_residuals.push_back(std::move(rb));
+    row += nb;
   }
-  const int p = static_cast<int>(free.size());
-  summary->reduced_chi2 = m > p ? 2.0 * cs.final_cost / (m - p) : std::numeric_limits<double>::quiet_NaN();
+  return out;
+}
 
-  // ---- step 3: identifiability ----
-  // The unknowns are dimensionless factors near 1, so the Jacobian's columns
-  // are comparable as they stand (singular values reported); collinearity is
-  // judged on the column-normalised Jacobian (Belsley's condition number).
+/// Step 3: identifiability. The unknowns are dimensionless factors near 1,
+/// so the Jacobian's columns are comparable as they stand (singular values
+/// reported); collinearity is judged on the column-normalised Jacobian
+/// (Belsley's condition number). Fails when it is rank deficient.
+void CheckIdentifiability(const Eigen::MatrixXd& J, const std::vector<int>& free, const FitProblem& fit,
+                          const RefineOptions& options, RefineSummary* summary) {
+  RefineIdentifiability& id = summary->identifiability;
+  const int m = static_cast<int>(J.rows());
+  const int p = static_cast<int>(free.size());
   Eigen::MatrixXd Jf(m, p);
   for (int k = 0; k < p; ++k) Jf.col(k) = J.col(free[static_cast<std::size_t>(k)]);
   const Eigen::VectorXd sv = Jf.jacobiSvd().singularValues();
@@ -313,37 +324,115 @@ void SolveAndAssess(FitProblem& fit, const RefineOptions& options, CovarianceKin
     const Eigen::VectorXd sn = svd_n.singularValues();
     if (sn(p - 1) > 0.0) id.condition_number = sn(0) / sn(p - 1);
   }
-  if (!(id.condition_number <= options.max_condition_number)) {
-    id.rank_deficient = true;
-    // Parameters taking part in a direction the data do not see: a zero
-    // column, or a large component of a weak right singular vector.
-    for (int k = 0; k < p; ++k) {
-      bool weak = too_few || !(norms(k) > 0.0);
-      if (!weak && !zero_column) {
-        const Eigen::VectorXd sn = svd_n.singularValues();
-        for (int j = 0; j < p; ++j) {
-          const bool weak_direction = !(sn(j) * options.max_condition_number >= sn(0));
-          if (weak_direction && std::abs(svd_n.matrixV()(k, j)) > 0.1) weak = true;
+  if (id.condition_number <= options.max_condition_number) return;
+  id.rank_deficient = true;
+  // Parameters taking part in a direction the data do not see: a zero
+  // column, or a large component of a weak right singular vector.
+  for (int k = 0; k < p; ++k) {
+    bool weak = too_few || !(norms(k) > 0.0);
+    if (!weak && !zero_column) {
+      const Eigen::VectorXd sn = svd_n.singularValues();
+      for (int j = 0; j < p; ++j) {
+        const bool weak_direction = !(sn(j) * options.max_condition_number >= sn(0));
+        if (weak_direction && std::abs(svd_n.matrixV()(k, j)) > 0.1) weak = true;
+      }
+    }
+    (weak ? id.undetermined : id.determined).emplace_back(kThetaNames[free[static_cast<std::size_t>(k)]]);
+  }
+  id.message = fmt::format(
+      "rank deficient: condition number {:.3g} of the normalised Jacobian exceeds max_condition_number = {:.3g}; "
+      "the data do not determine {}{}",
+      id.condition_number, options.max_condition_number, fmt::join(id.undetermined, ", "),
+      fit.scale_free ? " (the overall scale E_s is free: fix it)" : "");
+  Fail("refine: " + id.message, summary);
+}
+
+/// Cluster-robust sandwich over runs g (runs are independent, poses
+/// within a run are not): A^-1 (sum_g g_g g_g^T) A^-1 * R / (R - p),
+/// g_g the gradient of run g's cost, A the Hessian of the objective.
+/// Without a loss A^-1 is the Ceres covariance C. With a loss applied
+/// per pose k inside the block, C would be the Gauss-Newton matrix of
+/// the reweighted residual, which is not the M-estimator's Hessian, so
+/// A is formed per pose from the plain residual r_k, its Jacobian J_k
+/// and Ceres' rho', rho'' at s_k = |r_k|^2:
+///   A = sum_k rho'_k J_k^T J_k + 2 rho''_k (J_k^T r_k)(r_k^T J_k)
+/// (the Hessian Ceres' Triggs correction models; PSD for Huber).
+Eigen::Matrix3d RunClusteredCovariance(const FitProblem& fit, const Eigen::Matrix3d& C, const SolutionJacobian& sj,
+                                       const std::vector<int>& free, RefineSummary* summary) {
+  const int p = static_cast<int>(free.size());
+  Eigen::Matrix3d bread_inv = C;
+  Eigen::Matrix3d meat = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d mask = Eigen::Matrix3d::Zero();
+  for (int i : free) mask(i, i) = 1.0;
+  if (!fit.plain_blocks.empty()) {
+    std::unique_ptr<ceres::LossFunction> loss;
+    if (fit.loss == RobustLoss::kHuber) loss = std::make_unique<ceres::HuberLoss>(fit.loss_scale_m);
+    if (fit.loss == RobustLoss::kCauchy) loss = std::make_unique<ceres::CauchyLoss>(fit.loss_scale_m);
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    const double* params[] = {fit.theta};
+    for (const auto& plain : fit.plain_blocks) {
+      const int nb = plain->num_residuals();
+      BlockJacobian jb(nb, kNumRefineParameters);
+      Eigen::VectorXd rb(nb);
+      double* jacobians[] = {jb.data()};
+      if (!plain->Evaluate(params, rb.data(), jacobians)) {
+        Fail("refine: a residual could not be evaluated at the solution", summary);
+      }
+      Eigen::Vector3d g = Eigen::Vector3d::Zero();
+      for (int k = 0; k + 3 <= nb; k += 3) {
+        const Eigen::Vector3d rk = rb.segment<3>(k);
+        const Eigen::Matrix<double, 3, kNumRefineParameters> Jk = jb.middleRows<3>(k);
+        double rho[3] = {rk.squaredNorm(), 1.0, 0.0};
+        if (loss) loss->Evaluate(rk.squaredNorm(), rho);
+        const Eigen::Vector3d Jr = Jk.transpose() * rk;
+        A += rho[1] * Jk.transpose() * Jk + 2.0 * rho[2] * Jr * Jr.transpose();
+        g += rho[1] * Jr;
+      }
+      meat += g * g.transpose();
+    }
+    // Invert A on the free parameters.
+    std::vector<int> idx(free.begin(), free.end());
+    Eigen::MatrixXd Af(p, p);
+    for (int a = 0; a < p; ++a) {
+      for (int b = 0; b < p; ++b) Af(a, b) = A(idx[static_cast<std::size_t>(a)], idx[static_cast<std::size_t>(b)]);
+    }
+    Eigen::LLT<Eigen::MatrixXd> llt(Af);
+    if (llt.info() == Eigen::Success) {
+      const Eigen::MatrixXd Ai = llt.solve(Eigen::MatrixXd::Identity(p, p));
+      bread_inv.setZero();
+      for (int a = 0; a < p; ++a) {
+        for (int b = 0; b < p; ++b) {
+          bread_inv(idx[static_cast<std::size_t>(a)], idx[static_cast<std::size_t>(b)]) = Ai(a, b);
         }
       }
-      (weak ? id.undetermined : id.determined).emplace_back(kThetaNames[free[static_cast<std::size_t>(k)]]);
+    } else {
+      summary->notes.push_back(
+          "the robust objective's Hessian is not positive definite at the solution; the run-clustered "
+          "covariance uses the Gauss-Newton matrix instead");
     }
-    id.message = fmt::format(
-        "rank deficient: condition number {:.3g} of the normalised Jacobian exceeds max_condition_number = {:.3g}; "
-        "the data do not determine {}{}",
-        id.condition_number, options.max_condition_number, fmt::join(id.undetermined, ", "),
-        fit.scale_free ? " (the overall scale E_s is free: fix it)" : "");
-    Fail("refine: " + id.message, summary);
+  } else {
+    for (std::size_t g = 0; g < sj.block_jacobians.size(); ++g) {
+      const Eigen::Vector3d gg = sj.block_jacobians[g].transpose() * sj.block_residuals[g];
+      meat += gg * gg.transpose();
+    }
   }
+  const double R = static_cast<double>(fit.blocks.size());
+  return bread_inv * (mask * meat * mask) * bread_inv * (R / (R - 1.0));  // CR1 factor R / (R - 1)
+}
 
-  // ---- step 4: covariance (Ceres) ----
+/// Step 4: covariance of theta (Ceres' inverse information matrix, then as
+/// `kind` asks); fails when Ceres cannot invert it.
+Eigen::Matrix3d ThetaCovariance(FitProblem& fit, const RefineOptions& options, CovarianceKind kind,
+                                const SolutionJacobian& sj, const std::vector<int>& free, RefineSummary* summary) {
+  RefineIdentifiability& id = summary->identifiability;
   ceres::Covariance::Options co;
   co.algorithm_type = ceres::DENSE_SVD;
   co.num_threads = options.num_threads;
   ceres::Covariance covariance(co);
   std::vector<std::pair<const double*, const double*>> blocks = {{fit.theta, fit.theta}};
   Eigen::Matrix<double, 3, 3, Eigen::RowMajor> C;
-  if (!covariance.Compute(blocks, &problem) || !covariance.GetCovarianceBlock(fit.theta, fit.theta, C.data())) {
+  if (!covariance.Compute(blocks, fit.problem.get()) ||
+      !covariance.GetCovarianceBlock(fit.theta, fit.theta, C.data())) {
     id.rank_deficient = true;
     id.undetermined = id.free_parameters;
     id.message = "rank deficient: ceres::Covariance could not invert the information matrix";
@@ -352,92 +441,29 @@ void SolveAndAssess(FitProblem& fit, const RefineOptions& options, CovarianceKin
   Eigen::Matrix3d cov = C;
   switch (kind) {
     case CovarianceKind::kDirect:
-      if (any_omega) {
+      if (sj.any_omega) {
         Eigen::Matrix3d mask = Eigen::Matrix3d::Zero();
         for (int i : free) mask(i, i) = 1.0;
-        cov = C * (mask * omega_meat * mask) * C;
+        cov = C * (mask * sj.omega_meat * mask) * C;
       }
       break;
     case CovarianceKind::kSolverScaled:
       cov *= summary->reduced_chi2;
       if (summary->covariance_method.empty()) summary->covariance_method = "solver_scaled";
       break;
-    case CovarianceKind::kRunClustered: {
-      // Cluster-robust sandwich over runs g (runs are independent, poses
-      // within a run are not): A^-1 (sum_g g_g g_g^T) A^-1 * R / (R - p),
-      // g_g the gradient of run g's cost, A the Hessian of the objective.
-      // Without a loss A^-1 is the Ceres covariance C. With a loss applied
-      // per pose k inside the block, C would be the Gauss-Newton matrix of
-      // the reweighted residual, which is not the M-estimator's Hessian, so
-      // A is formed per pose from the plain residual r_k, its Jacobian J_k
-      // and Ceres' rho', rho'' at s_k = |r_k|^2:
-      //   A = sum_k rho'_k J_k^T J_k + 2 rho''_k (J_k^T r_k)(r_k^T J_k)
-      // (the Hessian Ceres' Triggs correction models; PSD for Huber).
-      Eigen::Matrix3d bread_inv = C;
-      Eigen::Matrix3d meat = Eigen::Matrix3d::Zero();
-      Eigen::Matrix3d mask = Eigen::Matrix3d::Zero();
-      for (int i : free) mask(i, i) = 1.0;
-      if (!fit.plain_blocks.empty()) {
-        std::unique_ptr<ceres::LossFunction> loss;
-        if (fit.loss == RobustLoss::kHuber) loss = std::make_unique<ceres::HuberLoss>(fit.loss_scale_m);
-        if (fit.loss == RobustLoss::kCauchy) loss = std::make_unique<ceres::CauchyLoss>(fit.loss_scale_m);
-        Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-        const double* params[] = {fit.theta};
-        for (const auto& plain : fit.plain_blocks) {
-          const int nb = plain->num_residuals();
-          BlockJacobian jb(nb, kNumRefineParameters);
-          Eigen::VectorXd rb(nb);
-          double* jacobians[] = {jb.data()};
-          if (!plain->Evaluate(params, rb.data(), jacobians)) {
-            Fail("refine: a residual could not be evaluated at the solution", summary);
-          }
-          Eigen::Vector3d g = Eigen::Vector3d::Zero();
-          for (int k = 0; k + 3 <= nb; k += 3) {
-            const Eigen::Vector3d rk = rb.segment<3>(k);
-            const Eigen::Matrix<double, 3, kNumRefineParameters> Jk = jb.middleRows<3>(k);
-            double rho[3] = {rk.squaredNorm(), 1.0, 0.0};
-            if (loss) loss->Evaluate(rk.squaredNorm(), rho);
-            const Eigen::Vector3d Jr = Jk.transpose() * rk;
-            A += rho[1] * Jk.transpose() * Jk + 2.0 * rho[2] * Jr * Jr.transpose();
-            g += rho[1] * Jr;
-          }
-          meat += g * g.transpose();
-        }
-        // Invert A on the free parameters.
-        std::vector<int> idx(free.begin(), free.end());
-        Eigen::MatrixXd Af(p, p);
-        for (int a = 0; a < p; ++a) {
-          for (int b = 0; b < p; ++b) Af(a, b) = A(idx[static_cast<std::size_t>(a)], idx[static_cast<std::size_t>(b)]);
-        }
-        Eigen::LLT<Eigen::MatrixXd> llt(Af);
-        if (llt.info() == Eigen::Success) {
-          const Eigen::MatrixXd Ai = llt.solve(Eigen::MatrixXd::Identity(p, p));
-          bread_inv.setZero();
-          for (int a = 0; a < p; ++a) {
-            for (int b = 0; b < p; ++b) {
-              bread_inv(idx[static_cast<std::size_t>(a)], idx[static_cast<std::size_t>(b)]) = Ai(a, b);
-            }
-          }
-        } else {
-          summary->notes.push_back(
-              "the robust objective's Hessian is not positive definite at the solution; the run-clustered "
-              "covariance uses the Gauss-Newton matrix instead");
-        }
-      } else {
-        for (std::size_t g = 0; g < block_jacobians.size(); ++g) {
-          const Eigen::Vector3d gg = block_jacobians[g].transpose() * block_residuals[g];
-          meat += gg * gg.transpose();
-        }
-      }
-      const double R = static_cast<double>(fit.blocks.size());
-      cov = bread_inv * (mask * meat * mask) * bread_inv * (R / (R - 1.0));  // CR1 factor R / (R - 1)
+    case CovarianceKind::kRunClustered:
+      cov = RunClusteredCovariance(fit, C, sj, free, summary);
       if (summary->covariance_method.empty()) summary->covariance_method = "run_clustered";
       break;
-    }
   }
-  summary->theta_covariance = cov;
+  return cov;
+}
 
-  // ---- step 5: is every free parameter determined? ----
+/// Step 5: every free parameter's standard deviation within
+/// max_relative_sigma; fails otherwise.
+void CheckDetermined(const Eigen::Matrix3d& cov, const std::vector<int>& free, const FitProblem& fit,
+                     const RefineOptions& options, RefineSummary* summary) {
+  RefineIdentifiability& id = summary->identifiability;
   bool all_determined = true;
   for (int i : free) {
     const double sigma = std::sqrt(std::max(0.0, cov(i, i)));
@@ -461,8 +487,11 @@ void SolveAndAssess(FitProblem& fit, const RefineOptions& options, CovarianceKin
                            id.condition_number,
                            id.fixed_parameters.empty() ? ""
                                                        : fmt::format("; held fixed: {}", fmt::join(id.fixed_parameters, ", ")));
+}
 
-  // ---- step 6: parameters, covariance in metres, intervals ----
+/// Step 6: refined parameters, their covariance in metres and the intervals.
+void FillParameters(const FitProblem& fit, const Eigen::Matrix3d& cov, const RefineOptions& options,
+                    std::optional<double> dof, RefineSummary* summary) {
   const RobotParams& ref = summary->reference;
   const double Eb = fit.theta[kIndexEb], Ed = fit.theta[kIndexEd], Es = fit.theta[kIndexEs];
   summary->refined = ApplyRefinedFactors(ref, Eb, Ed, Es);
@@ -486,6 +515,22 @@ void SolveAndAssess(FitProblem& fit, const RefineOptions& options, CovarianceKin
   iv.E_b = Interval(Eb, Eigen::Vector3d::UnitX(), cov, qt);
   iv.E_d = Interval(Ed, Eigen::Vector3d::UnitY(), cov, qt);
   iv.E_s = Interval(Es, Eigen::Vector3d::UnitZ(), cov, qt);
+}
+
+}  // namespace
+
+void SolveAndAssess(FitProblem& fit, const RefineOptions& options, CovarianceKind kind, std::optional<double> dof,
+                    RefineSummary* summary) {
+  const ceres::Solver::Summary cs = Solve(fit, options, summary);
+  const SolutionJacobian sj = EvaluateAtSolution(fit, summary);
+  const std::vector<int> free = FreeIndices(fit.scale_free);
+  const int m = static_cast<int>(sj.J.rows()), p = static_cast<int>(free.size());
+  summary->reduced_chi2 = m > p ? 2.0 * cs.final_cost / (m - p) : std::numeric_limits<double>::quiet_NaN();
+  CheckIdentifiability(sj.J, free, fit, options, summary);
+  const Eigen::Matrix3d cov = ThetaCovariance(fit, options, kind, sj, free, summary);
+  summary->theta_covariance = cov;
+  CheckDetermined(cov, free, fit, options, summary);
+  FillParameters(fit, cov, options, dof, summary);
 }
 
 }  // namespace refine_detail
