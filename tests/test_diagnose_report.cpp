@@ -14,7 +14,7 @@
 
 #include "diagnosis/advice.hpp"
 #include "diagnosis/diagnose.hpp"
-#include "simulation/campaign_sim.hpp"
+#include "support/diag_campaign.hpp"
 #include "support/run_cli.hpp"
 
 using namespace umbmark;
@@ -24,28 +24,13 @@ namespace {
 
 const std::filesystem::path kEx = std::filesystem::path(UMBMARK_SOURCE_DIR) / "data/examples";
 
-/// Squares (cw, ccw) and back-and-forth runs with ground truth at 10 Hz.
+/// The tests' small campaign (support/diag_campaign.hpp), with a time
+/// offset `tau` [s] and a ground-truth yaw misalignment `yaw` [rad].
 CampaignData Simulated(std::uint64_t seed, double tau = 0.0, double yaw = 0.0) {
-  RobotParams r;
-  r.wheelbase_m = 0.35;
-  r.wheel_diameter_left_m = r.wheel_diameter_right_m = 0.1;
-  r.ticks_per_rev = 8192;
-  const Manifest m = sim::StandardCampaignManifest(r, 2.0, 2.0, GroundTruthNoise{3e-4, 1.5e-3});
-  sim::CampaignSimOptions o;
-  o.seed = seed;
-  o.truth.E_d = 1.004;
-  o.truth.E_b = 1.012;
-  o.truth.k_L = 1.5e-3;
-  o.truth.k_R = 2.5e-3;
-  o.square_runs_per_direction = 5;
-  o.back_and_forth_runs = 10;
-  o.sample_rate_hz = 10.0;
-  o.speed_m_s = 0.5;
-  o.pause_s = 0.5;
-  o.effects.time_tau = tau;
-  o.effects.yaw_delta = yaw;
-  const sim::SimulatedCampaign c = sim::SimulateCampaign(m, o);
-  return BuildCampaign(c.manifest, c.data);
+  testing::SmallCampaign s = testing::MakeSmallCampaign(seed);
+  s.sim.effects.time_tau = tau;
+  s.sim.effects.yaw_delta = yaw;
+  return testing::BuildSmallCampaign(s);
 }
 
 DiagnoseOptions Fast() {

@@ -15,7 +15,7 @@
 #include "error_models/path_covariance.hpp"
 #include "error_models/wheel_noise_fit.hpp"
 #include "diagnosis/diagnose.hpp"
-#include "simulation/campaign_sim.hpp"
+#include "support/diag_campaign.hpp"
 #include "simulation/monte_carlo.hpp"
 #include "support/run_cli.hpp"
 
@@ -87,28 +87,14 @@ TEST_CASE("progress callback: stage mapping and the diagnosis' stages", "[progre
   CHECK_FALSE(StageProgress(nullptr, 0.0, 1.0, 1.0));
 
   // A diagnosis with a significant gap runs every stage.
-  RobotParams r;
-  r.wheelbase_m = 0.35;
-  r.wheel_diameter_left_m = r.wheel_diameter_right_m = 0.1;
-  r.ticks_per_rev = 8192;
-  const Manifest m = sim::StandardCampaignManifest(r, 2.0, 2.0, GroundTruthNoise{3e-4, 1.5e-3});
-  sim::CampaignSimOptions so;
-  so.seed = 3;
-  so.truth.k_L = 1.5e-3;
-  so.truth.k_R = 2.5e-3;
-  so.square_runs_per_direction = 3;
-  so.back_and_forth_runs = 6;
-  so.sample_rate_hz = 10.0;
-  so.speed_m_s = 0.5;
-  so.pause_s = 0.5;
-  so.effects.time_tau = 0.06;
-  const sim::SimulatedCampaign c = sim::SimulateCampaign(m, so);
+  testing::SmallCampaign small = testing::MakeSmallCampaign(3, 3, 6);
+  small.sim.effects.time_tau = 0.06;
   Recorder rec;
   diag::DiagnoseOptions o;
   o.null_simulations = 40;
   o.pieces.folds = 3;
   o.progress = rec.Callback();
-  const diag::DiagnoseSummary d = diag::Diagnose(diag::BuildCampaign(c.manifest, c.data), o);
+  const diag::DiagnoseSummary d = diag::Diagnose(testing::BuildSmallCampaign(small), o);
   REQUIRE(d.significant);
   CHECK_FALSE(rec.overlapped);
   CHECK(rec.Monotone());
