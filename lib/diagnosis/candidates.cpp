@@ -235,7 +235,7 @@ void FitNoiseEffect(const Shared& x, sim::EffectKind kind, Candidate& cd) {
   const CrossValidation cv = CrossValidate(
       c, x.b.bases, x.folds, x.b.eps, x.b.D, x.b.W, [&](const std::vector<double>& e, const std::vector<char>& use) {
         return corr ? FitPieceNoise(e, x.b.bases, c.pieces, use, ne, cf_fold)
-                    : FitBumps(e, x.b.bases, c.pieces, use, ne);
+                    : FitBumps(e, x.b.bases, c.pieces, use, ne, /*start_only=*/true);
       });
   cd.heldout_loglik_gain = cv.loglik - x.cv_ll_base;
   const double gcv = ComputeGap(c, cv.scores, x.options.gap).score;

@@ -60,8 +60,10 @@ MeanPart FitMeanPart(const CampaignData& c, const MeanModel& model, const Baseli
   return MeanPartFrom(c, model, FitMean(model, b.p, params, b.W, MeanFitOptions{12}), params);
 }
 
+/// warm: the chosen set's noise when it already has bumps (the bump fit
+/// then refits from there alone; else the multi-start from the baseline).
 SetFit FitSet(const CampaignData& c, const BaselineFit& b, const Folds& folds, const std::vector<sim::EffectKind>& set,
-              const MeanPart& mean, const GapOptions& gap) {
+              const MeanPart& mean, const GapOptions& gap, const NoiseParams* warm = nullptr) {
   const bool bumps = Contains(set, sim::EffectKind::kBumpOutliers);
   const MeanFit& mf = mean.mf;
   const std::vector<PieceBases>& bases = mean.scrub ? mean.scrub_bases : b.bases;
@@ -70,7 +72,8 @@ SetFit FitSet(const CampaignData& c, const BaselineFit& b, const Folds& folds, c
   SetFit out;
   out.p = mf.p;
   // Bumps and rho together: the bump mixture (its fit has no rho).
-  out.noise = bumps ? FitBumps(mf.eps, bases, c.pieces, {}, b.noise)
+  out.noise = bumps ? (warm ? FitBumps(mf.eps, bases, c.pieces, {}, *warm, /*start_only=*/true)
+                             : FitBumps(mf.eps, bases, c.pieces, {}, b.noise))
                     : FitPieceNoise(mf.eps, bases, c.pieces, {}, b.noise, nf);
   const std::vector<Eigen::Matrix3d> W = Whiteners(bases, c.pieces, out.noise);
   out.gap_after = ComputeGap(c, PieceScores(mf.eps, bases, c.pieces, out.noise), gap).score;
@@ -80,7 +83,8 @@ SetFit FitSet(const CampaignData& c, const BaselineFit& b, const Folds& folds, c
   const NoiseParams& ne = out.noise;
   const CrossValidation cv =
       CrossValidate(c, bases, folds, mf.eps, mf.D, W, [&](const std::vector<double>& e, const std::vector<char>& use) {
-        return bumps ? FitBumps(e, bases, c.pieces, use, ne) : FitPieceNoise(e, bases, c.pieces, use, ne, fold_fit);
+        return bumps ? FitBumps(e, bases, c.pieces, use, ne, /*start_only=*/true)
+                     : FitPieceNoise(e, bases, c.pieces, use, ne, fold_fit);
       });
   out.cv_loglik = cv.loglik;
   out.heldout_gap = ComputeGap(c, cv.scores, gap).score;
@@ -298,10 +302,11 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
     std::vector<std::vector<sim::EffectKind>> sets(remaining.size(), chosen);
     for (std::size_t i = 0; i < remaining.size(); ++i) sets[i].push_back(remaining[i]);
     means.Prepare(sets);
+    const NoiseParams* warm = Contains(chosen, sim::EffectKind::kBumpOutliers) ? &current.noise : nullptr;
     std::vector<SetFit> trial(remaining.size());
     ParallelFor(options.threads, static_cast<int>(remaining.size()), [&](int i) {
       const auto& set = sets[static_cast<std::size_t>(i)];
-      trial[static_cast<std::size_t>(i)] = FitSet(c, b, folds, set, means.Get(set), options.gap);
+      trial[static_cast<std::size_t>(i)] = FitSet(c, b, folds, set, means.Get(set), options.gap, warm);
       progress.Add();
     });
     std::size_t best = 0;

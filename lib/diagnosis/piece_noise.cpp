@@ -383,7 +383,8 @@ NoiseParams FitPieceNoise(const std::vector<double>& eps, const std::vector<Piec
 }
 
 NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
-                     const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start) {
+                     const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start,
+                     bool start_only) {
   // Bounded minimisation (NLopt Sbplx) of -log L over x = [log kL2, log kR2,
   // log rate, log sb2], from up to three starts; the box is the header's
   // physical bumps.
@@ -405,9 +406,11 @@ NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBase
        std::log(30.0 * k2)},
       {std::log(std::max(start.kL2, 1e-14) * 0.9), std::log(std::max(start.kR2, 1e-14) * 0.9), std::log(1.0),
        std::log(6.0 * k2)}};
-  if (start.bump_rate > 0.0 && start.bump_s2 > 0.0)
+  if (start.bump_rate > 0.0 && start.bump_s2 > 0.0) {
+    if (start_only) starts.clear();
     starts.insert(starts.begin(), {std::log(start.kL2), std::log(start.kR2), std::log(start.bump_rate),
                                    std::log(start.bump_s2)});
+  }
   for (auto& x : starts) {
     x[2] = std::clamp(x[2], std::log(2e-4), std::log(1.9));
     x[3] = std::clamp(x[3], std::log(2e-10), std::log(0.5e-2));

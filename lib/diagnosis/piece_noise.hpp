@@ -95,8 +95,12 @@ NoiseParams FitPieceNoise(const std::vector<double>& eps, const std::vector<Piec
 /// bounded Sbplx over log k_L^2, log k_R^2, log rate, log sigma_b^2; ground
 /// truth noise fixed at `start`'s). The search is bounded to physical
 /// bumps: rate in [1e-4, 2] per metre, sigma_b in [0.01, 100] mm.
+/// start_only: one search from `start` (which must carry bumps) instead of
+/// the multi-start -- for refits near a known answer, such as the
+/// cross-validation folds of a full-data fit.
 NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
-                     const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start);
+                     const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start,
+                     bool start_only = false);
 
 /// Log-likelihood of piece j's residual (Gaussian, or the bump mixture when
 /// n.bump_rate > 0).
