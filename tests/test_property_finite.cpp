@@ -15,6 +15,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "model/commanded_square.hpp"
+#include "model/true_robot.hpp"
 #include "support/run_cli.hpp"
 
 namespace fs = std::filesystem;
@@ -148,5 +150,59 @@ TEST_CASE("property: random byte mutations of valid files never crash a command"
     CHECK((r.status >= 0 && r.status <= 3));
     if (r.status == 0) CheckFinite(nlohmann::json::parse(r.out), "calibrate");
     if (r.status != 0) CHECK_FALSE(r.err.empty());
+  }
+}
+
+TEST_CASE("property: random unit mix-ups and reversed labels are never calibrated (exit 0)", "[safety][property]") {
+  // A realistic campaign (exact commanded squares, E_b 1 +- 0.5..3 %, E_d 1 +-
+  // 0.05..0.2 %, 1-10 mm scatter, 3-8 runs per direction, side 1-5 m)
+  // calibrates (exit 0); the same campaign with one random mix-up never
+  // does, and the message names the cause.
+  std::mt19937_64 rng(424242);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const auto sign = [&] { return u(rng) < 0.5 ? -1.0 : 1.0; };
+  const fs::path dir = umbmark::testing::TempDir("prop-mix");
+  const char* const kMixups[] = {"errors in mm", "labels reversed", "side in mm", "wheelbase in mm", "diameters in mm"};
+  const char* const kExpect[] = {"return errors are", "labels are reversed", "millimetres", "millimetres",
+                                 "millimetres"};
+  for (int trial = 0; trial < 30; ++trial) {
+    const double E_b = 1.0 + sign() * (0.005 + 0.025 * u(rng)), E_d = 1.0 + sign() * (0.0005 + 0.0015 * u(rng));
+    const double side = 1.0 + 4.0 * u(rng), sigma = 0.001 + 0.009 * u(rng), b = 0.2 + 0.4 * u(rng);
+    const double D = 0.05 + 0.15 * u(rng);
+    const int n = 3 + static_cast<int>(rng() % 6);
+    const int mix = static_cast<int>(rng() % 5);
+    std::normal_distribution<double> noise(0.0, sigma);
+    std::string good = "run,direction,ex_m,ey_m\n", bad = good;
+    int id = 0;
+    for (const auto dir_ : {umbmark::SquareDirection::kCw, umbmark::SquareDirection::kCcw}) {
+      const umbmark::Pose2 e = umbmark::SquareReturnError(dir_, side, b, E_b, umbmark::CorrectionLeft(E_d),
+                                                         umbmark::CorrectionRight(E_d));
+      const bool cw = dir_ == umbmark::SquareDirection::kCw;
+      for (int i = 0; i < n; ++i) {
+        const double x = e.x + noise(rng), y = e.y + noise(rng);
+        good += fmt::format("{},{},{},{}\n", ++id, cw ? "cw" : "ccw", x, y);
+        const double k = mix == 0 ? 1000.0 : 1.0;
+        bad += fmt::format("{},{},{},{}\n", id, (mix == 1) != cw ? "cw" : "ccw", k * x, k * y);
+      }
+    }
+    const auto robot = [&](double kb, double kd) {
+      return fmt::format("wheelbase_m = {}\nwheel_diameter_left_m = {}\nwheel_diameter_right_m = {}\n", kb * b, kd * D,
+                         kd * D);
+    };
+    Put(dir / "good.csv", good);
+    Put(dir / "bad.csv", bad);
+    Put(dir / "good.toml", robot(1.0, 1.0));
+    Put(dir / "bad.toml", robot(mix == 3 ? 1000.0 : 1.0, mix == 4 ? 1000.0 : 1.0));
+    const std::string tail = " --json -";
+    const auto ok = RunCli("calibrate " + Q(dir / "good.csv") + " --robot " + Q(dir / "good.toml") +
+                           fmt::format(" --side {}", side) + tail);
+    const auto r = RunCli("calibrate " + Q(dir / "bad.csv") + " --robot " + Q(dir / "bad.toml") +
+                          fmt::format(" --side {}", mix == 2 ? 1000.0 * side : side) + tail);
+    INFO("trial " << trial << ": " << kMixups[mix] << ", E_b " << E_b << ", E_d " << E_d << ", side " << side
+                  << ", sigma " << sigma << ", n " << n << "\n" << ok.err << "\n" << r.err);
+    CHECK(ok.status == 0);
+    if (ok.status == 0) CheckFinite(nlohmann::json::parse(ok.out), "calibrate");
+    CHECK(r.status != 0);
+    CHECK_THAT(r.err, Catch::Contains(kExpect[mix]));
   }
 }
