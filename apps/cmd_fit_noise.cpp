@@ -454,6 +454,10 @@ void PrintText(const FitNoiseOptions& o, const Loaded& data, const FitResult& f,
                                           : std::string(" (from the means; see the warning)"),
                e.E_b,
                f.estimate->E_b_determined ? fmt::format(" +- {:.5f} (from the means)", f.estimate->E_b_se) : "");
+    if (f.estimate->E_d_determined && f.estimate->E_d_se > 0.5 * WheelNoiseFitOptions{}.E_d_prior_sigma)
+      fmt::print("  note: the scatter of this design barely shows E_d (+- {:.4f}, near the prior's {}); the intervals "
+                 "include that uncertainty: give --params CAL.json for narrower ones\n",
+                 f.estimate->E_d_se, WheelNoiseFitOptions{}.E_d_prior_sigma);
     if (!f.estimate->E_b_determined)
       fmt::print("  note: this design (no turns) does not show E_b; k is relative to the recorded wheelbase "
                  "(a wheelbase off by x % moves k by up to x %): give --params CAL.json from `umbmark calibrate`\n");

@@ -264,3 +264,39 @@ TEST_CASE("fit-noise CLI: k at the boundary is 'not determined'; --params and --
   }
   fs::remove_all(dir);
 }
+
+TEST_CASE("fit-noise CLI: E_d is kept at the means' value, with a warning, when the scatter does not fit", "[fit_noise][cli]") {
+  // 3000 trajectory runs of 1 m straight whose lateral error is NOT the
+  // wheel-noise model's (y = theta / 2 plus independent 0.3 mm): the joint
+  // fit would pull E_d far from 1 to bend the model onto the misfit.
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / fmt::format("umbmark_fit_noise_ed_{}", ::getpid());
+  fs::create_directories(dir);
+  {
+    std::ofstream f(dir / "robot.toml");
+    f << "wheelbase_m = 0.371\nwheel_diameter_left_m = 0.1\nwheel_diameter_right_m = 0.1\n";
+  }
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> N01;
+  std::string csv = "run,direction,t_s,dist_left_m,dist_right_m,x_gt_m,y_gt_m,theta_gt_rad\n";
+  for (int i = 1; i <= 3000; ++i) {
+    const char* d = i % 2 ? "cw" : "ccw";
+    const double L = 1.0 + 0.001 * N01(rng), R = 1.0 + 0.001 * N01(rng), th = (R - L) / kB;
+    csv += fmt::format("{},{},0,0,0,0,0,0\n{},{},1,1.0,1.0,{:.9f},{:.9f},{:.9f}\n", i, d, i, d, 0.5 * (L + R),
+                       0.5 * th + 0.0003 * N01(rng), th);
+  }
+  {
+    std::ofstream f(dir / "straight.csv");
+    f << csv;
+  }
+  const auto r = testing::RunCli(fmt::format("fit-noise {} --robot {} --meas-sigma 0.0005,0.001 --json -",
+                                             (dir / "straight.csv").string(), (dir / "robot.toml").string()));
+  REQUIRE(r.status == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  CHECK(j["systematic_errors"]["source"] == "estimated");
+  CHECK(j["systematic_errors"]["E_d_determined"] == false);
+  CHECK(std::abs(j["systematic_errors"]["E_d"].get<double>() - 1.0) < 0.01);
+  REQUIRE(!j["warnings"].empty());
+  CHECK(j["warnings"][0].get<std::string>().find("the scatter pulled E_d more than 0.05") != std::string::npos);
+  fs::remove_all(dir);
+}
