@@ -535,7 +535,9 @@ int RunCalibrate(const CalibrateOptions& o) {
   double done = 0.0;
   // Within an input, the held-out comparison (the long part) moves the line
   // by its folds.
-  jo.progress = [&](double folds_done, double folds) { progress.Update(done - 1.0 + folds_done / folds); };
+  jo.progress = [&](double folds_done, double folds) {
+    progress.Update(done - 1.0 + (folds > 0.0 ? folds_done / folds : 1.0));
+  };
   for (const auto& path : o.inputs) {
     progress.Update(done++);
     std::vector<CalibrateInput> inputs;

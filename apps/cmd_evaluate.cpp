@@ -89,6 +89,51 @@ void PrintSummary(const char* title, const EvaluationSummary& s) {
              Rad2Deg(s.max_max_heading_error_rad));
 }
 
+// The paths of the worst runs (`worst`: indices into `runs`, worst first;
+// `final_mm`: their final position errors), each on its own scale, with one
+// key below. Returns the bottom.
+double WorstPathPanels(const std::vector<PlotRun>& runs, const std::vector<std::size_t>& worst,
+                       const std::vector<double>& final_mm, const std::optional<RobotParams>& params, Integrator integ,
+                       double bottom, std::vector<std::string>& parts) {
+  const io::SvgStyle rec_bold{"#c0392b", "", "5,3", 1.6, false}, par_bold{"#1f7a3a", "", "", 2.0, false};
+  const io::SvgStyle gt{"#111", "", "", 2.2, false};
+  const double size = 250;
+  double row_bottom = bottom;
+  for (std::size_t r = 0; r < worst.size(); ++r) {
+    const auto& [source, run] = runs[worst[r]];
+    const Source& src = *source;
+    const double left = 80 + static_cast<double>(r % 4) * (size + 60), top = bottom + static_cast<double>(r / 4) * (size + 90);
+    io::SvgPanel p(left, top, size, size,
+                   fmt::format("{}: run {} ({}), {:.1f} mm", r + 1, run.run, run.direction, final_mm[r]));
+    const RunTrack b = TrackRun(run, src.path, src.recorded, src.recorded, integ);
+    std::vector<io::SvgPoint> g, o0, o1, all;
+    for (std::size_t i = 0; i < run.size(); ++i) {
+      if (b.has_ground_truth[i]) g.push_back({b.ground_truth[i].x, b.ground_truth[i].y});
+      o0.push_back({b.odometry[i].x, b.odometry[i].y});
+    }
+    if (params) {
+      const RunTrack a = TrackRun(run, src.path, *params, src.recorded, integ);
+      for (const auto& q : a.odometry) o1.push_back({q.x, q.y});
+    }
+    all = g;
+    all.insert(all.end(), o0.begin(), o0.end());
+    p.FitExtent(all, true, true);
+    p.Axes("x [m]", "y [m]");
+    p.Polyline(g, gt);
+    p.Polyline(o0, rec_bold);
+    if (params) p.Polyline(o1, par_bold);
+    row_bottom = std::max(row_bottom, p.Bottom());
+    parts.push_back(p.Render());
+  }
+  io::SvgPanel key(80, row_bottom - 36, 0, 0, "");
+  std::vector<std::pair<io::SvgStyle, std::string>> key_entries = {{gt, "ground truth"},
+                                                                   {rec_bold, "odometry with the recorded parameters"}};
+  if (params) key_entries.push_back({par_bold, "odometry with the --params parameters"});
+  key.Legend(key_entries);
+  parts.push_back(key.Render());
+  return key.Bottom();
+}
+
 /// Runs kept for the --plot figure: every run up to this many (the plot
 /// says when there were more).
 constexpr std::size_t kPlotRuns = 200;
@@ -173,43 +218,9 @@ std::string PlotSvg(const std::vector<PlotRun>& runs, const std::optional<RobotP
       io::SvgEscape(fmt::format("Paths of the {} runs with the largest final position error ({}), worst first", worst.size(),
                                 which))));
   bottom += 30;
-  // The paths of the worst runs, each on its own scale.
-  const io::SvgStyle gt{"#111", "", "", 2.2, false};
-  const double size = 250;
-  double row_bottom = bottom;
-  for (std::size_t r = 0; r < worst.size(); ++r) {
-    const auto& [source, run] = runs[worst[r]];
-    const Source& src = *source;
-    const double left = 80 + static_cast<double>(r % 4) * (size + 60), top = bottom + static_cast<double>(r / 4) * (size + 90);
-    io::SvgPanel p(left, top, size, size,
-                   fmt::format("{}: run {} ({}), {:.1f} mm", r + 1, run.run, run.direction, final_mm(worst[r])));
-    const RunTrack b = TrackRun(run, src.path, src.recorded, src.recorded, integ);
-    std::vector<io::SvgPoint> g, o0, o1, all;
-    for (std::size_t i = 0; i < run.size(); ++i) {
-      if (b.has_ground_truth[i]) g.push_back({b.ground_truth[i].x, b.ground_truth[i].y});
-      o0.push_back({b.odometry[i].x, b.odometry[i].y});
-    }
-    if (params) {
-      const RunTrack a = TrackRun(run, src.path, *params, src.recorded, integ);
-      for (const auto& q : a.odometry) o1.push_back({q.x, q.y});
-    }
-    all = g;
-    all.insert(all.end(), o0.begin(), o0.end());
-    p.FitExtent(all, true, true);
-    p.Axes("x [m]", "y [m]");
-    p.Polyline(g, gt);
-    p.Polyline(o0, rec_bold);
-    if (params) p.Polyline(o1, par_bold);
-    row_bottom = std::max(row_bottom, p.Bottom());
-    parts.push_back(p.Render());
-  }
-  io::SvgPanel key(80, row_bottom - 36, 0, 0, "");
-  std::vector<std::pair<io::SvgStyle, std::string>> key_entries = {{gt, "ground truth"},
-                                                                   {rec_bold, "odometry with the recorded parameters"}};
-  if (params) key_entries.push_back({par_bold, "odometry with the --params parameters"});
-  key.Legend(key_entries);
-  parts.push_back(key.Render());
-  return io::SvgDocument(1260, key.Bottom() + 10, parts);
+  std::vector<double> worst_mm;
+  for (std::size_t i : worst) worst_mm.push_back(final_mm(i));
+  return io::SvgDocument(1260, WorstPathPanels(runs, worst, worst_mm, params, integ, bottom, parts) + 10, parts);
 }
 
 std::string EvaluateReportHtml(const std::vector<std::string>& inputs, const EvaluationSummary& base,

@@ -53,6 +53,8 @@ constexpr std::size_t kTopPieces = 8;
 // kTopPieces largest of the campaign ringed and numbered (listed in the
 // report's table). Values beyond the axis limit (10 SE at most, so the band
 // stays readable) are drawn at the edge and said so. Returns the bottom.
+// One function: one pass per experiment gathers points, run starts, the
+// fraction outside the band and the marks that the panel then draws.
 double ResidualPanels(const nlohmann::json& j, double top, std::vector<std::string>& parts) {
   if (!j.contains("piece_residuals")) return top;
   const auto& pieces = j["piece_residuals"].value("pieces", nlohmann::json::array());
