@@ -134,7 +134,7 @@ double PathPanels(const CalibrateInput& input, Integrator integrator, const Robo
   const double size = 150, gap_x = 62, gap_y = 84, top0 = bottom + 56;
   parts.push_back(fmt::format(
       R"svg(<text class="section-title" x="80" y="{:.0f}" font-size="13" font-weight="bold">{}</text>)svg", bottom + 24,
-      io::SvgEscape(shown.size() < tracked.size()
+      io::XmlEscape(shown.size() < tracked.size()
                         ? fmt::format("Paths: the {} of {} runs with the largest final error after correction "
                                       "(file order); title: run, direction, final position error after correction",
                                       shown.size(), tracked.size())

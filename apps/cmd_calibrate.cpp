@@ -470,11 +470,8 @@ std::string CalibrationReportHtml(const nlohmann::json& j, const CalibrateJobRes
   return rep.Render();
 }
 
-// Long (~190 lines) because it is the command's one sequence of steps: read
-// every input, calibrate each unit, gate, print, then write each requested
-// output. Splitting it is listed as follow-up work (issue 11).
-int RunCalibrate(const CalibrateOptions& o) {
-  if (o.use == "refined" && !o.refine) throw InvalidOptions("--use refined needs --refine");
+/// The job options of the command line (--refine's RefineOptions checked).
+CalibrateJobOptions JobOptions(const CalibrateOptions& o) {
   CalibrateJobOptions jo;
   jo.umbmark.estimator = *UmbmarkEstimatorFromString(o.estimator);
   jo.umbmark.ed_with_corrected_wheelbase = o.ed_wheelbase == "corrected";
@@ -500,6 +497,42 @@ int RunCalibrate(const CalibrateOptions& o) {
     if (auto err = ro.Check(); !err.empty()) throw InvalidOptions(err);
     jo.refine = ro;
   }
+  return jo;
+}
+
+/// Faults the data show before any fit: swapped encoder channels (exit 3)
+/// and unit mix-ups (exit 1).
+void CheckDataBeforeFit(const CalibrateInput& in) {
+  // Swapped encoder channels show in the data themselves: the odometry
+  // turns against the ground truth. Said plainly, before any fit.
+  if (in.trajectories) {
+    const int mirrored = CountMirroredRuns(*in.trajectories, in.recorded);
+    if (2 * mirrored > static_cast<int>(in.errors.size())) {
+      throw QualityGateError(fmt::format(
+          "{}: in {} of {} runs the odometry turns the other way than the ground truth and the cw/ccw label: "
+          "the left and right encoder channels (or the sign of the ticks) are swapped; swap the columns "
+          "ticks_left/ticks_right (or dist_left_m/dist_right_m) and run again",
+          in.label, mirrored, in.errors.size()));
+    }
+  }
+  // Unit mix-ups show in the data too: return errors as large as the
+  // square, or runs that travel far more or less than 4 sides.
+  if (in.trajectories) {
+    if (auto problem = CheckTravelScale(*in.trajectories, in.recorded, in.side_m); !problem.empty())
+      throw InputError(in.label, problem);
+  }
+  if (auto problem = CheckReturnErrorScale(in.errors, in.side_m); !problem.empty())
+    throw InputError(in.label, problem);
+}
+
+// ~150 lines: the command's one sequence (read every input, calibrate each
+// unit, gate, print, write each requested output) shares the batch state
+// (rows, results, status, warnings, written outputs) across all of it; the
+// self-contained parts are the helpers above and the plot / report / ros2
+// writers.
+int RunCalibrate(const CalibrateOptions& o) {
+  if (o.use == "refined" && !o.refine) throw InvalidOptions("--use refined needs --refine");
+  CalibrateJobOptions jo = JobOptions(o);
 
   // Output safety: no output may be an input or another output.
   io::OutputSet& outs = CommandOutputs();
@@ -553,26 +586,7 @@ int RunCalibrate(const CalibrateOptions& o) {
       CalibrateJobResult r;
       PlausibilityReport gate;
       try {
-        // Swapped encoder channels show in the data themselves: the odometry
-        // turns against the ground truth. Said plainly, before any fit.
-        if (in.trajectories) {
-          const int mirrored = CountMirroredRuns(*in.trajectories, in.recorded);
-          if (2 * mirrored > static_cast<int>(in.errors.size())) {
-            throw QualityGateError(fmt::format(
-                "{}: in {} of {} runs the odometry turns the other way than the ground truth and the cw/ccw label: "
-                "the left and right encoder channels (or the sign of the ticks) are swapped; swap the columns "
-                "ticks_left/ticks_right (or dist_left_m/dist_right_m) and run again",
-                in.label, mirrored, in.errors.size()));
-          }
-        }
-        // Unit mix-ups show in the data too: return errors as large as the
-        // square, or runs that travel far more or less than 4 sides.
-        if (in.trajectories) {
-          if (auto problem = CheckTravelScale(*in.trajectories, in.recorded, in.side_m); !problem.empty())
-            throw InputError(in.label, problem);
-        }
-        if (auto problem = CheckReturnErrorScale(in.errors, in.side_m); !problem.empty())
-          throw InputError(in.label, problem);
+        CheckDataBeforeFit(in);
         r = RunCalibrateJob(in, jo);
         // Plausibility gates: never print or write an impossible result.
         gate = CheckUmbmarkPlausibility(r.umbmark);
@@ -668,15 +682,12 @@ int RunCalibrate(const CalibrateOptions& o) {
                  s.corrected.wheel_diameter_right_m, s.E_max_syst_m * 1e3, after);
     }
   }
-  if (o.json.path.empty()) {
-    // No JSON asked for.
-  } else if (rows.size() == 1 && rows.front().result) {
-    o.json.Emit(results.front());
-  } else {
-    o.json.Emit({{"results", results}, {"failed", status != 0}, {"warnings", all_warnings}});
-  }
-  if (!o.json.path.empty() && !o.json.ToStdout()) written.push_back(o.json.path + " (JSON)");
-  PrintWritten(written, o.json.PrintText());
+  // (results holds the JSON of each unit only when --json asks for it.)
+  const bool single = rows.size() == 1 && rows.front().result && !results.empty();
+  o.json.EmitAndListOutputs(
+      single ? results.front()
+             : nlohmann::json{{"results", results}, {"failed", status != 0}, {"warnings", all_warnings}},
+      written);
   return status;
 }
 

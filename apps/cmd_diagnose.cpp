@@ -89,9 +89,7 @@ int RunDiagnose(DiagnoseCliOptions o) {
     outs.Write(o.report, DiagnoseReportHtml(j, o.manifest));
     written.push_back(o.report + " (HTML report)");
   }
-  if (!o.json.path.empty() && !o.json.ToStdout()) written.push_back(o.json.path + " (JSON)");
-  o.json.Emit(j);
-  PrintWritten(written, o.json.PrintText());
+  o.json.EmitAndListOutputs(j, written);
   if (o.quality_gate && s.verdict == "unexplained") {
     throw QualityGateError("the campaign leaves the model and no known effect explains the gap");
   }

@@ -215,7 +215,7 @@ std::string PlotSvg(const std::vector<PlotRun>& runs, const std::optional<RobotP
   double bottom = std::max(pp.Bottom(), ph.Bottom()) + 30;
   parts.push_back(fmt::format(
       R"svg(<text class="section-title" x="80" y="{:.0f}" font-size="13" font-weight="bold">{}</text>)svg", bottom,
-      io::SvgEscape(fmt::format("Paths of the {} runs with the largest final position error ({}), worst first", worst.size(),
+      io::XmlEscape(fmt::format("Paths of the {} runs with the largest final position error ({}), worst first", worst.size(),
                                 which))));
   bottom += 30;
   std::vector<double> worst_mm;
@@ -354,9 +354,7 @@ int RunEvaluate(const EvaluateOptions& o) {
     outs.Write(o.report, EvaluateReportHtml(o.inputs, base, with_params, o.params_file, svg));
     written.push_back(o.report + " (HTML report)");
   }
-  o.json.Emit(j);
-  if (!o.json.path.empty() && !o.json.ToStdout()) written.push_back(o.json.path + " (JSON)");
-  PrintWritten(written, o.json.PrintText());
+  o.json.EmitAndListOutputs(j, written);
   return 0;
 }
 

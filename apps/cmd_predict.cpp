@@ -131,16 +131,8 @@ MonteCarloErrors StandardErrors(const PoseCovariance& C, std::int64_t n) {
 /// Fewer Monte Carlo runs than this: a warning (covariance SE above 14 %).
 constexpr std::int64_t kFewMonteCarloRuns = 100;
 
-// Just over 100 lines: closed form, optional Monte Carlo, gates and output
-// in order; each step is a call, the length is the printing.
-int RunPredict(const PredictOptions& o) {
-  RegisterInputs({}, &o.robot);
-  CommandOutputs().AddOutput("--json", o.json.path);
-  CommandOutputs().Check();
-  const RobotParams robot = o.robot.Resolve();
-  const WheelNoise noise{o.k_L, o.k_R};
-  const std::vector<PathSegment> spec = ParsePathSpec(o.path);
-  const std::vector<WheelSegment> path = ToWheelSegments(spec, robot.wheelbase_m);
+/// --path segments a wheel could not travel without overflowing the covariance.
+void CheckWheelTravel(const std::vector<WheelSegment>& path) {
   for (std::size_t i = 0; i < path.size(); ++i) {
     const double longest = std::max(std::abs(path[i].left_m), std::abs(path[i].right_m));
     if (!(longest <= kMaxWheelTravel_m)) {
@@ -149,6 +141,91 @@ int RunPredict(const PredictOptions& o) {
                                        i + 1, longest, kMaxWheelTravel_m));
     }
   }
+}
+
+/// --monte-carlo: the simulated final poses' mean and covariance with their
+/// standard errors, printed unless `--json -`, as the JSON "monte_carlo".
+nlohmann::json MonteCarlo(const PredictOptions& o, const RobotParams& robot, const WheelNoise& noise,
+                          const PoseCovariance& P0, const std::vector<WheelSegment>& path, double theta_shift) {
+  sim::SimulationModel model;
+  model.nominal = robot;
+  model.noise = noise;
+  model.initial_covariance = P0;
+  const sim::SimPlan plan = sim::CompilePlan(model, path, o.partitions);
+  sim::MonteCarloOptions mo;
+  mo.runs = *o.mc_runs;
+  mo.seed = o.seed;
+  mo.threads = o.threads;
+  const sim::MonteCarloSummary mc = [&] {
+    Progress progress(fmt::format("Monte Carlo, {} runs", mo.runs));
+    mo.progress = progress.Callback();
+    return sim::RunMonteCarlo(plan, mo);
+  }();
+  const Pose2 mc_mean{mc.mean.x, mc.mean.y, mc.mean.theta + theta_shift};
+  const MonteCarloErrors se = StandardErrors(mc.covariance, mc.runs);
+  nlohmann::json out = {{"mean", {mc_mean.x, mc_mean.y, mc_mean.theta}},
+                        {"covariance", JsonMatrix(mc.covariance)},
+                        {"mean_se", {se.mean(0), se.mean(1), se.mean(2)}},
+                        {"covariance_se", JsonMatrix(se.covariance)},
+                        {"runs", mc.runs},
+                        {"partitions", o.partitions},
+                        {"seed", mc.seed},
+                        {"threads", mc.threads},
+                        {"steps", mc.runs * mc.steps_per_run},
+                        {"seconds", mc.seconds},
+                        {"steps_per_second", mc.steps_per_second},
+                        {"kernel", mc.kernel}};
+  if (o.json.PrintText()) {
+    fmt::print("\n");
+    PrintCovariance(fmt::format("Monte Carlo ({} runs x {} partitions per segment, seed {}):", mc.runs,
+                                o.partitions, mc.seed)
+                        .c_str(),
+                    mc_mean, mc.covariance);
+    fmt::print("  standard error of the mean  x {:.3g} m, y {:.3g} m, theta {:.3g} rad\n", se.mean(0), se.mean(1),
+               se.mean(2));
+    fmt::print("  standard error of the covariance (Gaussian approximation) [m, m, rad]:\n");
+    for (int i = 0; i < 3; ++i)
+      fmt::print("    {:>14.6e} {:>14.6e} {:>14.6e}\n", se.covariance(i, 0), se.covariance(i, 1), se.covariance(i, 2));
+    fmt::print("  {:.3e} wheel steps per second ({} threads, {} kernel, {:.3f} s)\n", mc.steps_per_second,
+               mc.threads, mc.kernel, mc.seconds);
+  }
+  return out;
+}
+
+/// Degenerate requests: a result, but one that says little (no motion, no
+/// noise, too few Monte Carlo runs).
+std::vector<std::string> DegenerateRequestWarnings(const PredictOptions& o, const std::vector<WheelSegment>& path,
+                                                   const PoseCovariance& P0) {
+  std::vector<std::string> warnings;
+  const bool moves = std::any_of(path.begin(), path.end(), [](const WheelSegment& w) {
+    return w.left_m != 0.0 || w.right_m != 0.0;
+  });
+  if (!moves) warnings.push_back("the path does not move (every segment has zero wheel travel): the prediction is P0");
+  if (o.k_L == 0.0 && o.k_R == 0.0) {
+    warnings.push_back(P0.isZero() ? "no noise at all (k_L = k_R = 0 and P0 = 0): the covariance is zero; take k_L, "
+                                     "k_R from `umbmark fit-noise`"
+                                   : "no wheel noise (k_L = k_R = 0): the covariance is P0 carried along the path; "
+                                     "take k_L, k_R from `umbmark fit-noise`");
+  }
+  if (o.mc_runs && *o.mc_runs < kFewMonteCarloRuns) {
+    warnings.push_back(fmt::format("Monte Carlo with {} runs: its covariance has a relative standard error of about "
+                                   "sqrt(2/N) = {:.0f} % (see covariance_se); use {} runs or more",
+                                   *o.mc_runs, 100.0 * std::sqrt(2.0 / static_cast<double>(*o.mc_runs)),
+                                   kFewMonteCarloRuns));
+  }
+  return warnings;
+}
+
+// Closed form, optional Monte Carlo, gate and output, in order.
+int RunPredict(const PredictOptions& o) {
+  RegisterInputs({}, &o.robot);
+  CommandOutputs().AddOutput("--json", o.json.path);
+  CommandOutputs().Check();
+  const RobotParams robot = o.robot.Resolve();
+  const WheelNoise noise{o.k_L, o.k_R};
+  const std::vector<PathSegment> spec = ParsePathSpec(o.path);
+  const std::vector<WheelSegment> path = ToWheelSegments(spec, robot.wheelbase_m);
+  CheckWheelTravel(path);
   const PoseCovariance P0 = ParseP0(o.p0);
   if (o.mc_runs) CheckMonteCarloSize(*o.mc_runs, o.partitions, path.size());
   const PathCovarianceSummary pred = PredictPathCovariance(path, robot.wheelbase_m, noise, P0);
@@ -184,50 +261,7 @@ int RunPredict(const PredictOptions& o) {
     PrintCovariance("With the second-order heading term (track shortening):", mean2, cov2);
   }
 
-  if (o.mc_runs) {
-    sim::SimulationModel model;
-    model.nominal = robot;
-    model.noise = noise;
-    model.initial_covariance = P0;
-    const sim::SimPlan plan = sim::CompilePlan(model, path, o.partitions);
-    sim::MonteCarloOptions mo;
-    mo.runs = *o.mc_runs;
-    mo.seed = o.seed;
-    mo.threads = o.threads;
-    const sim::MonteCarloSummary mc = [&] {
-      Progress progress(fmt::format("Monte Carlo, {} runs", mo.runs));
-      mo.progress = progress.Callback();
-      return sim::RunMonteCarlo(plan, mo);
-    }();
-    const Pose2 mc_mean{mc.mean.x, mc.mean.y, mc.mean.theta + theta_shift};
-    const MonteCarloErrors se = StandardErrors(mc.covariance, mc.runs);
-    j["monte_carlo"] = {{"mean", {mc_mean.x, mc_mean.y, mc_mean.theta}},
-                        {"covariance", JsonMatrix(mc.covariance)},
-                        {"mean_se", {se.mean(0), se.mean(1), se.mean(2)}},
-                        {"covariance_se", JsonMatrix(se.covariance)},
-                        {"runs", mc.runs},
-                        {"partitions", o.partitions},
-                        {"seed", mc.seed},
-                        {"threads", mc.threads},
-                        {"steps", mc.runs * mc.steps_per_run},
-                        {"seconds", mc.seconds},
-                        {"steps_per_second", mc.steps_per_second},
-                        {"kernel", mc.kernel}};
-    if (o.json.PrintText()) {
-      fmt::print("\n");
-      PrintCovariance(fmt::format("Monte Carlo ({} runs x {} partitions per segment, seed {}):", mc.runs,
-                                  o.partitions, mc.seed)
-                          .c_str(),
-                      mc_mean, mc.covariance);
-      fmt::print("  standard error of the mean  x {:.3g} m, y {:.3g} m, theta {:.3g} rad\n", se.mean(0), se.mean(1),
-                 se.mean(2));
-      fmt::print("  standard error of the covariance (Gaussian approximation) [m, m, rad]:\n");
-      for (int i = 0; i < 3; ++i)
-        fmt::print("    {:>14.6e} {:>14.6e} {:>14.6e}\n", se.covariance(i, 0), se.covariance(i, 1), se.covariance(i, 2));
-      fmt::print("  {:.3e} wheel steps per second ({} threads, {} kernel, {:.3f} s)\n", mc.steps_per_second,
-                 mc.threads, mc.kernel, mc.seconds);
-    }
-  }
+  if (o.mc_runs) j["monte_carlo"] = MonteCarlo(o, robot, noise, P0, path, theta_shift);
   // Gate: never print or write a number that is not one.
   const bool finite = std::isfinite(mean.x) && std::isfinite(mean.y) && std::isfinite(mean.theta) &&
                       pred.covariance.allFinite() && cov2.allFinite();
@@ -235,24 +269,7 @@ int RunPredict(const PredictOptions& o) {
     throw QualityGateError("the predicted mean or covariance is not finite (a path or noise constant too large for "
                            "double precision); shorten the path or check --kl/--kr");
   }
-  // Degenerate requests: a result, but one that says little.
-  std::vector<std::string> warnings;
-  const bool moves = std::any_of(path.begin(), path.end(), [](const WheelSegment& w) {
-    return w.left_m != 0.0 || w.right_m != 0.0;
-  });
-  if (!moves) warnings.push_back("the path does not move (every segment has zero wheel travel): the prediction is P0");
-  if (o.k_L == 0.0 && o.k_R == 0.0) {
-    warnings.push_back(P0.isZero() ? "no noise at all (k_L = k_R = 0 and P0 = 0): the covariance is zero; take k_L, "
-                                     "k_R from `umbmark fit-noise`"
-                                   : "no wheel noise (k_L = k_R = 0): the covariance is P0 carried along the path; "
-                                     "take k_L, k_R from `umbmark fit-noise`");
-  }
-  if (o.mc_runs && *o.mc_runs < kFewMonteCarloRuns) {
-    warnings.push_back(fmt::format("Monte Carlo with {} runs: its covariance has a relative standard error of about "
-                                   "sqrt(2/N) = {:.0f} % (see covariance_se); use {} runs or more",
-                                   *o.mc_runs, 100.0 * std::sqrt(2.0 / static_cast<double>(*o.mc_runs)),
-                                   kFewMonteCarloRuns));
-  }
+  const std::vector<std::string> warnings = DegenerateRequestWarnings(o, path, P0);
   j["warnings"] = warnings;
   if (o.json.PrintText()) {
     for (const auto& w : warnings) fmt::print("  WARNING: {}\n", w);

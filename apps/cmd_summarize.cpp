@@ -129,8 +129,112 @@ std::string FleetPlot(const std::vector<Robot>& robots, const FleetSummary& s, d
   return io::SvgDocument(880, p.Bottom() + 10, {p.Render()});
 }
 
-// ~120 lines: read the fleet, summarise, then text, CSV, JSON and report in
-// turn. Splitting the outputs into helpers is follow-up work (issue 11).
+/// The JSON of the fleet summary.
+nlohmann::json FleetJson(const SummarizeOptions& o, const std::vector<Robot>& robots, const FleetSummary& s,
+                         std::size_t n_out, const std::vector<std::string>& warnings) {
+  nlohmann::json j;
+  j["robots"] = nlohmann::json::array();
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    nlohmann::json z = nlohmann::json::object();
+    for (const auto& [q, v] : s.robots[i].z) z[FleetQuantityKey(q)] = v;
+    j["robots"].push_back({{"file", robots[i].fleet.file},
+                           {"parameters", robots[i].parameters},
+                           {"parameters_from", robots[i].source},
+                           {"robust_z", z},
+                           {"outlier", s.robots[i].outlier},
+                           {"outlier_reasons", s.robots[i].reasons}});
+  }
+  j["fleet"] = nlohmann::json::object();
+  for (const auto& [q, st] : s.fleet)
+    j["fleet"][FleetQuantityKey(q)] = {{"n", st.n}, {"median", st.median}, {"mad", st.mad}, {"spread_used", st.spread}};
+  j["threshold"] = o.fleet.threshold;
+  j["outliers"] = n_out;
+  j["warnings"] = warnings;
+
+  return j;
+}
+
+/// The text summary: the fleet's quantities, then every robot.
+void PrintFleet(const SummarizeOptions& o, const std::vector<Robot>& robots, const FleetSummary& s, std::size_t n_out,
+                const std::vector<std::string>& warnings) {
+  fmt::print("Fleet summary: {} robots from {} file(s), {} outlier(s) (robust |z| > {})\n", robots.size(),
+             o.inputs.size(), n_out, o.fleet.threshold);
+  fmt::print("  {:<24} {:>4} {:>16} {:>16}\n", "quantity", "n", "median", "robust SD (MAD)");
+  for (const auto& [q, st] : s.fleet)
+    fmt::print("  {:<24} {:>4} {:>16} {:>16}\n", FleetQuantityKey(q), st.n, Fmt(st.median, q), Fmt(st.mad, q));
+  fmt::print("  {:<40} {:>12} {:>12} {:>12}  {}\n", "robot", "wheelbase_m", "D_left_m", "D_right_m", "outlier");
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    const auto& p = robots[i].parameters;
+    fmt::print("  {:<40} {:>12.6f} {:>12.6f} {:>12.6f}  {}\n", robots[i].fleet.file, p["wheelbase_m"].get<double>(),
+               p["wheel_diameter_left_m"].get<double>(), p["wheel_diameter_right_m"].get<double>(),
+               s.robots[i].outlier ? "OUTLIER" : "-");
+    for (const auto& reason : s.robots[i].reasons) fmt::print("      {}\n", reason);
+  }
+  for (const auto& w : warnings) fmt::print("warning: {}\n", w);
+}
+
+/// --csv: one row per robot.
+std::string FleetCsv(const std::vector<Robot>& robots, const FleetSummary& s) {
+  std::string csv = "file,wheelbase_m,wheel_diameter_left_m,wheel_diameter_right_m,E_d,E_b,E_max_syst_m,residual_after_m,outlier,reasons\n";
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    std::string row = io::CsvField(robots[i].fleet.file);
+    for (FleetQuantity q : kFleetQuantities) {
+      const auto it = robots[i].fleet.values.find(q);
+      row += it == robots[i].fleet.values.end() ? "," : fmt::format(",{:.9g}", it->second);
+    }
+    std::string reasons;
+    for (const auto& r : s.robots[i].reasons) reasons += (reasons.empty() ? "" : "; ") + r;
+    row += fmt::format(",{},{}\n", s.robots[i].outlier ? "true" : "false", io::CsvField(reasons));
+    csv += row;
+  }
+  return csv;
+}
+
+/// --report: the fleet page.
+std::string FleetReportHtml(const SummarizeOptions& o, const std::vector<Robot>& robots, const FleetSummary& s,
+                            std::size_t n_out, const std::vector<std::string>& warnings) {
+  io::HtmlReport rep("umbmark summarize: fleet of " + std::to_string(robots.size()) + " robots",
+                     fmt::format("{} calibration file(s)", o.inputs.size()));
+  if (n_out == 0)
+    rep.Headline(fmt::format("No robot stands out of the fleet of {} (robust |z| <= {} in every quantity).",
+                             robots.size(), o.fleet.threshold),
+                 io::HtmlReport::Level::kGood);
+  else
+    rep.Headline(fmt::format("{} of {} robots stand out of the fleet (robust |z| > {}).", n_out, robots.size(),
+                             o.fleet.threshold),
+                 io::HtmlReport::Level::kWarn);
+  std::vector<std::string> steps;
+  if (n_out > 0) {
+    steps.push_back("Inspect the flagged robots for the reason given (wheel wear, wheel mounting, tyre pressure).");
+    steps.push_back("Recalibrate a flagged robot after the repair and summarize again.");
+  } else {
+    steps.push_back("Load each robot's corrected parameters (its calibrate JSON, or the --ros2 snippet).");
+  }
+  rep.NextSteps(steps);
+  rep.Warnings(warnings);
+  rep.Heading("Fleet distribution");
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& [q, st] : s.fleet)
+    rows.push_back({FleetQuantityKey(q), std::to_string(st.n), Fmt(st.median, q), Fmt(st.mad, q)});
+  rep.Table({"quantity", "robots", "median", "robust SD (1.4826 MAD)"}, rows);
+  rep.Heading("Robots");
+  rows.clear();
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    const auto& p = robots[i].parameters;
+    std::string reasons;
+    for (const auto& r : s.robots[i].reasons) reasons += (reasons.empty() ? "" : " | ") + r;
+    rows.push_back({robots[i].fleet.file, fmt::format("{:.6f}", p["wheelbase_m"].get<double>()),
+                    fmt::format("{:.6f}", p["wheel_diameter_left_m"].get<double>()),
+                    fmt::format("{:.6f}", p["wheel_diameter_right_m"].get<double>()),
+                    s.robots[i].outlier ? "OUTLIER" : "-", reasons});
+  }
+  rep.Table({"robot (file)", "wheelbase [m]", "D left [m]", "D right [m]", "outlier", "why"}, rows);
+  rep.Figure(FleetPlot(robots, s, o.fleet.threshold),
+             "Each robot's robust z-score per quantity; the grey band is the outlier threshold. Triangles: outliers.");
+  return rep.Render();
+}
+
+// Read the fleet, summarise, then text, CSV, report and JSON in turn.
 int RunSummarize(const SummarizeOptions& o) {
   if (auto e = o.fleet.Check(); !e.empty()) throw InvalidOptions("summarize: " + e);
   // Output safety: no output may be an input or another output.
@@ -153,103 +257,18 @@ int RunSummarize(const SummarizeOptions& o) {
   std::size_t n_out = 0;
   for (const auto& r : s.robots) n_out += r.outlier ? 1 : 0;
 
-  nlohmann::json j;
-  j["robots"] = nlohmann::json::array();
-  for (std::size_t i = 0; i < robots.size(); ++i) {
-    nlohmann::json z = nlohmann::json::object();
-    for (const auto& [q, v] : s.robots[i].z) z[FleetQuantityKey(q)] = v;
-    j["robots"].push_back({{"file", robots[i].fleet.file},
-                           {"parameters", robots[i].parameters},
-                           {"parameters_from", robots[i].source},
-                           {"robust_z", z},
-                           {"outlier", s.robots[i].outlier},
-                           {"outlier_reasons", s.robots[i].reasons}});
-  }
-  j["fleet"] = nlohmann::json::object();
-  for (const auto& [q, st] : s.fleet)
-    j["fleet"][FleetQuantityKey(q)] = {{"n", st.n}, {"median", st.median}, {"mad", st.mad}, {"spread_used", st.spread}};
-  j["threshold"] = o.fleet.threshold;
-  j["outliers"] = n_out;
-  j["warnings"] = warnings;
-
+  const nlohmann::json j = FleetJson(o, robots, s, n_out, warnings);
   std::vector<std::string> written;
-  if (o.json.PrintText()) {
-    fmt::print("Fleet summary: {} robots from {} file(s), {} outlier(s) (robust |z| > {})\n", robots.size(),
-               o.inputs.size(), n_out, o.fleet.threshold);
-    fmt::print("  {:<24} {:>4} {:>16} {:>16}\n", "quantity", "n", "median", "robust SD (MAD)");
-    for (const auto& [q, st] : s.fleet)
-      fmt::print("  {:<24} {:>4} {:>16} {:>16}\n", FleetQuantityKey(q), st.n, Fmt(st.median, q), Fmt(st.mad, q));
-    fmt::print("  {:<40} {:>12} {:>12} {:>12}  {}\n", "robot", "wheelbase_m", "D_left_m", "D_right_m", "outlier");
-    for (std::size_t i = 0; i < robots.size(); ++i) {
-      const auto& p = robots[i].parameters;
-      fmt::print("  {:<40} {:>12.6f} {:>12.6f} {:>12.6f}  {}\n", robots[i].fleet.file, p["wheelbase_m"].get<double>(),
-                 p["wheel_diameter_left_m"].get<double>(), p["wheel_diameter_right_m"].get<double>(),
-                 s.robots[i].outlier ? "OUTLIER" : "-");
-      for (const auto& reason : s.robots[i].reasons) fmt::print("      {}\n", reason);
-    }
-    for (const auto& w : warnings) fmt::print("warning: {}\n", w);
-  }
+  if (o.json.PrintText()) PrintFleet(o, robots, s, n_out, warnings);
   if (!o.csv.empty()) {
-    std::string csv = "file,wheelbase_m,wheel_diameter_left_m,wheel_diameter_right_m,E_d,E_b,E_max_syst_m,residual_after_m,outlier,reasons\n";
-    for (std::size_t i = 0; i < robots.size(); ++i) {
-      std::string row = io::CsvField(robots[i].fleet.file);
-      for (FleetQuantity q : kFleetQuantities) {
-        const auto it = robots[i].fleet.values.find(q);
-        row += it == robots[i].fleet.values.end() ? "," : fmt::format(",{:.9g}", it->second);
-      }
-      std::string reasons;
-      for (const auto& r : s.robots[i].reasons) reasons += (reasons.empty() ? "" : "; ") + r;
-      row += fmt::format(",{},{}\n", s.robots[i].outlier ? "true" : "false", io::CsvField(reasons));
-      csv += row;
-    }
-    outs.Write(o.csv, csv);
+    outs.Write(o.csv, FleetCsv(robots, s));
     written.push_back(o.csv + " (CSV, one row per robot)");
   }
   if (!o.report.empty()) {
-    io::HtmlReport rep("umbmark summarize: fleet of " + std::to_string(robots.size()) + " robots",
-                       fmt::format("{} calibration file(s)", o.inputs.size()));
-    if (n_out == 0)
-      rep.Headline(fmt::format("No robot stands out of the fleet of {} (robust |z| <= {} in every quantity).",
-                               robots.size(), o.fleet.threshold),
-                   io::HtmlReport::Level::kGood);
-    else
-      rep.Headline(fmt::format("{} of {} robots stand out of the fleet (robust |z| > {}).", n_out, robots.size(),
-                               o.fleet.threshold),
-                   io::HtmlReport::Level::kWarn);
-    std::vector<std::string> steps;
-    if (n_out > 0) {
-      steps.push_back("Inspect the flagged robots for the reason given (wheel wear, wheel mounting, tyre pressure).");
-      steps.push_back("Recalibrate a flagged robot after the repair and summarize again.");
-    } else {
-      steps.push_back("Load each robot's corrected parameters (its calibrate JSON, or the --ros2 snippet).");
-    }
-    rep.NextSteps(steps);
-    rep.Warnings(warnings);
-    rep.Heading("Fleet distribution");
-    std::vector<std::vector<std::string>> rows;
-    for (const auto& [q, st] : s.fleet)
-      rows.push_back({FleetQuantityKey(q), std::to_string(st.n), Fmt(st.median, q), Fmt(st.mad, q)});
-    rep.Table({"quantity", "robots", "median", "robust SD (1.4826 MAD)"}, rows);
-    rep.Heading("Robots");
-    rows.clear();
-    for (std::size_t i = 0; i < robots.size(); ++i) {
-      const auto& p = robots[i].parameters;
-      std::string reasons;
-      for (const auto& r : s.robots[i].reasons) reasons += (reasons.empty() ? "" : " | ") + r;
-      rows.push_back({robots[i].fleet.file, fmt::format("{:.6f}", p["wheelbase_m"].get<double>()),
-                      fmt::format("{:.6f}", p["wheel_diameter_left_m"].get<double>()),
-                      fmt::format("{:.6f}", p["wheel_diameter_right_m"].get<double>()),
-                      s.robots[i].outlier ? "OUTLIER" : "-", reasons});
-    }
-    rep.Table({"robot (file)", "wheelbase [m]", "D left [m]", "D right [m]", "outlier", "why"}, rows);
-    rep.Figure(FleetPlot(robots, s, o.fleet.threshold),
-               "Each robot's robust z-score per quantity; the grey band is the outlier threshold. Triangles: outliers.");
-    outs.Write(o.report, rep.Render());
+    outs.Write(o.report, FleetReportHtml(o, robots, s, n_out, warnings));
     written.push_back(o.report + " (HTML report)");
   }
-  o.json.Emit(j);
-  if (!o.json.path.empty() && !o.json.ToStdout()) written.push_back(o.json.path + " (JSON)");
-  PrintWritten(written, o.json.PrintText());
+  o.json.EmitAndListOutputs(j, written);
   return 0;
 }
 

@@ -65,6 +65,12 @@ void JsonFlag::Emit(const nlohmann::json& j) const {
   CommandOutputs().Write(path, DumpJson(out) + "\n");
 }
 
+void JsonFlag::EmitAndListOutputs(const nlohmann::json& j, std::vector<std::string> written) const {
+  Emit(j);
+  if (!path.empty() && !ToStdout()) written.push_back(path + " (JSON)");
+  PrintWritten(written, PrintText());
+}
+
 namespace {
 /// The number in `v` when all of it is one (finite), else nullopt.
 std::optional<double> WholeNumber(const std::string& v) {

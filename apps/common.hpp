@@ -44,6 +44,10 @@ struct JsonFlag {
   /// `j` is an object without one (the contract: every command's JSON has
   /// it); invalid UTF-8 in strings is escaped (see DumpJson).
   void Emit(const nlohmann::json& j) const;
+  /// The tail of every command that writes files: Emit(j), then "wrote
+  /// FILE (what)" for each of `written` and for the JSON file
+  /// (PrintWritten; on stderr with `--json -`).
+  void EmitAndListOutputs(const nlohmann::json& j, std::vector<std::string> written) const;
 };
 
 /// Validator for a number in [lo, hi]; the message quotes the value as the

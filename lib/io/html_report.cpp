@@ -5,50 +5,34 @@
 
 namespace umbmark::io {
 
-std::string HtmlEscape(const std::string& s) {
-  std::string out;
-  out.reserve(s.size());
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
 HtmlReport::HtmlReport(std::string title, std::string subject) : title_(std::move(title)), subject_(std::move(subject)) {}
 
 void HtmlReport::Headline(const std::string& text, Level level) {
   const char* cls = level == Level::kGood ? "good" : level == Level::kWarn ? "warn" : level == Level::kBad ? "bad" : "info";
   const char* word = level == Level::kGood ? "Result" : level == Level::kWarn ? "Attention" : level == Level::kBad ? "Problem" : "Result";
-  body_ += fmt::format("<section class=\"headline {}\"><strong>{}:</strong> {}</section>\n", cls, word, HtmlEscape(text));
+  body_ += fmt::format("<section class=\"headline {}\"><strong>{}:</strong> {}</section>\n", cls, word, XmlEscape(text));
 }
 
 void HtmlReport::NextSteps(const std::vector<std::string>& steps) {
   if (steps.empty()) return;
   body_ += "<section class=\"next\"><h2>What to do next</h2><ol>\n";
-  for (const auto& s : steps) body_ += fmt::format("<li>{}</li>\n", HtmlEscape(s));
+  for (const auto& s : steps) body_ += fmt::format("<li>{}</li>\n", XmlEscape(s));
   body_ += "</ol></section>\n";
 }
 
-void HtmlReport::Heading(const std::string& text) { body_ += fmt::format("<h2>{}</h2>\n", HtmlEscape(text)); }
+void HtmlReport::Heading(const std::string& text) { body_ += fmt::format("<h2>{}</h2>\n", XmlEscape(text)); }
 
-void HtmlReport::Paragraph(const std::string& text) { body_ += fmt::format("<p>{}</p>\n", HtmlEscape(text)); }
+void HtmlReport::Paragraph(const std::string& text) { body_ += fmt::format("<p>{}</p>\n", XmlEscape(text)); }
 
 void HtmlReport::Table(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows,
                        std::size_t numeric_from) {
   body_ += "<table class=\"numbers\"><thead><tr>";
-  for (const auto& h : header) body_ += fmt::format("<th>{}</th>", HtmlEscape(h));
+  for (const auto& h : header) body_ += fmt::format("<th>{}</th>", XmlEscape(h));
   body_ += "</tr></thead><tbody>\n";
   for (const auto& row : rows) {
     body_ += "<tr>";
     for (std::size_t c = 0; c < row.size(); ++c)
-      body_ += fmt::format("<td{}>{}</td>", c >= numeric_from ? " class=\"num\"" : "", HtmlEscape(row[c]));
+      body_ += fmt::format("<td{}>{}</td>", c >= numeric_from ? " class=\"num\"" : "", XmlEscape(row[c]));
     body_ += "</tr>\n";
   }
   body_ += "</tbody></table>\n";
@@ -57,12 +41,12 @@ void HtmlReport::Table(const std::vector<std::string>& header, const std::vector
 void HtmlReport::Warnings(const std::vector<std::string>& warnings) {
   if (warnings.empty()) return;
   body_ += "<section class=\"warnings\"><h2>Warnings</h2><ul>\n";
-  for (const auto& w : warnings) body_ += fmt::format("<li>{}</li>\n", HtmlEscape(w));
+  for (const auto& w : warnings) body_ += fmt::format("<li>{}</li>\n", XmlEscape(w));
   body_ += "</ul></section>\n";
 }
 
 void HtmlReport::Figure(const std::string& svg, const std::string& caption) {
-  body_ += fmt::format("<figure class=\"plot\">\n{}<figcaption>{}</figcaption></figure>\n", svg, HtmlEscape(caption));
+  body_ += fmt::format("<figure class=\"plot\">\n{}<figcaption>{}</figcaption></figure>\n", svg, XmlEscape(caption));
 }
 
 std::string HtmlReport::Render() const {
@@ -87,7 +71,7 @@ footer { color: #666; font-size: 0.85em; margin-top: 2em; }
       "<style>{2}</style>\n</head>\n<body>\n<h1>{0}</h1>\n<p class=\"subject\">{1}</p>\n{3}"
       "<footer>Written by umbmark. Units: SI unless a column says otherwise (mm, deg). Formats and keys: "
       "docs/formats.md.</footer>\n</body>\n</html>\n",
-      HtmlEscape(title_), HtmlEscape(subject_), kCss, body_);
+      XmlEscape(title_), XmlEscape(subject_), kCss, body_);
 }
 
 }  // namespace umbmark::io

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "io/xml_escape.hpp"
+
 namespace umbmark::io {
 
 class HtmlReport {
@@ -37,7 +39,7 @@ class HtmlReport {
   std::string body_;
 };
 
-/// Escapes &, <, >, quotes for HTML text and attributes.
-std::string HtmlEscape(const std::string& s);
+/// Escapes &, <, >, quotes for HTML text and attributes (XmlEscape).
+inline std::string HtmlEscape(const std::string& s) { return XmlEscape(s); }
 
 }  // namespace umbmark::io

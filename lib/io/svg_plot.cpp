@@ -9,20 +9,6 @@
 
 namespace umbmark::io {
 
-std::string SvgEscape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
 namespace {
 std::string DashAttr(const std::string& dash) {
   return dash.empty() ? "" : fmt::format(R"svg( stroke-dasharray="{}")svg", dash);
@@ -120,7 +106,7 @@ void SvgPanel::Points(const std::vector<SvgPoint>& pts, const SvgStyle& style, d
   SvgStyle st = style;
   if (st.marker.empty()) st.marker = "circle";
   body_ += fmt::format(R"svg(<g class="series points" data-n="{}"{}>)svg", pts.size(),
-                       name.empty() ? std::string() : fmt::format(R"svg( data-name="{}")svg", SvgEscape(name)));
+                       name.empty() ? std::string() : fmt::format(R"svg( data-name="{}")svg", XmlEscape(name)));
   for (const auto& p : pts) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
     body_ += Marker(Px(p.x), Py(p.y), st, r);
@@ -179,7 +165,7 @@ void SvgPanel::VLine(double x, const SvgStyle& st) { Polyline({{x, ymin_}, {x, y
 
 void SvgPanel::Text(SvgPoint at, const std::string& text, const std::string& color, double size) {
   body_ += fmt::format(R"svg(<text x="{:.1f}" y="{:.1f}" font-size="{}" fill="{}">{}</text>)svg", Px(at.x), Py(at.y),
-                       size, color, SvgEscape(text));
+                       size, color, XmlEscape(text));
   body_ += "\n";
 }
 
@@ -205,11 +191,11 @@ void SvgPanel::Axes(const std::string& xlabel, const std::string& ylabel) {
         y, left_ - 5, left_, left_ - 8, v, y + 4, TickLabel(v, ystep));
   }
   frame_ += fmt::format(R"svg(<text class="axis-label x" x="{:.1f}" y="{:.1f}" font-size="12" text-anchor="middle" fill="#111">{}</text>)svg",
-                        left_ + width_ / 2, bottom + 34, SvgEscape(xlabel));
+                        left_ + width_ / 2, bottom + 34, XmlEscape(xlabel));
   const double ly = top_ + height_ / 2, lx = left_ - 46;
   frame_ += fmt::format(
       R"svg(<text class="axis-label y" x="{0:.1f}" y="{1:.1f}" font-size="12" text-anchor="middle" fill="#111" transform="rotate(-90 {0:.1f} {1:.1f})">{2}</text>)svg",
-      lx, ly, SvgEscape(ylabel));
+      lx, ly, XmlEscape(ylabel));
   frame_ += "\n";
   bottom_ = std::max(bottom_, bottom + 40);
 }
@@ -218,13 +204,13 @@ void SvgPanel::Legend(const std::vector<std::pair<SvgStyle, std::string>>& entri
   double y = bottom_ + 6;
   for (const auto& [st, label] : entries) {
     const double x = left_;
-    frame_ += fmt::format(R"svg(<g class="legend-entry" data-label="{}">)svg", SvgEscape(label));
+    frame_ += fmt::format(R"svg(<g class="legend-entry" data-label="{}">)svg", XmlEscape(label));
     if (st.marker.empty() || !st.dash.empty() || st.marker == "line")
       frame_ += fmt::format(R"svg(<line x1="{:.1f}" y1="{:.1f}" x2="{:.1f}" y2="{:.1f}" stroke="{}" stroke-width="{}"{}/>)svg",
                             x, y, x + 28, y, st.color, std::max(st.line_width, 1.5), DashAttr(st.dash));
     if (!st.marker.empty() && st.marker != "line") frame_ += Marker(x + 14, y, st, 4.0);
     frame_ += fmt::format(R"svg(<text x="{:.1f}" y="{:.1f}" font-size="11" fill="#222">{}</text></g>)svg", x + 36, y + 4,
-                          SvgEscape(label));
+                          XmlEscape(label));
     frame_ += "\n";
     y += 16;
   }
@@ -236,7 +222,7 @@ std::string SvgPanel::Render() const {
       R"svg(<g class="panel" data-title="{6}"><rect x="{0:.1f}" y="{1:.1f}" width="{2:.1f}" height="{3:.1f}" fill="white" stroke="none"/>)svg"
       R"svg(<text class="panel-title" x="{0:.1f}" y="{4:.1f}" font-size="13" font-weight="bold" fill="#111">{5}</text>)svg"
       "\n",
-      left_, top_, width_, height_, top_ - 8, SvgEscape(title_), SvgEscape(title_));
+      left_, top_, width_, height_, top_ - 8, XmlEscape(title_), XmlEscape(title_));
   out += grid_;
   out += fmt::format(R"svg(<svg x="{:.1f}" y="{:.1f}" width="{:.1f}" height="{:.1f}" viewBox="{:.1f} {:.1f} {:.1f} {:.1f}" overflow="hidden">)svg",
                      left_, top_, width_, height_, left_, top_, width_, height_);
@@ -263,7 +249,7 @@ std::string SvgBarChart(const std::string& title, const std::vector<std::string>
   const double hi = std::max(vmax, ticks.empty() ? vmax : ticks.back());
   auto X = [&](double v) { return left + (v - lo) / (hi - lo) * width; };
   std::string out = fmt::format(R"svg(<g class="panel bars" data-title="{0}"><text class="panel-title" x="10" y="22" font-size="13" font-weight="bold">{0}</text>)svg",
-                                SvgEscape(title));
+                                XmlEscape(title));
   out += "\n";
   const double group_h = bar_h * static_cast<double>(series.size()) + 10;
   const double bottom = top + group_h * static_cast<double>(labels.size());
@@ -276,7 +262,7 @@ std::string SvgBarChart(const std::string& title, const std::vector<std::string>
   for (std::size_t i = 0; i < labels.size(); ++i) {
     const double y0 = top + group_h * static_cast<double>(i);
     out += fmt::format(R"svg(<text x="{:.1f}" y="{:.1f}" font-size="11" text-anchor="end">{}</text>)svg", left - 8,
-                       y0 + bar_h * static_cast<double>(series.size()) / 2 + 4, SvgEscape(labels[i]));
+                       y0 + bar_h * static_cast<double>(series.size()) / 2 + 4, XmlEscape(labels[i]));
     for (std::size_t s = 0; s < series.size(); ++s) {
       const double v = i < series[s].size() ? series[s][i] : 0.0;
       if (!std::isfinite(v)) continue;
@@ -284,7 +270,7 @@ std::string SvgBarChart(const std::string& title, const std::vector<std::string>
       // Series differ by fill pattern as well as colour: solid, hatched, hollow.
       const std::string fill = s % 3 == 0 ? colors[s % colors.size()] : s % 3 == 1 ? "url(#hatch)" : "white";
       out += fmt::format(R"svg(<rect class="bar" data-series="{}" data-value="{:.6g}" x="{:.1f}" y="{:.1f}" width="{:.1f}" height="{:.1f}" fill="{}" stroke="{}"/>)svg",
-                         SvgEscape(series_names[s]), v, x0, y0 + bar_h * static_cast<double>(s), std::max(x1 - x0, 0.5),
+                         XmlEscape(series_names[s]), v, x0, y0 + bar_h * static_cast<double>(s), std::max(x1 - x0, 0.5),
                          bar_h - 2, fill, colors[s % colors.size()]);
       out += fmt::format(R"svg(<text x="{:.1f}" y="{:.1f}" font-size="10">{:.3g}</text>)svg", x1 + 4,
                          y0 + bar_h * static_cast<double>(s) + bar_h - 3, v);
@@ -292,12 +278,12 @@ std::string SvgBarChart(const std::string& title, const std::vector<std::string>
     out += "\n";
   }
   out += fmt::format(R"svg(<text class="axis-label x" x="{:.1f}" y="{:.1f}" font-size="12" text-anchor="middle">{}</text>)svg",
-                     left + width / 2, bottom + 32, SvgEscape(value_label));
+                     left + width / 2, bottom + 32, XmlEscape(value_label));
   double ly = bottom + 50;
   for (std::size_t s = 0; s < series_names.size(); ++s) {
     const std::string fill = s % 3 == 0 ? colors[s % colors.size()] : s % 3 == 1 ? "url(#hatch)" : "white";
     out += fmt::format(R"svg(<g class="legend-entry" data-label="{3}"><rect x="{0:.1f}" y="{1:.1f}" width="14" height="10" fill="{4}" stroke="{2}"/><text x="{5:.1f}" y="{6:.1f}" font-size="11">{3}</text></g>)svg",
-                       left, ly, colors[s % colors.size()], SvgEscape(series_names[s]), fill, left + 20, ly + 9);
+                       left, ly, colors[s % colors.size()], XmlEscape(series_names[s]), fill, left + 20, ly + 9);
     out += "\n";
     ly += 16;
   }

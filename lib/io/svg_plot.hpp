@@ -12,6 +12,8 @@
 #include <utility>
 #include <vector>
 
+#include "io/xml_escape.hpp"
+
 namespace umbmark::io {
 
 struct SvgPoint {
@@ -98,7 +100,7 @@ std::string SvgBarChart(const std::string& title, const std::vector<std::string>
 /// Wraps panels into a document of the given pixel size.
 std::string SvgDocument(double width, double height, const std::vector<std::string>& parts);
 
-/// Escapes &, <, > and quotes for SVG text.
-std::string SvgEscape(const std::string& s);
+/// Escapes &, <, > and quotes for SVG text (XmlEscape).
+inline std::string SvgEscape(const std::string& s) { return XmlEscape(s); }
 
 }  // namespace umbmark::io
