@@ -136,6 +136,58 @@ TrajectoryRun ReadRun(const std::string& path, const std::string& id, const std:
 
 }  // namespace
 
+namespace {
+
+/// The metadata file and the run files (<id>_run-NN.csv, by NN) of a folder.
+struct DatasetFiles {
+  std::string metadata;
+  std::vector<std::pair<int, std::string>> runs;
+};
+
+DatasetFiles ListDatasetFiles(const fs::path& folder, const std::string& dir) {
+  DatasetFiles out;
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() > 13 && name.ends_with("_metadata.csv")) {
+      out.metadata = entry.path().string();
+    } else if (const auto pos = name.rfind("_run-"); pos != std::string::npos && name.ends_with(".csv")) {
+      // <id>_run-NN.csv
+      const std::string digits = name.substr(pos + 5, name.size() - pos - 9);
+      int number = 0;
+      auto [ptr, err] = std::from_chars(digits.data(), digits.data() + digits.size(), number);
+      if (!digits.empty() && err == std::errc() && ptr == digits.data() + digits.size())
+        out.runs.emplace_back(number, entry.path().string());
+    }
+  }
+  if (out.metadata.empty()) throw InputError(dir, "no <id>_metadata.csv in the folder");
+  if (out.runs.empty()) throw InputError(dir, "no <id>_run-NN.csv files in the folder");
+  std::sort(out.runs.begin(), out.runs.end());
+  return out;
+}
+
+/// square, circular, ivanjko or free: as given, else the parent folder's
+/// name when it is one of those, else square when the metadata give a side.
+std::string DatasetCategory(const fs::path& folder, const std::optional<std::string>& category, bool has_side) {
+  if (category) return *category;
+  const std::string parent = folder.parent_path().filename().string();
+  if (parent == "square" || parent == "circular" || parent == "ivanjko" || parent == "free") return parent;
+  return has_side ? "square" : "free";
+}
+
+/// cw or ccw from the ground truth's total rotation (sum of wrapped
+/// increments; theta_gt is unwrapped in these files, either works).
+std::string SquareDirection(const TrajectoryRun& run, const std::string& path) {
+  double total = 0.0;
+  for (std::size_t i = 1; i < run.size(); ++i) total += WrapAngle(run.gt_theta_rad[i] - run.gt_theta_rad[i - 1]);
+  if (std::abs(std::abs(total) - 2.0 * kPi) > kPi / 2.0) {
+    throw InputError(path, fmt::format("ground truth turns {:.1f} deg in total; a square run turns about +-360 deg",
+                                       Rad2Deg(total)));
+  }
+  return total < 0.0 ? "cw" : "ccw";
+}
+
+}  // namespace
+
 OptiOdomDataset ImportOptiOdom(const std::string& dir, const std::optional<std::string>& category) {
   fs::path folder = fs::path(dir).lexically_normal();
   if (folder.filename().empty()) folder = folder.parent_path();  // "DIR/" -> "DIR"
@@ -143,25 +195,8 @@ OptiOdomDataset ImportOptiOdom(const std::string& dir, const std::optional<std::
   if (!fs::is_directory(folder, ec)) throw InputError(dir, "not a directory");
   OptiOdomDataset ds;
   ds.id = folder.filename().string();
-
-  std::string meta_path;
-  std::vector<std::pair<int, std::string>> run_files;
-  for (const auto& entry : fs::directory_iterator(folder)) {
-    const std::string name = entry.path().filename().string();
-    if (name.size() > 13 && name.ends_with("_metadata.csv")) {
-      meta_path = entry.path().string();
-    } else if (const auto pos = name.rfind("_run-"); pos != std::string::npos && name.ends_with(".csv")) {
-      // <id>_run-NN.csv
-      const std::string digits = name.substr(pos + 5, name.size() - pos - 9);
-      int number = 0;
-      auto [ptr, err] = std::from_chars(digits.data(), digits.data() + digits.size(), number);
-      if (!digits.empty() && err == std::errc() && ptr == digits.data() + digits.size())
-        run_files.emplace_back(number, entry.path().string());
-    }
-  }
-  if (meta_path.empty()) throw InputError(dir, "no <id>_metadata.csv in the folder");
-  if (run_files.empty()) throw InputError(dir, "no <id>_run-NN.csv files in the folder");
-  std::sort(run_files.begin(), run_files.end());
+  const DatasetFiles files = ListDatasetFiles(folder, dir);
+  const std::string& meta_path = files.metadata;
 
   const auto meta = ReadMetadata(meta_path);
   auto number = [&](const std::string& key, std::size_t idx) {
@@ -179,41 +214,22 @@ OptiOdomDataset ImportOptiOdom(const std::string& dir, const std::optional<std::
   if (auto it = meta.find("L"); it != meta.end() && !it->second.values.empty()) side = number("L", 0);
   if (auto it = meta.find("N"); it != meta.end() && !it->second.values.empty()) {
     const double n = number("N", 0);
-    if (n != static_cast<double>(run_files.size())) {
+    if (n != static_cast<double>(files.runs.size())) {
       throw InputError(meta_path, it->second.line, it->second.values[0].column,
-                       fmt::format("N = {} but the folder has {} run files", n, run_files.size()));
+                       fmt::format("N = {} but the folder has {} run files", n, files.runs.size()));
     }
   }
 
-  if (category) {
-    ds.category = *category;
-  } else {
-    const std::string parent = folder.parent_path().filename().string();
-    if (parent == "square" || parent == "circular" || parent == "ivanjko" || parent == "free")
-      ds.category = parent;
-    else
-      ds.category = side ? "square" : "free";
-  }
+  ds.category = DatasetCategory(folder, category, side.has_value());
   const bool square = ds.category == "square";
   if (square && !side) throw InputError(meta_path, "square dataset without a side length L");
-
   ds.experiment.kind = square ? ExperimentKind::kSquare : ExperimentKind::kFree;
   ds.experiment.side_m = square ? *side : 0.0;
   ds.experiment.file = "runs.csv";
   ds.runs.path = (folder / "runs.csv").string();
-  for (const auto& [num, path] : run_files) {
+  for (const auto& [num, path] : files.runs) {
     TrajectoryRun run = ReadRun(path, std::to_string(num), ds.category);
-    if (square) {
-      // Direction from the ground-truth total rotation (sum of wrapped
-      // increments; theta_gt is unwrapped in these files, either works).
-      double total = 0.0;
-      for (std::size_t i = 1; i < run.size(); ++i) total += WrapAngle(run.gt_theta_rad[i] - run.gt_theta_rad[i - 1]);
-      if (std::abs(std::abs(total) - 2.0 * kPi) > kPi / 2.0) {
-        throw InputError(path, fmt::format("ground truth turns {:.1f} deg in total; a square run turns about +-360 deg",
-                                           Rad2Deg(total)));
-      }
-      run.direction = total < 0.0 ? "cw" : "ccw";
-    }
+    if (square) run.direction = SquareDirection(run, path);
     ds.runs.runs.push_back(std::move(run));
   }
   return ds;
