@@ -211,7 +211,7 @@ nlohmann::json JsonMatrix(const PoseCovariance& P) {
 /// each group (experiment and direction) its observed 95% ellipse (solid)
 /// and the fitted model's (dashed), both about the group's own systematic
 /// mean; for ex-ey, ex-etheta, ey-etheta.
-std::string PlotSvg(const WheelNoiseFitSummary& s, const std::vector<WheelNoiseFitRun>& runs) {
+std::string PlotSvg(const WheelNoiseFitSummary& s) {
   const double scale95 = std::sqrt(-2.0 * std::log(0.05));  // 2-D 95% ellipse: sqrt(chi^2_2(0.95))
   const double unit[3] = {1e3, 1e3, 1e3};                      // mm, mm, mrad
   const char* label[3] = {"e_x [mm]", "e_y [mm]", "e_theta [mrad]"};
@@ -221,9 +221,8 @@ std::string PlotSvg(const WheelNoiseFitSummary& s, const std::vector<WheelNoiseF
   const std::size_t G = s.groups.size();
   // Per group: members, observed covariance of residuals, mean predicted covariance.
   std::vector<std::vector<std::size_t>> members(G);
-  for (std::size_t i = 0; i < runs.size() && i < s.residuals.size(); ++i)
-    for (std::size_t g = 0; g < G; ++g)
-      if (runs[i].group == s.groups[g]) members[g].push_back(i);
+  for (std::size_t i = 0; i < s.group_of_run.size() && i < s.residuals.size(); ++i)
+    members[static_cast<std::size_t>(s.group_of_run[i])].push_back(i);
   std::vector<PoseCovariance> observed(G, PoseCovariance::Zero()), predicted(G, PoseCovariance::Zero());
   for (std::size_t g = 0; g < G; ++g) {
     const double n = static_cast<double>(members[g].size());
@@ -327,7 +326,7 @@ struct FitResult {
 
 /// Step 2: k_L, k_R with the systematic errors estimated jointly (default),
 /// given by --params, or none (a calibrated robot).
-FitResult Fit(const FitNoiseOptions& o, const Loaded& data) {
+FitResult Fit(const FitNoiseOptions& o, Loaded& data) {
   WheelNoiseFitOptions fo;
   fo.restricted = !o.ml;
   fo.sources = data.sources;
@@ -341,6 +340,9 @@ FitResult Fit(const FitNoiseOptions& o, const Loaded& data) {
   Progress progress(fmt::format("fitting k_L, k_R to {} runs", data.runs.size()));
   fo.progress = progress.Callback();
   if (f.source == "estimated") {
+    // The joint fit builds the runs again at three values of E_d: the
+    // first build is not needed any more (memory with 10^6 runs).
+    std::vector<WheelNoiseFitRun>().swap(data.runs);
     SystematicEstimate e;
     f.s = FitWheelNoiseWithSystematics([&](const SystematicErrors& x) { return Load(o, x).runs; }, fo, &e);
     f.estimate = e;
@@ -392,7 +394,7 @@ nlohmann::json ResultJson(const FitNoiseOptions& o, const Loaded& data, const Fi
                    {"z", g.z},
                    {"runs", g.runs}});
   std::map<std::string, int> per_group;
-  for (const auto& r : data.runs) ++per_group[r.group];
+  for (const int g : s.group_of_run) ++per_group[s.groups[static_cast<std::size_t>(g)]];
   nlohmann::json groups = nlohmann::json::array();
   for (std::size_t g = 0; g < s.groups.size(); ++g) {
     groups.push_back({{"group", s.groups[g]},
@@ -490,7 +492,7 @@ std::vector<std::string> WriteOutputs(const FitNoiseOptions& o, const Loaded& da
                                       nlohmann::json& j) {
   std::vector<std::string> written;
   std::string svg;
-  if (!o.plot.empty() || !o.report.empty()) svg = PlotSvg(s, data.runs);
+  if (!o.plot.empty() || !o.report.empty()) svg = PlotSvg(s);
   if (!o.plot.empty()) {
     CommandOutputs().Write(o.plot, svg);
     written.push_back(o.plot + " (plot)");
@@ -537,7 +539,7 @@ int RunFitNoise(const FitNoiseOptions& o) {
   if (!o.params_json.empty() && o.systematic == "estimate" && o.systematic_given)
     throw InvalidOptions("--params and --systematic estimate contradict each other (give one)");
   if (o.ml && o.reml) throw InvalidOptions("--ml and --reml contradict each other (give one)");
-  const Loaded data = Load(o);
+  Loaded data = Load(o);
   if (data.runs.empty()) throw InputError(o.inputs.front(), "no run with ground truth at its start and end");
   if (!o.ros2.empty() && !data.wheelbase_m)
     throw InvalidOptions("--ros2 needs the robot's wheelbase (--robot or --wheelbase)");

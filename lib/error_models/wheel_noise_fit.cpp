@@ -185,6 +185,7 @@ WheelNoiseFitSummary FitWheelNoise(const std::vector<WheelNoiseFitRun>& runs, co
   out.confidence = options.confidence;
   out.runs = static_cast<int>(runs.size());
   out.groups = grp.names;
+  out.group_of_run = grp.of_run;
   if (E_d_sensitivity) {
     out.E_d_offset = best.theta(2);
     const Eigen::Matrix3d Iinv = best.at.information.inverse();

@@ -141,6 +141,7 @@ struct WheelNoiseFitSummary {
   double neg_log_likelihood = 0.0;                 ///< at the optimum (constants dropped)
   int runs = 0;
   std::vector<std::string> groups;                 ///< group names, first-seen order
+  std::vector<int> group_of_run;                   ///< index into `groups` of each run
   std::vector<Eigen::Vector3d> group_means;        ///< fitted systematic means
   std::vector<Eigen::Vector3d> residuals;          ///< e_i - mu_g(i), per run
   std::vector<PoseCovariance> predicted_run_covariance;  ///< S_i at the fit
