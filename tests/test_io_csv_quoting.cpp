@@ -20,16 +20,13 @@
 #include "io/csv_writer.hpp"
 #include "io/endpoint_csv.hpp"
 #include "io/trajectory_csv.hpp"
+#include "support/bits.hpp"
 
 using namespace umbmark;
 
 namespace {
 
-std::uint64_t Bits(double v) {
-  std::uint64_t b = 0;
-  std::memcpy(&b, &v, sizeof b);
-  return b;
-}
+using test::Bits;
 
 // Run ids a user may give (the first one is the case named in issue 11).
 const std::vector<std::string> kIds = {"run 3, \"left\"", "plain", "a\nb", "c\r\nd", " padded\t", "#7", "\"\"", ",",

@@ -14,6 +14,7 @@
 
 #include "core/errors.hpp"
 #include "io/csv_table.hpp"
+#include "support/bits.hpp"
 
 using namespace umbmark;
 using namespace umbmark::io::detail;
@@ -34,11 +35,7 @@ std::string RandomDecimal(std::mt19937_64& rng) {
   return s;
 }
 
-std::uint64_t Bits(double v) {
-  std::uint64_t b = 0;
-  std::memcpy(&b, &v, sizeof b);
-  return b;
-}
+using test::Bits;
 
 }  // namespace
 

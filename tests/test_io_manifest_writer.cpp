@@ -14,16 +14,13 @@
 
 #include "io/campaign_writer.hpp"
 #include "io/manifest.hpp"
+#include "support/bits.hpp"
 
 using namespace umbmark;
 
 namespace {
 
-std::uint64_t Bits(double v) {
-  std::uint64_t b = 0;
-  std::memcpy(&b, &v, sizeof b);
-  return b;
-}
+using test::Bits;
 
 }  // namespace
 

@@ -442,6 +442,16 @@ class CampaignBuilder {
     return r;
   }
 
+  /// Finds the intervals and junctions of `r` (wheel travel, times, motions
+  /// and quantisation set), appends it to the campaign and returns its fold.
+  int AddRun(DiagRun&& r) {
+    AnnotateIntervals(r);
+    FindJunctions(r);
+    const int fold = FoldOf(r.direction);
+    c_.runs.push_back(std::move(r));
+    return fold;
+  }
+
   void AddEndpointRuns(std::size_t e, const EndpointData& ep, ExperimentInfo& info) {
     const Experiment& ex = manifest_.experiments[e];
     if (ex.kind != ExperimentKind::kSquare)
@@ -460,10 +470,7 @@ class CampaignBuilder {
       r.motions = sim::SegmentMotions(r.left, r.right, manifest_.robot.wheelbase_m, mo);
       r.q_sd_left.assign(r.t.size(), 0.0);
       r.q_sd_right.assign(r.t.size(), 0.0);
-      AnnotateIntervals(r);
-      FindJunctions(r);
-      const int fold = FoldOf(r.direction);
-      c_.runs.push_back(std::move(r));
+      const int fold = AddRun(std::move(r));
       const DiagRun& run = c_.runs.back();
       Piece p;
       p.run = static_cast<int>(c_.runs.size()) - 1;
@@ -509,10 +516,7 @@ class CampaignBuilder {
         r.q_sd_left.assign(r.t.size(), 0.0);
         r.q_sd_right.assign(r.t.size(), 0.0);
       }
-      AnnotateIntervals(r);
-      FindJunctions(r);
-      const int fold = FoldOf(r.direction);
-      c_.runs.push_back(std::move(r));
+      const int fold = AddRun(std::move(r));
       const std::size_t before = c_.pieces.size();
       AddTrajectoryPieces(c_, static_cast<int>(c_.runs.size()) - 1, ex.kind, options_, subsets_);
       for (std::size_t k = before; k < c_.pieces.size(); ++k) c_.pieces[k].fold = fold;
