@@ -2,8 +2,11 @@
 // model (E_d, E_b, k_L, k_R), which contract effect causes the gap, and how
 // far it shrinks once that effect is modelled (lib/diagnosis/diagnose.hpp).
 // Readable report on stdout, contract JSON with --json, gap bars with --plot.
+#include <cmath>
 #include <memory>
 #include <variant>
+#include <optional>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -19,6 +22,7 @@
 #include "diagnosis/pieces.hpp"
 #include "diagnosis/diagnose.hpp"
 #include "io/atomic_write.hpp"
+#include "io/params_json.hpp"
 #include "io/svg_plot.hpp"
 
 namespace umbmark::cli {
@@ -32,8 +36,26 @@ struct DiagnoseCliOptions {
   std::string plot;
   std::string report;
   bool quality_gate = false;
+  std::string baseline;  ///< --baseline CAL.json
+  std::optional<double> k_L, k_R;
   JsonFlag json;
 };
+
+/// --kl / --kr: both or neither, finite, >= 0, not both 0; only with --baseline.
+void CheckGivenNoise(const DiagnoseCliOptions& o) {
+  if ((o.k_L || o.k_R) && o.baseline.empty())
+    throw InvalidOptions("--kl/--kr give the wheel noise of a model given by --baseline CAL.json; without "
+                         "--baseline the noise is fitted to the runs");
+  if (o.k_L.has_value() != o.k_R.has_value())
+    throw InvalidOptions(fmt::format("{} given without {}: give both wheels' noise k_L and k_R [m^1/2] (or neither, "
+                                     "and it is fitted)",
+                                     o.k_L ? "--kl" : "--kr", o.k_L ? "--kr" : "--kl"));
+  for (const auto& [flag, v] : {std::pair{"--kl", o.k_L}, std::pair{"--kr", o.k_R}})
+    if (v && !(std::isfinite(*v) && *v >= 0.0))
+      throw InvalidOptions(fmt::format("{} = {} must be a finite wheel noise >= 0 [m^1/2]", flag, *v));
+  if (o.k_L && *o.k_L == 0.0 && *o.k_R == 0.0)
+    throw InvalidOptions("--kl and --kr are both 0: a model without wheel noise cannot be compared with real runs");
+}
 
 int RunDiagnose(DiagnoseCliOptions o) {
   for (const auto& name : o.effects) {
@@ -41,8 +63,10 @@ int RunDiagnose(DiagnoseCliOptions o) {
     if (!k) throw InvalidOptions(fmt::format("--effects: unknown effect '{}'", name));
     o.diag.effects.push_back(*k);
   }
+  CheckGivenNoise(o);
   io::OutputSet& outs = CommandOutputs();
-  RegisterInputs({o.manifest});
+  RegisterInputs(o.baseline.empty() ? std::vector<std::string>{o.manifest}
+                                    : std::vector<std::string>{o.manifest, o.baseline});
   outs.AddOutput("--json", o.json.path);
   outs.AddOutput("--plot", o.plot);
   outs.AddOutput("--report", o.report);
@@ -60,6 +84,15 @@ int RunDiagnose(DiagnoseCliOptions o) {
     TrajectoryDataCheck check(campaign.robot);
     for (const auto& run : t->runs) check.Add(run);
     for (auto& w : check.Warnings(t->path)) warnings.push_back(std::move(w));
+  }
+  if (!o.baseline.empty()) {
+    diag::GivenModel g;
+    g.params = io::ReadParamsJson(o.baseline, campaign.robot);
+    g.source = o.baseline;
+    g.noise_given = o.k_L.has_value();
+    g.k_L = o.k_L.value_or(0.0);
+    g.k_R = o.k_R.value_or(0.0);
+    o.diag.given = g;
   }
   const diag::DiagnoseSummary s = [&] {
     Progress progress(fmt::format("diagnosing {} ({} null simulations)", o.manifest, o.diag.null_simulations));
@@ -134,6 +167,13 @@ Command SetupDiagnose(CLI::App& parent) {
                   "SVG: located discrepancies against the model's 95% band, shrink per candidate and of the explanation");
   app->add_option("--report", opts->report, "Write a self-contained HTML report (verdict, next steps, tables, plots)");
   app->add_flag("--fail-unexplained", opts->quality_gate, "Exit 3 when the verdict is 'unexplained'");
+  app->add_option("--baseline", opts->baseline,
+                  "Compare the runs with your simulation's parameters (a `calibrate` JSON: refined.parameters if "
+                  "present) instead of a model fitted to them; also names wheelbase_error and diameter_ratio_error");
+  app->add_option("--kl", opts->k_L,
+                  "With --baseline: your simulation's left wheel noise k_L [m^1/2] (with --kr; also names "
+                  "wheel_noise_error; without them the noise is fitted)");
+  app->add_option("--kr", opts->k_R, "With --baseline: your simulation's right wheel noise k_R [m^1/2] (with --kl)");
   opts->json.Bind(*app);
   return {app, [opts] { return RunDiagnose(*opts); }};
 }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 
 #include <fmt/format.h>
 
@@ -250,7 +251,9 @@ std::string Percent(double v) {
 
 /// The baseline's numbers with units.
 void BaselineTable(io::HtmlReport& rep, const nlohmann::json& b) {
-  rep.Heading("Baseline model (fitted to these runs)");
+  const nlohmann::json given = b.value("given", nlohmann::json());
+  rep.Heading(given.is_object() ? fmt::format("Baseline model (your simulation, {})", given.value("source", "?"))
+                                : std::string("Baseline model (fitted to these runs)"));
   rep.Table({"parameter", "value"},
             {{"E_d (wheel diameter ratio)", fmt::format("{:.6f}", Number(b, "E_d"))},
              {"E_b (wheelbase factor)", fmt::format("{:.6f}", Number(b, "E_b"))},
@@ -259,6 +262,33 @@ void BaselineTable(io::HtmlReport& rep, const nlohmann::json& b) {
              {fmt::format("ground truth noise ({})", b.value("ground_truth_noise_estimated", false) ? "estimated" : "as stated"),
               fmt::format("{:.3g} mm, {:.3g} mrad", 1e3 * Number(b, "sigma_xy_m"), 1e3 * Number(b, "sigma_theta_rad"))},
              {"runs, pieces compared", fmt::format("{}, {}", b.value("runs", 0), b.value("pieces", 0))}});
+}
+
+/// `diagnose --baseline`: the given model's parameters, and for each one
+/// the verdict names as wrong, the value to set instead.
+void GivenModelTable(io::HtmlReport& rep, const nlohmann::json& j) {
+  const nlohmann::json given = j.contains("baseline") ? j["baseline"].value("given", nlohmann::json()) : nlohmann::json();
+  if (!given.is_object()) return;
+  std::map<std::string, double> corrected;
+  for (const auto& c : j.value("corrections", nlohmann::json::array()))
+    corrected[c.value("parameter", "")] = Number(c, "corrected");
+  std::vector<std::vector<std::string>> rows;
+  auto row = [&](const char* key, const char* unit, int digits) {
+    if (!given.contains(key) || !given[key].is_number()) return;
+    const auto it = corrected.find(key);
+    rows.push_back({key, fmt::format("{:.{}f} {}", given[key].get<double>(), digits, unit),
+                    it == corrected.end() ? std::string("keep") : fmt::format("set {:.{}f} {}", it->second, digits, unit)});
+  };
+  row("wheelbase_m", "m", 5);
+  row("wheel_diameter_left_m", "m", 6);
+  row("wheel_diameter_right_m", "m", 6);
+  row("k_L", "m^1/2", 6);
+  row("k_R", "m^1/2", 6);
+  rep.Heading("Your simulation: what to change");
+  rep.Table({"parameter", "your value", "the runs say"}, rows);
+  if (!given.value("noise_given", false))
+    rep.Paragraph("Wheel noise not given (--kl, --kr): it was fitted to the runs (baseline table above) and is not "
+                  "checked.");
 }
 
 /// Candidate effects: parameters with units, shrink, evidence in words,
@@ -371,6 +401,7 @@ std::string DiagnoseReportHtml(const nlohmann::json& j, const std::string& manif
              {"p-value of G alone", diag::FormatPValue(Number(gap, "score_p_value"))},
              {"null simulations; alpha", fmt::format("{}; {}", gap.value("null_simulations", 0), Number(gap, "alpha"))}});
   if (j.contains("baseline")) BaselineTable(rep, j["baseline"]);
+  GivenModelTable(rep, j);
   CandidateTable(rep, j);
   ExplanationTable(rep, j);
   TopPiecesTable(rep, j);

@@ -36,7 +36,9 @@
 // 0.1-0.8 mm marker offset, a 1-2 ms time offset, a 0.5-2e-4 scale error;
 // --clean campaigns; target verdict `none`), `pair_castor_bumps` and
 // `pair_time_gt` (both effects at the single ranges; both must be in
-// verdict.effects).
+// verdict.effects), and the baseline-mode classes `base_*` (MakeBaselineCase:
+// `diagnose --baseline` with the user's model one parameter off; base_ok
+// has --clean campaigns).
 //
 // Usage: bench_diagnose [--per-class N] [--clean N] [--seed S] [--threads T]
 //                       [--null-sims B] [--extended] [--classes a,b,...]
@@ -51,6 +53,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -124,8 +127,12 @@ Args Parse(int argc, char** argv) {
 }
 
 struct Case {
-  std::string truth;  ///< "none", a contract effect, or an outside effect
+  std::string truth;  ///< "none", a contract effect, an outside effect, or a base_* class
   bool outside = false;
+  /// Baseline-mode classes (`diagnose --baseline`): the given model, and
+  /// what the verdict must name (`expected` empty: `none`).
+  std::optional<diag::GivenModel> given;
+  std::vector<std::string> expected;
   std::uint64_t seed = 0;
   sim::CampaignSimOptions sim;
   Manifest manifest;
@@ -134,6 +141,58 @@ struct Case {
 double U(std::mt19937_64& g, double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(g); }
 double Sign(std::mt19937_64& g) { return U(g, 0.0, 1.0) < 0.5 ? -1.0 : 1.0; }
 double LogU(std::mt19937_64& g, double lo, double hi) { return std::exp(U(g, std::log(lo), std::log(hi))); }
+
+/// Baseline-mode classes: the user's model (CAL.json parameters and k_L,
+/// k_R) is the true robot with one parameter wrong by a realistic amount --
+///   base_ok                none wrong (target `none`)
+///   base_wheelbase         wheelbase +-0.5-2 % (1-12 mm)
+///   base_ratio             D_R/D_L +-1000-5000 ppm, mean diameter kept
+///   base_noise             k_L, k_R both x2 or both x0.5
+///   base_wheelbase_castor  base_wheelbase + castor_kick kappa +-0.005-0.02 rad
+///   base_ratio_gt_offset   base_ratio + gt_offset |(dx, dy)| 0.01-0.05 m
+/// -- and the verdict must name every wrong parameter and effect.
+void MakeBaselineCase(std::mt19937_64& g, Case& c) {
+  const sim::CampaignSimOptions& o = c.sim;
+  const RobotParams& rec = c.manifest.robot;
+  diag::GivenModel m;
+  m.params = rec;
+  m.params.wheelbase_m = rec.wheelbase_m * o.truth.E_b;
+  m.params.wheel_diameter_left_m = rec.wheel_diameter_left_m * 2.0 / (o.truth.E_d + 1.0);
+  m.params.wheel_diameter_right_m = rec.wheel_diameter_right_m * 2.0 * o.truth.E_d / (o.truth.E_d + 1.0);
+  m.source = "CAL.json";
+  m.noise_given = true;
+  m.k_L = o.truth.k_L;
+  m.k_R = o.truth.k_R;
+  const std::string& t = c.truth;
+  if (t == "base_wheelbase" || t == "base_wheelbase_castor") {
+    m.params.wheelbase_m *= 1.0 + Sign(g) * U(g, 0.005, 0.02);
+    c.expected.push_back("wheelbase_error");
+  }
+  if (t == "base_ratio" || t == "base_ratio_gt_offset") {
+    const double e = Sign(g) * U(g, 1e-3, 5e-3);
+    m.params.wheel_diameter_left_m *= 1.0 - 0.5 * e;
+    m.params.wheel_diameter_right_m *= 1.0 + 0.5 * e;
+    c.expected.push_back("diameter_ratio_error");
+  }
+  if (t == "base_noise") {
+    const double f = U(g, 0.0, 1.0) < 0.5 ? 2.0 : 0.5;
+    m.k_L *= f;
+    m.k_R *= f;
+    c.expected.push_back("wheel_noise_error");
+  }
+  sim::Effects& fx = c.sim.effects;
+  if (t == "base_wheelbase_castor") {
+    fx.castor_kappa = Sign(g) * U(g, 0.005, 0.02);
+    c.expected.push_back("castor_kick");
+  }
+  if (t == "base_ratio_gt_offset") {
+    const double r = U(g, 0.01, 0.05), a = U(g, 0.0, 2.0 * kPi);
+    fx.gt_dx = r * std::cos(a);
+    fx.gt_dy = r * std::sin(a);
+    c.expected.push_back("gt_offset");
+  }
+  c.given = m;
+}
 
 Case MakeCase(const std::string& truth, std::uint64_t seed, bool extended, double pause_s) {
   std::mt19937_64 g(seed);
@@ -231,8 +290,12 @@ Case MakeCase(const std::string& truth, std::uint64_t seed, bool extended, doubl
         fx.slope_g = U(g, 0.002, 0.01);
         fx.slope_dir = U(g, 0.0, 2.0 * kPi);
         break;
+      case sim::EffectKind::kWheelbaseError:
+      case sim::EffectKind::kDiameterRatioError:
+      case sim::EffectKind::kWheelNoiseError: break;  // baseline mode: the base_* classes
     }
   }
+  if (truth.rfind("base_", 0) == 0) MakeBaselineCase(g, c);
   return c;
 }
 
@@ -250,11 +313,16 @@ int main(int argc, char** argv) {
   std::vector<std::string> classes = args.classes;
   if (classes.empty()) {
     classes.push_back("none");
-    for (const auto& d : sim::EffectCatalogue()) classes.emplace_back(d.name);
+    for (const auto& d : sim::EffectCatalogue())
+      if (d.simulated) classes.emplace_back(d.name);
+    for (const char* b : {"base_ok", "base_wheelbase", "base_ratio", "base_noise", "base_wheelbase_castor",
+                          "base_ratio_gt_offset"})
+      classes.emplace_back(b);
   }
   std::vector<Case> cases;
   for (std::size_t ci = 0; ci < classes.size(); ++ci) {
-    const int count = classes[ci] == "none" || classes[ci] == "negligible" ? args.clean : args.per_class;
+    const int count =
+        classes[ci] == "none" || classes[ci] == "negligible" || classes[ci] == "base_ok" ? args.clean : args.per_class;
     for (int i = 0; i < count; ++i)
       cases.push_back(MakeCase(classes[ci], args.seed * 1000003ull + ci * 10007ull + static_cast<std::uint64_t>(i),
                                args.extended, args.pause_s));
@@ -265,6 +333,7 @@ int main(int argc, char** argv) {
   dopt.null_simulations = args.null_sims;
   std::vector<std::string> verdict_names = {"none", "unexplained"};
   for (auto k : sim::ContractEffects()) verdict_names.emplace_back(sim::EffectToString(k));
+  for (auto k : sim::ParameterErrorEffects()) verdict_names.emplace_back(sim::EffectToString(k));
 
   std::map<std::string, std::map<std::string, int>> confusion;
   nlohmann::json records = nlohmann::json::array();
@@ -273,6 +342,11 @@ int main(int argc, char** argv) {
   int listed = 0, listed_right = 0, listed_no_scrub = 0, listed_no_scrub_right = 0;
   int clean = 0, false_alarms = 0, outside = 0, outside_unexplained = 0;
   int negligible = 0, negligible_none = 0, pairs = 0, pairs_both = 0;
+  struct BaselineTally {
+    int n = 0, right = 0;
+  };
+  std::map<std::string, BaselineTally> baseline;
+  int base_wrong = 0, base_wrong_named = 0;
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const Case& c = cases[i];
     if (args.only_case >= 0 && static_cast<int>(i) != args.only_case) continue;
@@ -281,12 +355,29 @@ int main(int argc, char** argv) {
       const std::string dir = fmt::format("{}/{:03d}_{}", args.write_dir, i, c.truth);
       io::WriteCampaign(campaign.manifest, campaign.data, dir + "/campaign");
       io::WriteFileAtomically(dir + "/truth.json", sim::CampaignTruthJson(campaign, c.sim).dump(2) + "\n");
+      if (c.given) {
+        // The user's model as `diagnose --baseline` reads it (a calibrate
+        // JSON's `parameters`), and its k_L, k_R for --kl/--kr.
+        const RobotParams& p = c.given->params;
+        io::WriteFileAtomically(dir + "/given.json",
+                                nlohmann::json{{"parameters",
+                                                {{"wheelbase_m", p.wheelbase_m},
+                                                 {"wheel_diameter_left_m", p.wheel_diameter_left_m},
+                                                 {"wheel_diameter_right_m", p.wheel_diameter_right_m}}}}
+                                        .dump(2) + "\n");
+        io::WriteFileAtomically(dir + "/given_noise.txt", fmt::format("{:.17g} {:.17g}\n", c.given->k_L, c.given->k_R));
+        // What the verdict must name (every word; none: `none`).
+        io::WriteFileAtomically(dir + "/expected.txt",
+                                (c.expected.empty() ? std::string("none") : fmt::format("{}", fmt::join(c.expected, " "))) +
+                                    "\n");
+      }
     }
     // Blind: the diagnosis sees the manifest and the data only.
     const auto t0 = std::chrono::steady_clock::now();
     const diag::CampaignData data = diag::BuildCampaign(campaign.manifest, campaign.data, dopt.pieces);
     diag::DiagnoseOptions o = dopt;
     o.seed = c.seed;
+    o.given = c.given;
     const diag::DiagnoseSummary s = diag::Diagnose(data, o);
     const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     times.push_back(dt);
@@ -296,7 +387,18 @@ int main(int argc, char** argv) {
     auto named = [&](const char* e) {
       return std::find(s.verdict_effects.begin(), s.verdict_effects.end(), e) != s.verdict_effects.end();
     };
-    if (c.truth == "negligible") {
+    if (c.given) {
+      bool all = true;
+      for (const auto& e : c.expected) all = all && named(e.c_str());
+      const bool ok = c.expected.empty() ? s.verdict == "none" : all;
+      BaselineTally& t = baseline[c.truth];
+      ++t.n;
+      t.right += ok;
+      if (!c.expected.empty()) {
+        ++base_wrong;
+        base_wrong_named += named(c.expected.front().c_str());
+      }
+    } else if (c.truth == "negligible") {
       ++negligible;
       negligible_none += s.verdict == "none";
     } else if (c.truth.rfind("pair_", 0) == 0) {
@@ -326,6 +428,7 @@ int main(int argc, char** argv) {
                        {"truth", c.truth},
                        {"verdict", s.verdict},
                        {"verdict_effects", s.verdict_effects},
+                       {"expected", c.expected},
                        {"p_value", s.p_value},
                        {"score_p_value", s.score_p_value},
                        {"tests_p_value", s.tests_p_value},
@@ -365,6 +468,11 @@ int main(int argc, char** argv) {
   fmt::print("'none' on negligible-mismatch campaigns:   {:5.1f}% ({}/{})\n", pct(negligible_none, negligible),
              negligible_none, negligible);
   fmt::print("both effects named on pair campaigns:      {:5.1f}% ({}/{})\n", pct(pairs_both, pairs), pairs_both, pairs);
+  fmt::print("baseline mode (--baseline CAL.json --kl --kr; all of the class's wrong parameters and effects named, "
+             "base_ok: none):\n");
+  for (const auto& [cls, t] : baseline) fmt::print("  {:<24} {:5.1f}% ({}/{})\n", cls, pct(t.right, t.n), t.right, t.n);
+  fmt::print("baseline mode, wrong parameter named:      {:5.1f}% ({}/{})\n", pct(base_wrong_named, base_wrong),
+             base_wrong_named, base_wrong);
   fmt::print("median heldout_shrink (true effect):       {:.3f}\n", Median(heldout_true));
   fmt::print("median heldout_shrink (verdict's effect):  {:.3f}\n", Median(heldout_verdict));
   fmt::print("time per diagnosis: median {:.2f} s, max {:.2f} s\n", Median(times),
@@ -379,6 +487,7 @@ int main(int argc, char** argv) {
                               {"outside_unexplained_rate", pct(outside_unexplained, outside) / 100.0},
                               {"negligible_none_rate", pct(negligible_none, negligible) / 100.0},
                               {"pairs_both_named_rate", pct(pairs_both, pairs) / 100.0},
+                              {"baseline_wrong_parameter_named_rate", pct(base_wrong_named, base_wrong) / 100.0},
                               {"median_heldout_shrink_true", Median(heldout_true)},
                               {"median_heldout_shrink_verdict", Median(heldout_verdict)},
                               {"median_seconds", Median(times)},

@@ -9,6 +9,11 @@
 # 2. Every campaign is diagnosed with the `umbmark diagnose` command, its
 #    verdict read from the JSON and compared with the hidden truth.
 #
+# 3. Baseline-mode campaigns (base_*: `diagnose --baseline given.json --kl
+#    --kr` with the user's model one parameter off, given.json and
+#    given_noise.txt beside the campaign) must name every word of
+#    expected.txt in verdict.effects (base_ok: verdict none).
+#
 # Usage: bench/blind_validation.sh [BUILD_DIR] [N] [SEED] [--extended]
 #   defaults: BUILD_DIR=build, N=3 campaigns per class (2N clean), SEED=99.
 # Prints per-class results and the top-1 accuracy, false-alarm rate and
@@ -31,13 +36,31 @@ echo "writing campaigns to $OUT/cases"
   --json "$OUT/inprocess.json" > "$OUT/inprocess.txt"
 
 declare -A total right
-listed=0; listed_right=0; clean=0; alarms=0; outside=0; outside_unexplained=0
+listed=0; listed_right=0; clean=0; alarms=0; outside=0; outside_unexplained=0; base=0; base_right=0
 start=$(date +%s.%N)
 for dir in "$OUT"/cases/*/; do
   name=$(basename "$dir")
   truth=${name#*_}
-  "$UMBMARK" diagnose "$dir/campaign/campaign.toml" --json "$dir/diagnosis.json" > "$dir/report.txt"
+  given=()
+  if [[ -f "$dir/given.json" ]]; then
+    read -r kl kr < "$dir/given_noise.txt"
+    given=(--baseline "$dir/given.json" --kl "$kl" --kr "$kr")
+  fi
+  "$UMBMARK" diagnose "$dir/campaign/campaign.toml" "${given[@]}" --json "$dir/diagnosis.json" > "$dir/report.txt"
   verdict=$(tr -d '\n ' < "$dir/diagnosis.json" | sed -n 's/.*"verdict":{"effect":"\([a-z_]*\)".*/\1/p')
+  if [[ -f "$dir/expected.txt" ]]; then
+    # JSON keys are sorted: verdict.effects follows verdict.effect.
+    named=$(tr -d '\n ' < "$dir/diagnosis.json" | sed -n 's/.*"verdict":{"effect":"[a-z_]*","effects":\[\([^]]*\)\].*/\1/p' | tr -d '"' | tr ',' ' ')
+    ok=1
+    read -r -a want < "$dir/expected.txt"
+    if [[ "${want[*]}" == none ]]; then [[ "$verdict" == none ]] || ok=0
+    else for w in "${want[@]}"; do [[ " $named " == *" $w "* ]] || ok=0; done; fi
+    total[$truth]=$(( ${total[$truth]:-0} + 1 ))
+    base=$((base + 1)); base_right=$((base_right + ok))
+    [[ $ok == 1 ]] && right[$truth]=$(( ${right[$truth]:-0} + 1 ))
+    printf '%-40s truth %-20s verdict %s (named: %s)\n' "$name" "$truth" "$verdict" "$named"
+    continue
+  fi
   total[$truth]=$(( ${total[$truth]:-0} + 1 ))
   expected=$truth
   [[ "$truth" == gt_yaw_misalignment || "$truth" == floor_slope ]] && expected=unexplained
@@ -61,5 +84,6 @@ pct() { awk -v a="$1" -v b="$2" 'BEGIN { if (b > 0) printf "%.1f%%", 100 * a / b
 echo "top-1 on listed effects:   $(pct $listed_right $listed) ($listed_right/$listed)"
 echo "false alarms (clean):      $(pct $alarms $clean) ($alarms/$clean)"
 echo "unexplained (outside):     $(pct $outside_unexplained $outside) ($outside_unexplained/$outside)"
-echo "command-line time per diagnosis: $(awk -v s="$start" -v e="$end" -v n="$((listed + clean + outside))" 'BEGIN { printf "%.2f s", (e - s) / n }')"
+echo "baseline mode (all named): $(pct $base_right $base) ($base_right/$base)"
+echo "command-line time per diagnosis: $(awk -v s="$start" -v e="$end" -v n="$((listed + clean + outside + base))" 'BEGIN { printf "%.2f s", (e - s) / n }')"
 echo "in-process results: $OUT/inprocess.txt"

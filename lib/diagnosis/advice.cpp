@@ -20,11 +20,22 @@ std::pair<double, const char*> ParamUnit(const std::string& name) {
   if (name == "rate") return {1.0, " per metre"};
   if (name == "r") return {1.0, " per run"};
   if (name == "s" || name == "a") return {1e2, " %"};
+  // Parameter errors of a given model (baseline_given.hpp).
+  if (name == "error_mm") return {1.0, " mm"};
+  if (name == "error_ppm") return {1.0, " ppm"};
+  if (name == "relative_error") return {1e2, " %"};
+  if (name == "k_L" || name == "k_R" || name == "k_L_given" || name == "k_R_given") return {1.0, " m^1/2"};
   return {1.0, ""};
 }
 }  // namespace
 
 std::string FormatEffectParam(const std::string& name, double v, double se) {
+  // A given model's lengths (wheelbase_m, wheel_diameter_left_m, ...): to
+  // 10 micrometres, so that a millimetre's correction shows.
+  if (name.size() > 2 && name.ends_with("_m")) {
+    if (std::isfinite(se)) return fmt::format("{} = {:.5f} m (se {:.2g} mm)", name, v, 1e3 * se);
+    return fmt::format("{} = {:.5f} m", name, v);
+  }
   const auto [scale, unit] = ParamUnit(name);
   if (std::isfinite(se)) return fmt::format("{} = {:.3g}{} (se {:.2g})", name, scale * v, unit, scale * se);
   return fmt::format("{} = {:.3g}{}", name, scale * v, unit);
@@ -125,9 +136,16 @@ std::vector<std::string> MissingDesign(const CampaignData& c) {
 std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSummary& s) {
   std::vector<std::string> out;
   if (s.verdict == "none") {
-    out.push_back("The baseline model describes these runs: simulate with its E_d, E_b and k_L, k_R (calibrate JSON, "
-                  "fit-noise).");
+    out.push_back(s.baseline.given ? fmt::format("Your simulation's parameters ({}) describe these runs: keep them.",
+                                                 s.baseline.given->source)
+                                   : "The baseline model describes these runs: simulate with its E_d, E_b and k_L, "
+                                     "k_R (calibrate JSON, fit-noise).");
     return out;
+  }
+  // With a given model (`--baseline`): what to change in it first.
+  for (const ParameterCorrection& pc : s.corrections) {
+    const std::string step = "Change your simulation: " + pc.text + ".";
+    if (out.empty() || out.back() != step) out.push_back(step);
   }
   std::vector<std::string> symptoms;
   for (const auto& cand : s.candidates) {
@@ -141,7 +159,8 @@ std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSu
                                                                                      : s.verdict_effects, " and ")));
     std::vector<std::string> specs;
     for (const auto& step : s.explanation) {
-      if (step.negligible) continue;
+      // Parameter errors are not simulated effects: their fix is above.
+      if (step.negligible || sim::IsParameterError(step.effect)) continue;
       std::vector<std::string> kv;
       for (const auto& [k, v] : step.params) kv.push_back(fmt::format("{}={:.4g}", k, v));
       specs.push_back(fmt::format("--effect {}:{}", sim::EffectToString(step.effect), fmt::join(kv, ",")));

@@ -42,6 +42,11 @@ struct BaselineFitOptions {
 /// The fitted baseline and what every later stage needs of it.
 struct BaselineFit {
   ParamVector p{};
+  /// Mean parameters fitted in the baseline (BaselineParams(); none for a
+  /// given model, baseline_given.hpp). Candidates are fitted jointly with these.
+  std::vector<int> free = BaselineParams();
+  /// The user's model (`diagnose --baseline`), not one fitted to the runs.
+  bool given = false;
   NoiseParams noise;
   /// Noise-fit options of this campaign (ground-truth sigmas fitted when the
   /// manifest does not state them); later stages refit noise with these.
@@ -50,8 +55,8 @@ struct BaselineFit {
   std::vector<PieceBases> bases;
   std::vector<double> eps;            ///< piece residuals at p
   std::vector<Eigen::Matrix3d> W;     ///< whiteners at `noise`
-  Eigen::MatrixXd D;                  ///< d eps / d (E_d, E_b) at p
-  Eigen::MatrixXd cov;                ///< covariance of (E_d, E_b)
+  Eigen::MatrixXd D;                  ///< d eps / d free at p (no columns for a given model)
+  Eigen::MatrixXd cov;                ///< covariance of the free parameters
   std::vector<std::string> notes;
 };
 

@@ -24,6 +24,8 @@ std::vector<int> EffectParams(sim::EffectKind k) {
     case sim::EffectKind::kParameterDrift: return {kParamDrift};
     case sim::EffectKind::kGtOffset: return {kParamDx, kParamDy};
     case sim::EffectKind::kTimeOffset: return {kParamTau};
+    case sim::EffectKind::kWheelbaseError: return {kParamEb};
+    case sim::EffectKind::kDiameterRatioError: return {kParamEd};
     default: return {};
   }
 }
@@ -48,7 +50,7 @@ double TypicalMagnitude(int param) {
 bool IsNoiseEffect(sim::EffectKind k) {
   return k == sim::EffectKind::kCorrelatedNoise || k == sim::EffectKind::kBumpOutliers ||
          k == sim::EffectKind::kStandstillMotion || k == sim::EffectKind::kMotionNoiseFloor ||
-         k == sim::EffectKind::kRunTimeOffset;
+         k == sim::EffectKind::kRunTimeOffset || k == sim::EffectKind::kWheelNoiseError;
 }
 
 void EnableNoiseEffect(sim::EffectKind k, PieceNoiseFitOptions& o) {
@@ -56,6 +58,7 @@ void EnableNoiseEffect(sim::EffectKind k, PieceNoiseFitOptions& o) {
   if (k == sim::EffectKind::kStandstillMotion) o.standstill = true;
   if (k == sim::EffectKind::kMotionNoiseFloor) o.motion_floor = true;
   if (k == sim::EffectKind::kRunTimeOffset) o.run_time = true;
+  if (k == sim::EffectKind::kWheelNoiseError) o.fit_wheel_noise = true;
 }
 
 std::map<std::string, double> NoiseEffectParams(sim::EffectKind k, const NoiseParams& n) {
@@ -66,12 +69,15 @@ std::map<std::string, double> NoiseEffectParams(sim::EffectKind k, const NoisePa
       return {{"sigma_xy", std::sqrt(n.stand_xy2)}, {"sigma_theta", std::sqrt(n.stand_th2)}};
     case sim::EffectKind::kMotionNoiseFloor: return {{"sigma", std::sqrt(n.floor_s2)}};
     case sim::EffectKind::kRunTimeOffset: return {{"tau_sd", std::sqrt(n.run_tau2)}};
+    case sim::EffectKind::kWheelNoiseError: return {{"k_L", std::sqrt(n.kL2)}, {"k_R", std::sqrt(n.kR2)}};
     default: return {};
   }
 }
 
 int EffectParameterCount(sim::EffectKind k) {
-  if (k == sim::EffectKind::kBumpOutliers || k == sim::EffectKind::kStandstillMotion) return 2;
+  if (k == sim::EffectKind::kBumpOutliers || k == sim::EffectKind::kStandstillMotion ||
+      k == sim::EffectKind::kWheelNoiseError)
+    return 2;
   if (IsNoiseEffect(k)) return 1;
   return static_cast<int>(EffectParams(k).size());
 }
@@ -146,6 +152,10 @@ bool Identify(const Shared& x, const std::vector<int>& eparams, Candidate& cd, E
       }
     }
   }
+  // Against a given model (baseline_given.hpp) E_d, E_b are not fitted: an
+  // effect they mostly absorb would take the credit for a wheelbase or
+  // diameter-ratio error, the simpler name, so it is not named there.
+  if (x.b.given && weakest < 3.0) identifiable = false;
   if (!identifiable) {
     cd.identifiable = false;
     cd.note = !(Jw_e.norm() > 0.0) ? "not identifiable on these data: these experiments do not show it at all"
@@ -173,7 +183,7 @@ bool Identify(const Shared& x, const std::vector<int>& eparams, Candidate& cd, E
 /// A mean effect fitted jointly with E_d, E_b.
 MeanFit FitMeanEffect(const Shared& x, sim::EffectKind kind, const std::vector<int>& eparams, Candidate& cd) {
   const CampaignData& c = x.c;
-  std::vector<int> joint = BaselineParams();
+  std::vector<int> joint = x.b.free;
   joint.insert(joint.end(), eparams.begin(), eparams.end());
   MeanFit mf = FitMean(x.model, x.b.p, joint, x.b.W, MeanFitOptions{12});
   // turn_scrub also changes the noise's heading in spot turns relative
@@ -189,9 +199,9 @@ MeanFit FitMeanEffect(const Shared& x, sim::EffectKind kind, const std::vector<i
   Whiten(We, mf.eps, mf.D, r2, J2);
   const Eigen::MatrixXd cov = (J2.transpose() * J2).ldlt().solve(Eigen::MatrixXd::Identity(J2.cols(), J2.cols()));
   for (std::size_t k = 0; k < eparams.size(); ++k) {
+    const auto at = static_cast<Eigen::Index>(x.b.free.size() + k);
     cd.params[ParamName(eparams[k])] = mf.p[eparams[k]];
-    cd.param_se[ParamName(eparams[k])] =
-        std::sqrt(std::max(0.0, cov(static_cast<Eigen::Index>(2 + k), static_cast<Eigen::Index>(2 + k))));
+    cd.param_se[ParamName(eparams[k])] = std::sqrt(std::max(0.0, cov(at, at)));
   }
   cd.E_d = mf.p[kParamEd];
   cd.E_b = mf.p[kParamEb];
@@ -223,7 +233,8 @@ void FitNoiseEffect(const Shared& x, sim::EffectKind kind, Candidate& cd) {
   PieceNoiseFitOptions cf_fold = x.fold_fit;
   EnableNoiseEffect(kind, cf_fold);
   const NoiseParams ne = corr ? FitPieceNoise(x.b.eps, x.b.bases, c.pieces, {}, x.b.noise, cf)
-                              : FitBumps(x.b.eps, x.b.bases, c.pieces, {}, x.b.noise);
+                              : FitBumps(x.b.eps, x.b.bases, c.pieces, {}, x.b.noise, /*start_only=*/false,
+                                                 cf.fit_wheel_noise);
   cd.params = NoiseEffectParams(kind, ne);
   // A variance at its boundary 0 under the baseline: Wilks' chi^2 is
   // conservative there (the true null is a 50:50 mixture), so the test
@@ -235,7 +246,7 @@ void FitNoiseEffect(const Shared& x, sim::EffectKind kind, Candidate& cd) {
   const CrossValidation cv = CrossValidate(
       c, x.b.bases, x.folds, x.b.eps, x.b.D, x.b.W, [&](const std::vector<double>& e, const std::vector<char>& use) {
         return corr ? FitPieceNoise(e, x.b.bases, c.pieces, use, ne, cf_fold)
-                    : FitBumps(e, x.b.bases, c.pieces, use, ne, /*start_only=*/true);
+                    : FitBumps(e, x.b.bases, c.pieces, use, ne, /*start_only=*/true, cf_fold.fit_wheel_noise);
       });
   cd.heldout_loglik_gain = cv.loglik - x.cv_ll_base;
   const double gcv = ComputeGap(c, cv.scores, x.options.gap).score;
@@ -261,8 +272,11 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
   x.gap_before = Gap(gap_score, null_median);
   x.gap_cv_before = Gap(gcv_base, null_median);
   x.ll_base = TotalLogLik(c, b.bases, b.eps, b.noise);
+  // Identifiability is judged against E_d, E_b also for a given model
+  // (baseline_given.hpp), whose baseline fits neither: an effect they
+  // absorb would be a wheelbase or diameter-ratio error in disguise.
   Eigen::VectorXd rw_b;
-  Whiten(b.W, b.eps, b.D, rw_b, x.Jw_b);
+  Whiten(b.W, b.eps, b.free == BaselineParams() ? b.D : model.Jacobian(b.p, BaselineParams(), b.eps), rw_b, x.Jw_b);
   x.Ab = x.Jw_b.transpose() * x.Jw_b;
 
   CandidateFits out;
@@ -278,7 +292,9 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
     const std::vector<int> eparams = EffectParams(kind);
     if (!eparams.empty()) {
       cd.parameters = static_cast<int>(eparams.size());
-      if (!Identify(x, eparams, cd, out.projected[ei])) return;
+      // A parameter error frees a baseline parameter itself: nothing to
+      // tell it apart from.
+      if (!sim::IsParameterError(kind) && !Identify(x, eparams, cd, out.projected[ei])) return;
       mean_fits[ei] = FitMeanEffect(x, kind, eparams, cd);
     } else if (IsNoiseEffect(kind)) {
       FitNoiseEffect(x, kind, cd);
@@ -297,7 +313,7 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
   });
   for (std::size_t i = 0; i < effects.size(); ++i) {
     if (mean_fits[i].eps.empty()) continue;
-    std::vector<int> key = BaselineParams();
+    std::vector<int> key = b.free;
     for (int k : EffectParams(effects[i])) key.push_back(k);
     out.mean_fits.emplace(std::move(key), std::move(mean_fits[i]));
   }

@@ -36,6 +36,17 @@ std::string DiagnoseOptions::Check() const {
   if (max_explanation_effects < 1)
     return fmt::format("max_explanation_effects = {} must be >= 1", max_explanation_effects);
   if (where_top < 0) return fmt::format("where_top = {} must be >= 0", where_top);
+  if (given) {
+    if (auto e = given->Check(); !e.empty()) return "given model: " + e;
+  }
+  for (sim::EffectKind k : effects) {
+    if (!sim::IsParameterError(k)) continue;
+    if (!given)
+      return fmt::format("effect {} is a parameter error of a given model: a candidate only with --baseline CAL.json",
+                         sim::EffectToString(k));
+    if (k == sim::EffectKind::kWheelNoiseError && !given->noise_given)
+      return "effect wheel_noise_error needs the given model's wheel noise (--kl, --kr)";
+  }
   if (auto e = pieces.Check(); !e.empty()) return "pieces: " + e;
   if (!(gap.threshold_se >= 0.0)) return fmt::format("gap.threshold_se = {} must be >= 0", gap.threshold_se);
   return {};
@@ -86,6 +97,22 @@ BaselineSummary Summarise(const CampaignData& c, const BaselineStart& start, con
   bs.return_k_R_ci = rc.return_k_R_ci;
   bs.return_fit_note = std::move(rc.return_fit_note);
   return bs;
+}
+
+/// With a given model: parameters in the user's terms (baseline_given.hpp)
+/// and the corrections for every parameter error the verdict names.
+void DescribeGivenModel(const CampaignData& c, const GivenModel& given, DiagnoseSummary& out) {
+  for (Candidate& cd : out.candidates) {
+    cd.params = DescribeGivenParams(cd.effect, cd.params, c.robot, given);
+    cd.param_se = DescribeGivenParamErrors(cd.effect, cd.param_se, c.robot, given);
+  }
+  for (ExplanationStep& s : out.explanation) {
+    s.params = DescribeGivenParams(s.effect, s.params, c.robot, given);
+    const bool named = std::find(out.verdict_effects.begin(), out.verdict_effects.end(),
+                                 sim::EffectToString(s.effect)) != out.verdict_effects.end();
+    if (!named || !sim::IsParameterError(s.effect)) continue;
+    for (ParameterCorrection& pc : Corrections(s.effect, s.params, given)) out.corrections.push_back(std::move(pc));
+  }
 }
 
 /// The verdict's effects from the explanation: its non-negligible effects.
@@ -149,14 +176,22 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
   StageTimer timer;
   const MeanModel model(c);
 
-  // 1. Baseline.
-  const BaselineStart start = StartBaseline(c, options.use_refine);
-  out.notes = start.notes;
-  timer.Lap("refined calibration (start)");
-  const BaselineFit base = FitBaseline(c, model, start, BaselineFitOptions{});
+  // 1. Baseline: fitted to the runs, or the user's model.
+  BaselineStart start;
+  if (options.given) {
+    start.p = GivenParams(c.robot, options.given->params);
+    start.description = fmt::format("given model ({})", options.given->source);
+  } else {
+    start = StartBaseline(c, options.use_refine);
+    out.notes = start.notes;
+    timer.Lap("refined calibration (start)");
+  }
+  const BaselineFit base =
+      options.given ? FitGivenBaseline(c, model, *options.given) : FitBaseline(c, model, start, BaselineFitOptions{});
   out.notes.insert(out.notes.end(), base.notes.begin(), base.notes.end());
   const ReturnCheck returns = CheckReturns(c, model, base);
   out.baseline = Summarise(c, start, base, returns);
+  out.baseline.given = options.given;
   timer.Lap("baseline fit and predictions");
 
   // 2. Where, and the gap's null distribution.
@@ -178,6 +213,8 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
   // 3. Which: candidate effects, cross-validated over runs.
   CandidateOptions co;
   co.effects = options.effects.empty() ? sim::ContractEffects() : options.effects;
+  if (options.given && options.effects.empty())
+    for (sim::EffectKind k : GivenModelCandidates(*options.given)) co.effects.push_back(k);
   co.complexity_penalty_nats = options.complexity_penalty_nats;
   co.threads = options.threads;
   co.gap = options.gap;
@@ -219,6 +256,7 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
     NameEffects(ex, options, out);
     timer.Lap("stepwise explanation");
   }
+  if (options.given) DescribeGivenModel(c, *options.given, out);
   if (options.progress) options.progress(1000.0, 1000.0);
   out.next_steps = AdviseNextSteps(c, out);
   out.timings = timer.Finish();

@@ -48,6 +48,7 @@
 #include <array>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -55,6 +56,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json_fwd.hpp>
 
+#include "diagnosis/baseline_given.hpp"
 #include "diagnosis/candidates.hpp"
 #include "diagnosis/explanation.hpp"
 #include "diagnosis/gap_stats.hpp"
@@ -100,8 +102,14 @@ struct DiagnoseOptions {
   double negligible = 0.25;
   /// Most effects in the stepwise explanation (>= 1). Default 4.
   int max_explanation_effects = 4;
-  /// Effects to try (empty: the contract's nine).
+  /// Effects to try (empty: the contract's twelve; with `given`, also its
+  /// parameter errors).
   std::vector<sim::EffectKind> effects;
+  /// The user's simulation model as the baseline (`--baseline CAL.json
+  /// [--kl K --kr K]`, baseline_given.hpp); absent: the model fitted to the
+  /// runs. Only with it are wheelbase_error, diameter_ratio_error and
+  /// wheel_noise_error candidates.
+  std::optional<GivenModel> given;
   PieceOptions pieces;
   GapOptions gap;
   /// Progress of the whole diagnosis (core/progress.hpp), in thousandths:
@@ -132,6 +140,9 @@ struct BaselineSummary {
   double return_k_L = 0.0, return_k_R = 0.0;
   std::array<double, 2> return_k_L_ci{0.0, 0.0}, return_k_R_ci{0.0, 0.0};
   std::string return_fit_note;
+  /// The given model (`--baseline`): its source and values; E_d, E_b above
+  /// are then its own, k_L, k_R too when noise_given.
+  std::optional<GivenModel> given;
 };
 
 struct DiagnoseSummary {
@@ -165,6 +176,9 @@ struct DiagnoseSummary {
   double unexplained_fraction = 0.0;
   double negligible_threshold = 0.25;
   std::vector<std::string> indistinguishable;
+  /// With a given model: what to change in the user's simulation, for every
+  /// parameter error the verdict names.
+  std::vector<ParameterCorrection> corrections;
   std::vector<std::pair<std::string, double>> timings;  ///< stage, seconds
   std::vector<std::string> experiment_labels;
   std::vector<std::string> notes;

@@ -26,10 +26,11 @@ struct SetFit {
   double gap_after = 0.0, heldout_gap = 0.0, cv_loglik = 0.0;
 };
 
-/// The mean parameters a set of effects fits: E_d, E_b, then each mean
-/// effect's parameters in the set's order.
-std::vector<int> MeanParamsOf(const std::vector<sim::EffectKind>& set) {
-  std::vector<int> params = BaselineParams();
+/// The mean parameters a set of effects fits: the baseline's free ones
+/// (E_d, E_b; none against a given model), then each mean effect's
+/// parameters in the set's order.
+std::vector<int> MeanParamsOf(const std::vector<int>& free, const std::vector<sim::EffectKind>& set) {
+  std::vector<int> params = free;
   for (sim::EffectKind e : set)
     for (int k : EffectParams(e)) params.push_back(k);
   return params;
@@ -72,8 +73,8 @@ SetFit FitSet(const CampaignData& c, const BaselineFit& b, const Folds& folds, c
   SetFit out;
   out.p = mf.p;
   // Bumps and rho together: the bump mixture (its fit has no rho).
-  out.noise = bumps ? (warm ? FitBumps(mf.eps, bases, c.pieces, {}, *warm, /*start_only=*/true)
-                             : FitBumps(mf.eps, bases, c.pieces, {}, b.noise))
+  out.noise = bumps ? (warm ? FitBumps(mf.eps, bases, c.pieces, {}, *warm, /*start_only=*/true, nf.fit_wheel_noise)
+                             : FitBumps(mf.eps, bases, c.pieces, {}, b.noise, /*start_only=*/false, nf.fit_wheel_noise))
                     : FitPieceNoise(mf.eps, bases, c.pieces, {}, b.noise, nf);
   const std::vector<Eigen::Matrix3d> W = Whiteners(bases, c.pieces, out.noise);
   out.gap_after = ComputeGap(c, PieceScores(mf.eps, bases, c.pieces, out.noise), gap).score;
@@ -83,7 +84,7 @@ SetFit FitSet(const CampaignData& c, const BaselineFit& b, const Folds& folds, c
   const NoiseParams& ne = out.noise;
   const CrossValidation cv =
       CrossValidate(c, bases, folds, mf.eps, mf.D, W, [&](const std::vector<double>& e, const std::vector<char>& use) {
-        return bumps ? FitBumps(e, bases, c.pieces, use, ne, /*start_only=*/true)
+        return bumps ? FitBumps(e, bases, c.pieces, use, ne, /*start_only=*/true, fold_fit.fit_wheel_noise)
                      : FitPieceNoise(e, bases, c.pieces, use, ne, fold_fit);
       });
   out.cv_loglik = cv.loglik;
@@ -101,7 +102,7 @@ class MeanPartCache {
   void Prepare(const std::vector<std::vector<sim::EffectKind>>& sets) {
     std::vector<std::vector<int>> missing;
     for (const auto& set : sets) {
-      std::vector<int> key = MeanParamsOf(set);
+      std::vector<int> key = MeanParamsOf(b_.free, set);
       if (parts_.count(key) || std::find(missing.begin(), missing.end(), key) != missing.end()) continue;
       if (const auto it = known_.find(key); it != known_.end()) {
         parts_.emplace(key, MeanPartFrom(c_, model_, it->second, key));
@@ -116,7 +117,7 @@ class MeanPartCache {
     for (std::size_t i = 0; i < missing.size(); ++i) parts_.emplace(std::move(missing[i]), std::move(fitted[i]));
   }
   /// The mean part of `set` (Prepare'd before).
-  const MeanPart& Get(const std::vector<sim::EffectKind>& set) const { return parts_.at(MeanParamsOf(set)); }
+  const MeanPart& Get(const std::vector<sim::EffectKind>& set) const { return parts_.at(MeanParamsOf(b_.free, set)); }
 
  private:
   const CampaignData& c_;
@@ -165,8 +166,9 @@ PieceScatter Scatter(const CampaignData& c, const std::vector<PieceBases>& bases
 }
 
 /// Practical size of effect e within the joint fit f (see explanation.hpp).
-void Size(const CampaignData& c, const MeanModel& model, const std::vector<PieceBases>& bases,
-          const PieceScatter& noise, const SetFit& f, sim::EffectKind e, ExplanationStep& s) {
+void Size(const CampaignData& c, const MeanModel& model, const BaselineFit& base,
+          const std::vector<PieceBases>& bases, const PieceScatter& noise, const SetFit& f, sim::EffectKind e,
+          ExplanationStep& s) {
   const double kL2 = f.noise.kL2, kR2 = f.noise.kR2, kbar2 = 0.5 * (kL2 + kR2);
   if (e == sim::EffectKind::kCorrelatedNoise) {
     const double ratio = kbar2 > 0.0 ? f.noise.c_LR / kbar2 : 0.0;
@@ -175,6 +177,25 @@ void Size(const CampaignData& c, const MeanModel& model, const std::vector<Piece
   }
   if (e == sim::EffectKind::kBumpOutliers) {
     s.relative_size = kbar2 > 0.0 ? std::sqrt(1.0 + f.noise.bump_rate * f.noise.bump_s2 / kbar2) - 1.0 : 1.0;
+    return;
+  }
+  if (e == sim::EffectKind::kWheelNoiseError) {
+    // A given model's wheel noise (baseline_given.hpp): how far the fitted
+    // k_L, k_R are from the given ones (relative change of the standard
+    // deviation, the wheel further off; x2 and x0.5 both count), like the
+    // other noise effects, since wheel noise grows along a run while the
+    // ground truth's does not; and the change of one piece's wheel-noise
+    // scatter [mm, mrad].
+    auto rel = [](double fit2, double given2) { return given2 > 0.0 ? std::abs(std::sqrt(fit2 / given2) - 1.0) : 1.0; };
+    s.relative_size = std::max(rel(kL2, base.noise.kL2), rel(kR2, base.noise.kR2));
+    std::vector<double> pos, head;
+    for (const PieceBases& B : bases) {
+      const Eigen::Matrix3d A = kL2 * B.A_L + kR2 * B.A_R, G = base.noise.kL2 * B.A_L + base.noise.kR2 * B.A_R;
+      pos.push_back(std::abs(std::sqrt(A(0, 0) + A(1, 1)) - std::sqrt(G(0, 0) + G(1, 1))));
+      head.push_back(std::abs(std::sqrt(A(2, 2)) - std::sqrt(G(2, 2))));
+    }
+    s.size_mm = 1e3 * Median(pos);
+    s.size_mrad = 1e3 * Median(head);
     return;
   }
   if (IsNoiseEffect(e)) {
@@ -202,8 +223,10 @@ void Size(const CampaignData& c, const MeanModel& model, const std::vector<Piece
     s.size_mrad = 1e3 * Median(head);
     return;
   }
+  // Removing an effect sets its parameters back to the baseline's (0 for
+  // the effects; the given model's E_d, E_b for a parameter error).
   ParamVector without = f.p;
-  for (int k : EffectParams(e)) without[k] = 0.0;
+  for (int k : EffectParams(e)) without[k] = base.p[k];
   // Per experiment: an effect may show in one kind of run only (turn_scrub
   // in the squares' spot turns), so the typical run is that of the
   // experiment where it shows most.
@@ -329,7 +352,7 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
   const std::vector<PieceBases>& last_bases = means.Get(chosen).scrub ? means.Get(chosen).scrub_bases : b.bases;
   const PieceScatter scatter = Scatter(c, last_bases, current.noise);
   for (ExplanationStep& s : ex.steps) {
-    Size(c, model, last_bases, scatter, current, s.effect, s);
+    Size(c, model, b, last_bases, scatter, current, s.effect, s);
     s.negligible = s.relative_size < options.negligible;
   }
   return ex;

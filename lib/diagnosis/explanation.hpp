@@ -19,7 +19,8 @@
 // turn, plus the ground truth's noise at both ends; RMS over the pieces;
 // position and heading separately, the larger ratio counts). For the noise
 // effects it is the relative change of the wheel-noise standard deviation
-// they cause. Below `negligible` (default 0.25: a quarter of the noise) an
+// they cause (wheel_noise_error: |k_fit / k_given - 1|, the wheel
+// further off). Below `negligible` (default 0.25: a quarter of the noise) an
 // effect is negligible: reported, never named in the verdict, however
 // significant.
 #pragma once

@@ -230,7 +230,8 @@ namespace {
 NoiseParams FitPieceNoiseOnce(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
                          const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start,
                          const PieceNoiseFitOptions& options) {
-  std::vector<int> active = {0, 1};
+  std::vector<int> active;
+  if (options.fit_wheel_noise) active = {0, 1};
   if (options.correlated) active.push_back(2);
   if (options.fit_ground_truth) {
     active.push_back(3);
@@ -259,6 +260,7 @@ NoiseParams FitPieceNoiseOnce(const std::vector<double>& eps, const std::vector<
   });
   const int p = static_cast<int>(active.size());
   Clamp(n, options);
+  if (p == 0) return n;  // everything given
 
   // Rough start: scale the fitted variances so the median chi^2 per piece
   // matches its expectation (median, so that pieces the mean model misses
@@ -372,8 +374,10 @@ NoiseParams FitPieceNoise(const std::vector<double>& eps, const std::vector<Piec
   }
   NoiseParams out = n;
   const double f = kTrimConsistency;
-  out.kL2 *= f;
-  out.kR2 *= f;
+  if (options.fit_wheel_noise) {
+    out.kL2 *= f;
+    out.kR2 *= f;
+  }
   out.c_LR *= f;
   if (options.fit_ground_truth) {
     out.sxy2 *= f;
@@ -384,15 +388,15 @@ NoiseParams FitPieceNoise(const std::vector<double>& eps, const std::vector<Piec
 
 NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
                      const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start,
-                     bool start_only) {
+                     bool start_only, bool fit_wheel_noise) {
   // Bounded minimisation (NLopt Sbplx) of -log L over x = [log kL2, log kR2,
   // log rate, log sb2], from up to three starts; the box is the header's
-  // physical bumps.
+  // physical bumps. With k_L, k_R given the first two have no effect.
   auto unpack = [&](const std::vector<double>& x) {
     NoiseParams n = start;
     n.c_LR = 0.0;
-    n.kL2 = std::exp(x[0]);
-    n.kR2 = std::exp(x[1]);
+    n.kL2 = fit_wheel_noise ? std::exp(x[0]) : start.kL2;
+    n.kR2 = fit_wheel_noise ? std::exp(x[1]) : start.kR2;
     n.bump_rate = std::exp(x[2]);
     n.bump_s2 = std::exp(x[3]);
     return n;

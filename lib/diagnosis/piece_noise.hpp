@@ -62,6 +62,9 @@ struct BumpMixture {
 BumpMixture PieceMixture(const PieceBases& B, const NoiseParams& n);
 
 struct PieceNoiseFitOptions {
+  /// Estimate k_L^2, k_R^2 (else fixed at the start values: a given model's
+  /// wheel noise, `diagnose --baseline --kl --kr`). Default true.
+  bool fit_wheel_noise = true;
   /// Estimate sigma_xy, sigma_theta (else fixed at the start values).
   bool fit_ground_truth = false;
   /// Estimate c = rho k_L k_R (correlated_noise).
@@ -98,9 +101,10 @@ NoiseParams FitPieceNoise(const std::vector<double>& eps, const std::vector<Piec
 /// start_only: one search from `start` (which must carry bumps) instead of
 /// the multi-start -- for refits near a known answer, such as the
 /// cross-validation folds of a full-data fit.
+/// fit_wheel_noise false: k_L, k_R stay at `start`'s (a given model's).
 NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
                      const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start,
-                     bool start_only = false);
+                     bool start_only = false, bool fit_wheel_noise = true);
 
 /// Log-likelihood of piece j's residual (Gaussian, or the bump mixture when
 /// n.bump_rate > 0).

@@ -9,6 +9,7 @@
 #include "core/angles.hpp"
 #include "diagnosis/advice.hpp"
 #include "diagnosis/diagnose.hpp"
+#include "diagnosis/report_given.hpp"
 #include "io/svg_plot.hpp"
 
 namespace umbmark::diag {
@@ -120,7 +121,7 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
   }
   nlohmann::json timing = nlohmann::json::object();
   for (const auto& [k, v] : s.timings) timing[k] = Num(v);
-  return {{"gap",
+  nlohmann::json j = {{"gap",
            {{"score", Num(s.gap_score)},
             {"p_value", Num(s.p_value)},
             {"where", where},
@@ -167,6 +168,8 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
           {"notes", s.notes},
           {"next_steps", s.next_steps},
           {"timing_s", timing}};
+  AddGivenModelJson(s, j);
+  return j;
 }
 
 std::string DiagnoseReport(const DiagnoseSummary& s) {
@@ -271,6 +274,10 @@ std::string DiagnoseReport(const DiagnoseSummary& s) {
   line("What to do next:");
   for (std::size_t i = 0; i < s.next_steps.size(); ++i) line(fmt::format("  {}. {}", i + 1, s.next_steps[i]));
   line("");
+  if (const std::string given = GivenModelReport(s); !given.empty()) {
+    out += given;
+    line("");
+  }
   line("Time per stage:");
   for (const auto& [k, v] : s.timings) line(fmt::format("  {:<42} {:8.3f} s", k, v));
   return out;

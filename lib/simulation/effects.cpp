@@ -57,6 +57,12 @@ const std::vector<EffectDescriptor>& EffectCatalogue() {
        false,
        "(outside the contract) the robot slides g metres per metre of wheel travel towards direction dir of "
        "its start frame"},
+      {EffectKind::kWheelbaseError, "wheelbase_error", {}, true,
+       "(diagnose --baseline) the given model's wheelbase differs from the robot's", false},
+      {EffectKind::kDiameterRatioError, "diameter_ratio_error", {}, true,
+       "(diagnose --baseline) the given model's wheel-diameter ratio differs from the robot's", false},
+      {EffectKind::kWheelNoiseError, "wheel_noise_error", {}, true,
+       "(diagnose --baseline) the given wheel noise k_L, k_R differs from the robot's", false},
   };
   return catalogue;
 }
@@ -64,9 +70,15 @@ const std::vector<EffectDescriptor>& EffectCatalogue() {
 std::vector<EffectKind> ContractEffects() {
   std::vector<EffectKind> out;
   for (const auto& d : EffectCatalogue())
-    if (d.in_contract) out.push_back(d.kind);
+    if (d.in_contract && d.simulated) out.push_back(d.kind);
   return out;
 }
+
+std::vector<EffectKind> ParameterErrorEffects() {
+  return {EffectKind::kWheelbaseError, EffectKind::kDiameterRatioError, EffectKind::kWheelNoiseError};
+}
+
+bool IsParameterError(EffectKind kind) { return !Describe(kind).simulated; }
 
 const EffectDescriptor& Describe(EffectKind kind) {
   for (const auto& d : EffectCatalogue())
@@ -149,6 +161,10 @@ void ParseEffectSpec(std::string_view spec, Effects& effects) {
     fail(fmt::format("unknown effect '{}' (known: {})", name, known));
   }
   const EffectDescriptor& d = Describe(*kind);
+  if (!d.simulated)
+    fail(fmt::format("'{}' is a parameter error that `diagnose --baseline` names, not an effect the simulator "
+                     "produces: simulate the robot with other parameters instead (E_d, E_b, k_L, k_R)",
+                     d.name));
   if (colon == std::string_view::npos || colon + 1 >= spec.size())
     fail(fmt::format("no parameters; expected {}:{}=VALUE,...", d.name, d.parameters.front().name));
   std::string_view rest = spec.substr(colon + 1);

@@ -41,6 +41,10 @@
 //   floor_slope         g, dir      a tilted floor: the robot slides g metres per
 //                                   metre of wheel travel ((|l| + |r|)/2) towards the
 //                                   direction `dir` [rad] of its start frame
+//
+// Three contract names are parameter errors of a model the user gives
+// (`diagnose --baseline CAL.json`), candidates of the diagnosis only:
+// wheelbase_error, diameter_ratio_error, wheel_noise_error.
 #pragma once
 
 #include <optional>
@@ -66,6 +70,12 @@ enum class EffectKind {
   // Outside the contract (blind benchmark only).
   kGtYawMisalignment,
   kFloorSlope,
+  // Parameter errors of a given model (`diagnose --baseline`): contract
+  // names, candidates of the diagnosis only; nothing the simulator produces
+  // (simulate the robot with other parameters instead).
+  kWheelbaseError,
+  kDiameterRatioError,
+  kWheelNoiseError,
 };
 
 /// Magnitudes of every effect; zero means absent. Field names follow the
@@ -113,12 +123,19 @@ struct EffectDescriptor {
   std::vector<EffectParameter> parameters;
   bool in_contract = true;
   std::string_view definition;
+  /// False for the parameter errors of `diagnose --baseline`.
+  bool simulated = true;
 };
 
 /// All effects, contract ones first (in the contract's table order).
 const std::vector<EffectDescriptor>& EffectCatalogue();
-/// The contract's twelve effects.
+/// The contract's twelve effects (those the simulator produces).
 std::vector<EffectKind> ContractEffects();
+/// The contract's parameter errors of a given model (`diagnose --baseline`):
+/// wheelbase_error, diameter_ratio_error, wheel_noise_error.
+std::vector<EffectKind> ParameterErrorEffects();
+/// Whether `kind` is one of ParameterErrorEffects().
+bool IsParameterError(EffectKind kind);
 const EffectDescriptor& Describe(EffectKind kind);
 const char* EffectToString(EffectKind kind);
 std::optional<EffectKind> EffectFromString(std::string_view name);

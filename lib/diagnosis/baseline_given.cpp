@@ -1,0 +1,190 @@
+// The user's simulation model as the diagnosis' baseline (see
+// baseline_given.hpp).
+#include "diagnosis/baseline_given.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "diagnosis/mean_fit.hpp"
+
+namespace umbmark::diag {
+
+std::string GivenModel::Check() const {
+  if (auto e = params.Check(); !e.empty()) return fmt::format("{}: {}", source, e);
+  if (!noise_given) return {};
+  if (!(std::isfinite(k_L) && k_L >= 0.0)) return fmt::format("--kl = {} must be finite and >= 0 [m^1/2]", k_L);
+  if (!(std::isfinite(k_R) && k_R >= 0.0)) return fmt::format("--kr = {} must be finite and >= 0 [m^1/2]", k_R);
+  if (!(k_L > 0.0 || k_R > 0.0)) return "--kl and --kr are both 0: a model without wheel noise cannot be compared";
+  return {};
+}
+
+ParamVector GivenParams(const RobotParams& recorded, const RobotParams& given) {
+  ParamVector p = NominalParams();
+  const double cL = given.wheel_diameter_left_m / recorded.wheel_diameter_left_m;
+  const double cR = given.wheel_diameter_right_m / recorded.wheel_diameter_right_m;
+  p[kParamEb] = given.wheelbase_m / recorded.wheelbase_m;
+  p[kParamEd] = cR / cL;
+  p[kParamScale] = 0.5 * (cL + cR) - 1.0;
+  return p;
+}
+
+BaselineFit FitGivenBaseline(const CampaignData& c, const MeanModel& model, const GivenModel& given) {
+  BaselineFit b;
+  b.free.clear();
+  b.given = true;
+  b.p = GivenParams(c.robot, given.params);
+  b.ground_truth_known = c.ground_truth.has_value();
+  b.noise_fit.fit_ground_truth = !b.ground_truth_known;
+  b.noise_fit.fit_wheel_noise = !given.noise_given;
+  b.noise_fit.min_sigma_xy2 = 1e-12;
+  b.noise_fit.min_sigma_theta2 = 1e-12;
+  NoiseParams noise;
+  // Floors as in the default baseline: 1 micrometre / 1 microradian.
+  noise.sxy2 = b.ground_truth_known ? std::max(c.ground_truth->sigma_xy_m * c.ground_truth->sigma_xy_m, 1e-12) : 1e-8;
+  noise.sth2 =
+      b.ground_truth_known ? std::max(c.ground_truth->sigma_theta_rad * c.ground_truth->sigma_theta_rad, 1e-12) : 1e-6;
+  if (given.noise_given) {
+    // A wheel given as noise-free keeps a tiny variance: the covariances
+    // must stay invertible.
+    noise.kL2 = std::max(given.k_L * given.k_L, b.noise_fit.min_k2);
+    noise.kR2 = std::max(given.k_R * given.k_R, b.noise_fit.min_k2);
+  }
+  model.Residuals(b.p, b.eps);
+  b.bases = ComputeBases(c, model, b.p);
+  b.noise = FitPieceNoise(b.eps, b.bases, c.pieces, {}, noise, b.noise_fit);
+  b.W = Whiteners(b.bases, c.pieces, b.noise);
+  b.D = Eigen::MatrixXd(static_cast<Eigen::Index>(b.eps.size()), 0);
+  b.cov = Eigen::MatrixXd(0, 0);
+  b.notes.push_back(fmt::format(
+      "baseline: the given model from {} (wheelbase {:.4f} m, wheel diameters {:.5f} / {:.5f} m: E_d = {:.6f}, "
+      "E_b = {:.6f}, scale {:+.4f} % relative to the recorded robot), wheel noise {}",
+      given.source, given.params.wheelbase_m, given.params.wheel_diameter_left_m,
+      given.params.wheel_diameter_right_m, b.p[kParamEd], b.p[kParamEb], 100.0 * b.p[kParamScale],
+      given.noise_given ? fmt::format("given (k_L = {:.3g}, k_R = {:.3g} m^1/2)", given.k_L, given.k_R)
+                        : fmt::format("not given: fitted (k_L = {:.3g}, k_R = {:.3g} m^1/2; wheel_noise_error is not a "
+                                      "candidate)",
+                                      std::sqrt(b.noise.kL2), std::sqrt(b.noise.kR2))));
+  return b;
+}
+
+std::vector<sim::EffectKind> GivenModelCandidates(const GivenModel& given) {
+  std::vector<sim::EffectKind> out = {sim::EffectKind::kWheelbaseError, sim::EffectKind::kDiameterRatioError};
+  if (given.noise_given) out.push_back(sim::EffectKind::kWheelNoiseError);
+  return out;
+}
+
+namespace {
+
+double Get(const std::map<std::string, double>& m, const char* key, double fallback) {
+  const auto it = m.find(key);
+  return it == m.end() ? fallback : it->second;
+}
+
+}  // namespace
+
+std::map<std::string, double> DescribeGivenParams(sim::EffectKind kind, const std::map<std::string, double>& raw,
+                                                  const RobotParams& recorded, const GivenModel& given) {
+  const ParamVector g = GivenParams(recorded, given.params);
+  switch (kind) {
+    case sim::EffectKind::kWheelbaseError: {
+      const double shown = Get(raw, "E_b", g[kParamEb]) * recorded.wheelbase_m;
+      const double err = given.params.wheelbase_m - shown;
+      return {{"wheelbase_m", shown},
+              {"wheelbase_given_m", given.params.wheelbase_m},
+              {"error_mm", 1e3 * err},
+              {"relative_error", err / shown}};
+    }
+    case sim::EffectKind::kDiameterRatioError: {
+      // E_d is relative to the recorded ratio; the scale (mean diameter
+      // factor) stays the given model's.
+      const double E_d = Get(raw, "E_d", g[kParamEd]);
+      const double rec_ratio = recorded.wheel_diameter_right_m / recorded.wheel_diameter_left_m;
+      const double shown = E_d * rec_ratio;
+      const double given_ratio = given.params.wheel_diameter_right_m / given.params.wheel_diameter_left_m;
+      const double scale = 1.0 + g[kParamScale];
+      return {{"ratio", shown},
+              {"ratio_given", given_ratio},
+              {"error_ppm", 1e6 * (given_ratio / shown - 1.0)},
+              {"wheel_diameter_left_m", recorded.wheel_diameter_left_m * scale * 2.0 / (E_d + 1.0)},
+              {"wheel_diameter_right_m", recorded.wheel_diameter_right_m * scale * 2.0 * E_d / (E_d + 1.0)}};
+    }
+    case sim::EffectKind::kWheelNoiseError: {
+      const double kL = Get(raw, "k_L", given.k_L), kR = Get(raw, "k_R", given.k_R);
+      auto ratio = [](double fit, double giv) { return giv > 0.0 ? fit / giv : 0.0; };
+      return {{"k_L", kL},
+              {"k_R", kR},
+              {"k_L_given", given.k_L},
+              {"k_R_given", given.k_R},
+              {"ratio_L", ratio(kL, given.k_L)},
+              {"ratio_R", ratio(kR, given.k_R)}};
+    }
+    case sim::EffectKind::kScaleError: {
+      // Relative to the given model's own mean diameter.
+      std::map<std::string, double> out = raw;
+      if (const auto it = raw.find("s"); it != raw.end()) out["s"] = (1.0 + it->second) / (1.0 + g[kParamScale]) - 1.0;
+      return out;
+    }
+    default: return raw;
+  }
+}
+
+std::map<std::string, double> DescribeGivenParamErrors(sim::EffectKind kind,
+                                                       const std::map<std::string, double>& raw_se,
+                                                       const RobotParams& recorded, const GivenModel& given) {
+  if (kind == sim::EffectKind::kWheelbaseError) {
+    const auto it = raw_se.find("E_b");
+    if (it == raw_se.end()) return {};
+    return {{"wheelbase_m", it->second * recorded.wheelbase_m}, {"error_mm", 1e3 * it->second * recorded.wheelbase_m}};
+  }
+  if (kind == sim::EffectKind::kDiameterRatioError) {
+    const auto it = raw_se.find("E_d");
+    if (it == raw_se.end()) return {};
+    const double rec_ratio = recorded.wheel_diameter_right_m / recorded.wheel_diameter_left_m;
+    return {{"ratio", it->second * rec_ratio}, {"error_ppm", 1e6 * it->second}};
+  }
+  if (kind == sim::EffectKind::kScaleError) {
+    const ParamVector g = GivenParams(recorded, given.params);
+    std::map<std::string, double> out = raw_se;
+    if (const auto it = raw_se.find("s"); it != raw_se.end()) out["s"] = it->second / (1.0 + g[kParamScale]);
+    return out;
+  }
+  return raw_se;
+}
+
+std::vector<ParameterCorrection> Corrections(sim::EffectKind kind, const std::map<std::string, double>& d,
+                                             const GivenModel& given) {
+  std::vector<ParameterCorrection> out;
+  const std::string name = sim::EffectToString(kind);
+  if (kind == sim::EffectKind::kWheelbaseError) {
+    const double err = Get(d, "error_mm", 0.0);
+    out.push_back({name, "wheelbase_m", given.params.wheelbase_m, Get(d, "wheelbase_m", 0.0), "m",
+                   fmt::format("the simulation's wheelbase is {:.2f} mm ({:.2f} %) too {}: set wheelbase_m = {:.5f} "
+                               "(was {:.5f})",
+                               std::abs(err), 100.0 * std::abs(Get(d, "relative_error", 0.0)),
+                               err > 0.0 ? "long" : "short", Get(d, "wheelbase_m", 0.0), given.params.wheelbase_m)});
+  } else if (kind == sim::EffectKind::kDiameterRatioError) {
+    const double ppm = Get(d, "error_ppm", 0.0);
+    const std::string text = fmt::format(
+        "the simulation's wheel-diameter ratio D_R/D_L is {:.0f} ppm ({:.3f} %) too {}: set wheel_diameter_left_m "
+        "= {:.6f}, wheel_diameter_right_m = {:.6f} (were {:.6f}, {:.6f}; mean diameter kept)",
+        std::abs(ppm), 1e-4 * std::abs(ppm), ppm > 0.0 ? "large" : "small", Get(d, "wheel_diameter_left_m", 0.0),
+        Get(d, "wheel_diameter_right_m", 0.0), given.params.wheel_diameter_left_m,
+        given.params.wheel_diameter_right_m);
+    out.push_back({name, "wheel_diameter_left_m", given.params.wheel_diameter_left_m,
+                   Get(d, "wheel_diameter_left_m", 0.0), "m", text});
+    out.push_back({name, "wheel_diameter_right_m", given.params.wheel_diameter_right_m,
+                   Get(d, "wheel_diameter_right_m", 0.0), "m", text});
+  } else if (kind == sim::EffectKind::kWheelNoiseError) {
+    const std::string text = fmt::format(
+        "the simulation's wheel noise is off by x{:.2f} (left) and x{:.2f} (right): set k_L = {:.3g}, k_R = {:.3g} "
+        "m^1/2 (were {:.3g}, {:.3g})",
+        Get(d, "ratio_L", 0.0), Get(d, "ratio_R", 0.0), Get(d, "k_L", 0.0), Get(d, "k_R", 0.0), given.k_L, given.k_R);
+    out.push_back({name, "k_L", given.k_L, Get(d, "k_L", 0.0), "m^1/2", text});
+    out.push_back({name, "k_R", given.k_R, Get(d, "k_R", 0.0), "m^1/2", text});
+  }
+  return out;
+}
+
+}  // namespace umbmark::diag
