@@ -296,3 +296,23 @@ TEST_CASE("CLI: a robot fault found while reading a file names the file, not <in
   CHECK(r.err.find(csv + ":2: run 1: ticks_per_rev is required") != std::string::npos);
   CHECK(r.err.find("<input>") == std::string::npos);
 }
+
+TEST_CASE("streaming: a row starting with blanks after a buffer refill is split where it starts", "[io][stream]") {
+  // fuzz_csv found it: Next() kept a pointer to the row taken before
+  // SkipIfBlankOrComment() refilled (moved or grew) the buffer, so the cells
+  // and the error column came from stale bytes (heap-use-after-free when
+  // the buffer grew).
+  const std::string header = "run,direction,t_s,ticks_left,ticks_right,x_gt_m,y_gt_m,theta_gt_rad\n";
+  // The input it found (read whole: column 8 of line 9; 7-byte chunks
+  // through a 1-byte buffer: column 2).
+  CheckAllChunkings(std::string(
+      "# trajecticks; ground truer sample ()CF\x0dLR\x0arun,direction,t_s,ticks_left,ticks_right,x_gt_m,y_g"
+      "t_m,theta_gt_rad\x0d\x0a" "1,cw,0.00,1000,-5,0,0,0\x0d\x0a" "1,cw,0.05,1010,6,,,\x0d\x0a# nohing mea"
+      "su\x05" "ed yet\xe9\xe9\xe9\xe9\xe9\xe9\xe9\xe9\xe9\xe9\xe9\xe9\xe9\xe9\xe9\xe9\xe9\xe9\xe9\xe9\xe9\xe9"
+      "\xe9\xe9\xe9\xe9\xe9\xe9\xe9\x0a   \x0a#\xa9\xa9\xa9\xa9\xa9\xff\xa9\xa9\xa9\xa9\xa9\xb9\xa9\xa9vvvv"
+      "vvvvvvvvvvvvvvvvvvvvvvvvvvvvvvvv\xa9\xa9\xa9\xa9\xa9\xa9\xa9\xa9\x0a\x0a  \xff\xff\xff\x02 \x0a\x00\x00"
+      "\x0a\x00=====3========\x0d=\x0a===u\x8c\xd1",
+      309));
+  CheckAllChunkings(header + "1,cw,0,0,0,0,0,0\n   \t  1,cw,0.1,5,6,0.01,0,0\n");
+  CheckAllChunkings(header + "\n      \"r,1\",cw,0,0,0,0,0,0\n   \"r,1\" ,cw,0.1,1,1,0,0,0\n");
+}

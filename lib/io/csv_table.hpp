@@ -265,9 +265,11 @@ inline bool CsvReader::Next() {
   using csv_internal::IsBlank;
   for (;;) {
     if (pos_ == len_ && !Fill()) return false;
-    const char* const b = buf_.get() + pos_;
-    const char c0 = *b;
+    const char c0 = buf_[pos_];
     if ((c0 == '#' || c0 == '\n' || c0 == '\r' || IsBlank(c0)) && SkipIfBlankOrComment()) continue;
+    // Taken only now: SkipIfBlankOrComment may have refilled (moved or
+    // grown) the buffer even when the line holds content.
+    const char* const b = buf_.get() + pos_;
     // One pass: split at commas up to the line end.
     const char* const end = buf_.get() + len_;
     const std::size_t expected = cells_.size();
