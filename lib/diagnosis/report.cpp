@@ -63,9 +63,7 @@ nlohmann::json ExplanationJson(const DiagnoseSummary& s) {
   return steps;
 }
 
-}  // namespace
-
-nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
+nlohmann::json WhereJson(const DiagnoseSummary& s) {
   nlohmann::json where = nlohmann::json::array();
   for (const auto& w : s.where) {
     where.push_back({{"experiment", w.experiment + 1},
@@ -76,6 +74,10 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
                      {"size_se", Num(w.z)},
                      {"n", w.n}});
   }
+  return where;
+}
+
+nlohmann::json CandidatesJson(const DiagnoseSummary& s) {
   nlohmann::json cands = nlohmann::json::array();
   for (const auto& c : s.candidates) {
     nlohmann::json params = nlohmann::json::object(), se = nlohmann::json::object();
@@ -100,7 +102,10 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
                      {"note", c.note},
                      {"unphysical", UnphysicalFit(sim::EffectToString(c.effect), c.params, s.baseline.runs, c.param_se)}});
   }
-  const BaselineSummary& b = s.baseline;
+  return cands;
+}
+
+nlohmann::json BaselineJson(const BaselineSummary& b) {
   nlohmann::json returns = nlohmann::json::array();
   for (const auto& r : b.returns) {
     returns.push_back({{"experiment", r.experiment + 1},
@@ -119,12 +124,165 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
                       {"observed_rms", Vec(g.observed_rms)},
                       {"predicted_rms", Vec(g.predicted_rms)}});
   }
+  return {{"E_d", Num(b.E_d)},
+          {"E_b", Num(b.E_b)},
+          {"k_L", Num(b.k_L)},
+          {"k_R", Num(b.k_R)},
+          {"sigma_xy_m", Num(b.sigma_xy_m)},
+          {"sigma_theta_rad", Num(b.sigma_theta_rad)},
+          {"ground_truth_noise_estimated", b.ground_truth_estimated},
+          {"start", b.start},
+          {"return_error_noise_fit",
+           b.return_fit ? nlohmann::json{{"k_L", Num(b.return_k_L)},
+                                         {"k_R", Num(b.return_k_R)},
+                                         {"k_L_ci95", {Num(b.return_k_L_ci[0]), Num(b.return_k_L_ci[1])}},
+                                         {"k_R_ci95", {Num(b.return_k_R_ci[0]), Num(b.return_k_R_ci[1])}}}
+                        : nlohmann::json(b.return_fit_note)},
+          {"runs", b.runs},
+          {"pieces", b.pieces},
+          {"return_errors", returns},
+          {"residual_growth", growth}};
+}
+
+// The readable report, one function per numbered section.
+struct TextReport {
+  std::string text;
+  void line(const std::string& t) { text += t + "\n"; }
+};
+
+void BaselineSection(TextReport& o, const DiagnoseSummary& s) {
+  const BaselineSummary& b = s.baseline;
+  o.line("Diagnosis of the sim-to-real gap");
+  for (const auto& l : s.experiment_labels) o.line("  experiment " + l);
+  o.line("");
+  o.line("1. Baseline (E_d, E_b, k_L, k_R; ground-truth noise " +
+         std::string(b.ground_truth_estimated ? "estimated" : "as stated in the manifest") + ")");
+  o.line(fmt::format("  E_d = {:.6f}   E_b = {:.6f}   k_L = {:.3g} m^1/2   k_R = {:.3g} m^1/2", b.E_d, b.E_b, b.k_L, b.k_R));
+  o.line(fmt::format("  ground truth: sigma_xy = {:.3g} mm, sigma_theta = {:.3g} mrad; start: {}", 1e3 * b.sigma_xy_m,
+                     1e3 * b.sigma_theta_rad, b.start));
+  o.line(fmt::format("  {} runs, {} pieces", b.runs, b.pieces));
+  if (b.return_fit)
+    o.line(fmt::format("  cross-check, fit-noise on the runs' return errors: k_L = {:.3g} [{:.3g}, {:.3g}], k_R = {:.3g} "
+                       "[{:.3g}, {:.3g}] m^1/2 (95%)",
+                       b.return_k_L, b.return_k_L_ci[0], b.return_k_L_ci[1], b.return_k_R, b.return_k_R_ci[0],
+                       b.return_k_R_ci[1]));
+  else if (!b.return_fit_note.empty())
+    o.line("  " + b.return_fit_note);
+  o.line("  return errors per experiment and direction (mean x, y [mm], theta [mrad]; sd from the covariance):");
+  for (const auto& r : b.returns) {
+    o.line(fmt::format("    exp {} {:<10} {:>3} runs  observed ({:+8.2f}, {:+8.2f}, {:+8.2f}) sd ({:6.2f}, {:6.2f}, {:6.2f})",
+                       r.experiment + 1, r.direction, r.runs, 1e3 * r.observed_mean[0], 1e3 * r.observed_mean[1],
+                       1e3 * r.observed_mean[2], 1e3 * std::sqrt(r.observed_cov(0, 0)),
+                       1e3 * std::sqrt(r.observed_cov(1, 1)), 1e3 * std::sqrt(r.observed_cov(2, 2))));
+    o.line(fmt::format("    {:<24}  predicted ({:+8.2f}, {:+8.2f}, {:+8.2f}) sd ({:6.2f}, {:6.2f}, {:6.2f})", "",
+                       1e3 * r.predicted_mean[0], 1e3 * r.predicted_mean[1], 1e3 * r.predicted_mean[2],
+                       1e3 * std::sqrt(r.predicted_cov(0, 0)), 1e3 * std::sqrt(r.predicted_cov(1, 1)),
+                       1e3 * std::sqrt(r.predicted_cov(2, 2))));
+  }
+  o.line("  residual growth per segment type (RMS per piece x [mm], y [mm], theta [mrad]: observed / predicted):");
+  for (const auto& g : b.growth) {
+    o.line(fmt::format("    {:<13} {:>5} pieces, {:6.3f} m each: x {:6.2f}/{:6.2f}  y {:6.2f}/{:6.2f}  theta {:6.2f}/{:6.2f}",
+                       PieceTypeToString(g.type), g.pieces, g.mean_travel_m, 1e3 * g.observed_rms[0],
+                       1e3 * g.predicted_rms[0], 1e3 * g.observed_rms[1], 1e3 * g.predicted_rms[1],
+                       1e3 * g.observed_rms[2], 1e3 * g.predicted_rms[2]));
+  }
+  o.line("");
+}
+
+void WhereSection(TextReport& o, const DiagnoseSummary& s) {
+  o.line(fmt::format("2. Where: gap score G = {:.2f} (null median {:.2f}, {:.0f}% quantile {:.2f}); p = {} from {} "
+                     "simulations of the baseline",
+                     s.gap_score, s.null_median, 100.0 * (1.0 - s.alpha), s.null_quantile_alpha, FormatP(s.score_p_value),
+                     s.null_simulations));
+  if (s.tests > 0)
+    o.line(fmt::format("   likelihood-ratio tests of the candidates: p = {} (Bonferroni over {}); combined p = {} "
+                       "-> {}",
+                       FormatP(s.tests_p_value), s.tests, FormatP(s.p_value), s.significant ? "significant" : "not significant"));
+  else
+    o.line(fmt::format("   p = {} -> {}", FormatP(s.p_value), s.significant ? "significant" : "not significant"));
+  for (const auto& w : s.where) {
+    o.line(fmt::format("    {:+8.2f} SE  {:<6} {:<40} {:<11} {}", w.z,
+                       w.experiment >= 0 ? fmt::format("exp {}", w.experiment + 1) : std::string("all"), w.subset,
+                       StatKindToString(w.statistic), w.component));
+  }
+  o.line("");
+}
+
+void CandidatesSection(TextReport& o, const DiagnoseSummary& s) {
+  const BaselineSummary& b = s.baseline;
+  o.line("3. Which: candidate effects (best first; shrink = 1 - gap after / gap before)");
+  o.line(fmt::format("    {:<20} {:>8} {:>9} {:>11} {:>10}  {}", "effect", "shrink", "held-out", "evidence", "LR p",
+                     "parameters"));
+  for (const auto& c : s.candidates) {
+    std::string params;
+    for (const auto& [k, v] : c.params) {
+      const auto se = c.param_se.find(k);
+      params += FormatEffectParam(k, v, se != c.param_se.end() ? se->second : NAN) + "  ";
+    }
+    if (!c.note.empty()) params += "(" + c.note + ")";
+    if (const auto why = UnphysicalFit(sim::EffectToString(c.effect), c.params, b.runs, c.param_se); !why.empty())
+      params += " IMPOSSIBLE VALUE, a symptom (the gap is something else): " + why;
+    o.line(fmt::format("    {:<20} {:>8.3f} {:>9.3f} {:>9.1f} n {:>10}  {}", sim::EffectToString(c.effect), c.shrink,
+                       c.heldout_shrink, c.evidence, c.tested ? FormatP(c.lr_p_value) : std::string("-"),
+                       params));
+  }
+  o.line("");
+}
+
+void ExplanationSection(TextReport& o, const DiagnoseSummary& s) {
+  if (!s.explanation.empty()) {
+    o.line("");
+    o.line(fmt::format("   Stepwise explanation (effects added one at a time, fitted jointly; stops: {}):",
+                       s.explanation_stop));
+    o.line("    step effect                 cumulative shrink  held-out   size (mm / mrad, x scatter)  parameters");
+    int k = 0;
+    for (const auto& e : s.explanation) {
+      std::string params;
+      for (const auto& [n, v] : e.params) params += FormatParam(n, v) + "  ";
+      o.line(fmt::format("    {:>4} {:<22} {:>17.0f}% {:>8.0f}%   {:>7.2f} / {:>6.2f}, x {:<5.2f}{}  {}", ++k,
+                         sim::EffectToString(e.effect), 100.0 * e.cumulative_shrink, 100.0 * e.cumulative_heldout_shrink,
+                         e.size_mm, e.size_mrad, e.relative_size, e.negligible ? " (negligible)" : "", params));
+    }
+    o.line(fmt::format("    unexplained on held-out runs: {:.0f}%; negligible = size below {:.2g} x the noise of one "
+                       "piece (<= 1 m of travel or a spot turn)",
+                       100.0 * s.unexplained_fraction, s.negligible_threshold));
+  }
+  o.line("");
+}
+
+void VerdictSection(TextReport& o, const DiagnoseSummary& s) {
+  o.line("4. Verdict: " + s.verdict +
+         (s.verdict_effects.size() > 1 ? fmt::format(" (effects: {})", fmt::join(s.verdict_effects, ", ")) : ""));
+  o.line("  " + s.verdict_reason);
+  for (const auto& i : s.indistinguishable) o.line("  cannot tell apart: " + i);
+  for (const auto& n : s.notes) o.line("  note: " + n);
+  if (const Candidate* w = Winner(s); w && s.verdict != "none")
+    o.line(std::string("  evidence for ") + sim::EffectToString(w->effect) + ": " +
+           EvidenceInWords(w->heldout_loglik_gain, w->evidence, w->heldout_shrink));
+  o.line("");
+  o.line("What to do next:");
+  for (std::size_t i = 0; i < s.next_steps.size(); ++i) o.line(fmt::format("  {}. {}", i + 1, s.next_steps[i]));
+  o.line("");
+  if (const std::string given = GivenModelReport(s); !given.empty()) {
+    o.text += given;
+    o.line("");
+  }
+}
+
+void TimingSection(TextReport& o, const DiagnoseSummary& s) {
+  o.line("Time per stage:");
+  for (const auto& [k, v] : s.timings) o.line(fmt::format("  {:<42} {:8.3f} s", k, v));
+}
+
+}  // namespace
+
+nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
   nlohmann::json timing = nlohmann::json::object();
   for (const auto& [k, v] : s.timings) timing[k] = Num(v);
   nlohmann::json j = {{"gap",
            {{"score", Num(s.gap_score)},
             {"p_value", Num(s.p_value)},
-            {"where", where},
+            {"where", WhereJson(s)},
             {"score_p_value", Num(s.score_p_value)},
             {"tests_p_value", Num(s.tests_p_value)},
             {"tests", s.tests},
@@ -135,7 +293,7 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
             {"null_quantile_1_minus_alpha", Num(s.null_quantile_alpha)},
             {"by_statistic", ByKind(s.gap_by_kind)},
             {"seed", s.seed}}},
-          {"candidates", cands},
+          {"candidates", CandidatesJson(s)},
           {"explanation", ExplanationJson(s)},
           {"verdict",
            {{"effect", s.verdict},
@@ -144,25 +302,7 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
             {"reason", s.verdict_reason},
             {"negligible_threshold", Num(s.negligible_threshold)}}},
           {"indistinguishable", s.indistinguishable},
-          {"baseline",
-           {{"E_d", Num(b.E_d)},
-            {"E_b", Num(b.E_b)},
-            {"k_L", Num(b.k_L)},
-            {"k_R", Num(b.k_R)},
-            {"sigma_xy_m", Num(b.sigma_xy_m)},
-            {"sigma_theta_rad", Num(b.sigma_theta_rad)},
-            {"ground_truth_noise_estimated", b.ground_truth_estimated},
-            {"start", b.start},
-            {"return_error_noise_fit",
-             b.return_fit ? nlohmann::json{{"k_L", Num(b.return_k_L)},
-                                           {"k_R", Num(b.return_k_R)},
-                                           {"k_L_ci95", {Num(b.return_k_L_ci[0]), Num(b.return_k_L_ci[1])}},
-                                           {"k_R_ci95", {Num(b.return_k_R_ci[0]), Num(b.return_k_R_ci[1])}}}
-                          : nlohmann::json(b.return_fit_note)},
-            {"runs", b.runs},
-            {"pieces", b.pieces},
-            {"return_errors", returns},
-            {"residual_growth", growth}}},
+          {"baseline", BaselineJson(s.baseline)},
           {"experiments", s.experiment_labels},
           {"piece_residuals", PieceResidualsToJson(s.piece_residuals)},
           {"notes", s.notes},
@@ -173,114 +313,14 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
 }
 
 std::string DiagnoseReport(const DiagnoseSummary& s) {
-  std::string out;
-  auto line = [&](const std::string& t) { out += t + "\n"; };
-  const BaselineSummary& b = s.baseline;
-  line("Diagnosis of the sim-to-real gap");
-  for (const auto& l : s.experiment_labels) line("  experiment " + l);
-  line("");
-  line("1. Baseline (E_d, E_b, k_L, k_R; ground-truth noise " +
-       std::string(b.ground_truth_estimated ? "estimated" : "as stated in the manifest") + ")");
-  line(fmt::format("  E_d = {:.6f}   E_b = {:.6f}   k_L = {:.3g} m^1/2   k_R = {:.3g} m^1/2", b.E_d, b.E_b, b.k_L, b.k_R));
-  line(fmt::format("  ground truth: sigma_xy = {:.3g} mm, sigma_theta = {:.3g} mrad; start: {}", 1e3 * b.sigma_xy_m,
-                   1e3 * b.sigma_theta_rad, b.start));
-  line(fmt::format("  {} runs, {} pieces", b.runs, b.pieces));
-  if (b.return_fit)
-    line(fmt::format("  cross-check, fit-noise on the runs' return errors: k_L = {:.3g} [{:.3g}, {:.3g}], k_R = {:.3g} "
-                     "[{:.3g}, {:.3g}] m^1/2 (95%)",
-                     b.return_k_L, b.return_k_L_ci[0], b.return_k_L_ci[1], b.return_k_R, b.return_k_R_ci[0],
-                     b.return_k_R_ci[1]));
-  else if (!b.return_fit_note.empty())
-    line("  " + b.return_fit_note);
-  line("  return errors per experiment and direction (mean x, y [mm], theta [mrad]; sd from the covariance):");
-  for (const auto& r : b.returns) {
-    line(fmt::format("    exp {} {:<10} {:>3} runs  observed ({:+8.2f}, {:+8.2f}, {:+8.2f}) sd ({:6.2f}, {:6.2f}, {:6.2f})",
-                     r.experiment + 1, r.direction, r.runs, 1e3 * r.observed_mean[0], 1e3 * r.observed_mean[1],
-                     1e3 * r.observed_mean[2], 1e3 * std::sqrt(r.observed_cov(0, 0)),
-                     1e3 * std::sqrt(r.observed_cov(1, 1)), 1e3 * std::sqrt(r.observed_cov(2, 2))));
-    line(fmt::format("    {:<24}  predicted ({:+8.2f}, {:+8.2f}, {:+8.2f}) sd ({:6.2f}, {:6.2f}, {:6.2f})", "",
-                     1e3 * r.predicted_mean[0], 1e3 * r.predicted_mean[1], 1e3 * r.predicted_mean[2],
-                     1e3 * std::sqrt(r.predicted_cov(0, 0)), 1e3 * std::sqrt(r.predicted_cov(1, 1)),
-                     1e3 * std::sqrt(r.predicted_cov(2, 2))));
-  }
-  line("  residual growth per segment type (RMS per piece x [mm], y [mm], theta [mrad]: observed / predicted):");
-  for (const auto& g : b.growth) {
-    line(fmt::format("    {:<13} {:>5} pieces, {:6.3f} m each: x {:6.2f}/{:6.2f}  y {:6.2f}/{:6.2f}  theta {:6.2f}/{:6.2f}",
-                     PieceTypeToString(g.type), g.pieces, g.mean_travel_m, 1e3 * g.observed_rms[0],
-                     1e3 * g.predicted_rms[0], 1e3 * g.observed_rms[1], 1e3 * g.predicted_rms[1],
-                     1e3 * g.observed_rms[2], 1e3 * g.predicted_rms[2]));
-  }
-  line("");
-  line(fmt::format("2. Where: gap score G = {:.2f} (null median {:.2f}, {:.0f}% quantile {:.2f}); p = {} from {} "
-                   "simulations of the baseline",
-                   s.gap_score, s.null_median, 100.0 * (1.0 - s.alpha), s.null_quantile_alpha, FormatP(s.score_p_value),
-                   s.null_simulations));
-  if (s.tests > 0)
-    line(fmt::format("   likelihood-ratio tests of the candidates: p = {} (Bonferroni over {}); combined p = {} "
-                     "-> {}",
-                     FormatP(s.tests_p_value), s.tests, FormatP(s.p_value), s.significant ? "significant" : "not significant"));
-  else
-    line(fmt::format("   p = {} -> {}", FormatP(s.p_value), s.significant ? "significant" : "not significant"));
-  for (const auto& w : s.where) {
-    line(fmt::format("    {:+8.2f} SE  {:<6} {:<40} {:<11} {}", w.z,
-                     w.experiment >= 0 ? fmt::format("exp {}", w.experiment + 1) : std::string("all"), w.subset,
-                     StatKindToString(w.statistic), w.component));
-  }
-  line("");
-  line("3. Which: candidate effects (best first; shrink = 1 - gap after / gap before)");
-  line(fmt::format("    {:<20} {:>8} {:>9} {:>11} {:>10}  {}", "effect", "shrink", "held-out", "evidence", "LR p",
-                   "parameters"));
-  for (const auto& c : s.candidates) {
-    std::string params;
-    for (const auto& [k, v] : c.params) {
-      const auto se = c.param_se.find(k);
-      params += FormatEffectParam(k, v, se != c.param_se.end() ? se->second : NAN) + "  ";
-    }
-    if (!c.note.empty()) params += "(" + c.note + ")";
-    if (const auto why = UnphysicalFit(sim::EffectToString(c.effect), c.params, b.runs, c.param_se); !why.empty())
-      params += " IMPOSSIBLE VALUE, a symptom (the gap is something else): " + why;
-    line(fmt::format("    {:<20} {:>8.3f} {:>9.3f} {:>9.1f} n {:>10}  {}", sim::EffectToString(c.effect), c.shrink,
-                     c.heldout_shrink, c.evidence, c.tested ? FormatP(c.lr_p_value) : std::string("-"),
-                     params));
-  }
-  line("");
-  if (!s.explanation.empty()) {
-    line("");
-    line(fmt::format("   Stepwise explanation (effects added one at a time, fitted jointly; stops: {}):",
-                     s.explanation_stop));
-    line("    step effect                 cumulative shrink  held-out   size (mm / mrad, x scatter)  parameters");
-    int k = 0;
-    for (const auto& e : s.explanation) {
-      std::string params;
-      for (const auto& [n, v] : e.params) params += FormatParam(n, v) + "  ";
-      line(fmt::format("    {:>4} {:<22} {:>17.0f}% {:>8.0f}%   {:>7.2f} / {:>6.2f}, x {:<5.2f}{}  {}", ++k,
-                       sim::EffectToString(e.effect), 100.0 * e.cumulative_shrink, 100.0 * e.cumulative_heldout_shrink,
-                       e.size_mm, e.size_mrad, e.relative_size, e.negligible ? " (negligible)" : "", params));
-    }
-    line(fmt::format("    unexplained on held-out runs: {:.0f}%; negligible = size below {:.2g} x the noise of one "
-                     "piece (<= 1 m of travel or a spot turn)",
-                     100.0 * s.unexplained_fraction, s.negligible_threshold));
-  }
-  line("");
-  line("4. Verdict: " + s.verdict +
-       (s.verdict_effects.size() > 1 ? fmt::format(" (effects: {})", fmt::join(s.verdict_effects, ", ")) : ""));
-  line("  " + s.verdict_reason);
-  for (const auto& i : s.indistinguishable) line("  cannot tell apart: " + i);
-  for (const auto& n : s.notes) line("  note: " + n);
-  if (const Candidate* w = Winner(s); w && s.verdict != "none")
-    line(std::string("  evidence for ") + sim::EffectToString(w->effect) + ": " +
-         EvidenceInWords(w->heldout_loglik_gain, w->evidence, w->heldout_shrink));
-  line("");
-  line("What to do next:");
-  for (std::size_t i = 0; i < s.next_steps.size(); ++i) line(fmt::format("  {}. {}", i + 1, s.next_steps[i]));
-  line("");
-  if (const std::string given = GivenModelReport(s); !given.empty()) {
-    out += given;
-    line("");
-  }
-  line("Time per stage:");
-  for (const auto& [k, v] : s.timings) line(fmt::format("  {:<42} {:8.3f} s", k, v));
-  return out;
+  TextReport o;
+  BaselineSection(o, s);
+  WhereSection(o, s);
+  CandidatesSection(o, s);
+  ExplanationSection(o, s);
+  VerdictSection(o, s);
+  TimingSection(o, s);
+  return o.text;
 }
 
 std::string DiagnosePlotSvg(const DiagnoseSummary& s) {
