@@ -165,6 +165,9 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, Diagnose
 
 }  // namespace
 
+// The diagnosis as its numbered stages, each a call into its own file. About
+// 95 lines because each stage's options are filled from DiagnoseOptions here,
+// in place, so that every route of a user's option is visible in one place.
 DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) {
   if (auto e = options.Check(); !e.empty()) throw InvalidOptions("diagnose: " + e);
   DiagnoseSummary out;

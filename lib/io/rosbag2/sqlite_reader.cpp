@@ -31,6 +31,10 @@ std::string Text(sqlite3_stmt* s, int col) {
 
 void SqliteBagFile::Fail(const std::string& what) const { throw InputError(path_, what); }
 
+// Long because opening a bag read-only without writing beside it (WAL and
+// rollback journals), checking the rosbag2 schema (Humble and Jazzy) and
+// preparing the statements must all succeed before the handle is kept; any
+// failure closes the handle on the way out (no leak on a throwing constructor).
 SqliteBagFile::SqliteBagFile(std::string path) : path_(std::move(path)) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path_, ec)) Fail("not a regular file");
