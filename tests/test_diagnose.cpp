@@ -20,6 +20,7 @@
 #include "diagnosis/piece_noise.hpp"
 #include "io/campaign_writer.hpp"
 #include "simulation/campaign_sim.hpp"
+#include "support/diag_campaign.hpp"
 #include "support/run_cli.hpp"
 
 using namespace umbmark;
@@ -29,15 +30,6 @@ using Catch::Matchers::WithinRel;
 
 namespace {
 
-RobotParams Robot(bool ticks = true) {
-  RobotParams r;
-  r.wheelbase_m = 0.35;
-  r.wheel_diameter_left_m = 0.1;
-  r.wheel_diameter_right_m = 0.1;
-  if (ticks) r.ticks_per_rev = 8192;
-  return r;
-}
-
 /// A small campaign: `square_runs` cw and ccw squares of 2 m, `bf_runs`
 /// back-and-forth runs of 2 m, optionally 3 figure-eights; 10 Hz, 0.5 m/s.
 struct Small {
@@ -46,25 +38,16 @@ struct Small {
 };
 
 Small MakeSmall(std::uint64_t seed, int square_runs = 5, int bf_runs = 10, bool free = false, bool ticks = true) {
-  Small s;
-  s.manifest = sim::StandardCampaignManifest(Robot(ticks), 2.0, 2.0, GroundTruthNoise{3e-4, 1.5e-3});
+  const testing::SmallCampaign base = testing::MakeSmallCampaign(seed, square_runs, bf_runs);
+  Small s{base.manifest, base.sim};
+  if (!ticks) s.manifest.robot.ticks_per_rev.reset();
   if (free) {
     Experiment e;
     e.kind = ExperimentKind::kFree;
     e.file = e.resolved_file = "free.csv";
     s.manifest.experiments.push_back(e);
   }
-  s.sim.seed = seed;
-  s.sim.truth.E_d = 1.004;
-  s.sim.truth.E_b = 1.012;
-  s.sim.truth.k_L = 1.5e-3;
-  s.sim.truth.k_R = 2.5e-3;
-  s.sim.square_runs_per_direction = square_runs;
-  s.sim.back_and_forth_runs = bf_runs;
   s.sim.free_runs = 3;
-  s.sim.sample_rate_hz = 10.0;
-  s.sim.speed_m_s = 0.5;
-  s.sim.pause_s = 0.5;
   return s;
 }
 
