@@ -154,8 +154,9 @@ Command SetupDiagnose(CLI::App& parent) {
                 "Measure motions from/to single ground-truth samples (default: the adjacent standstills' mean pose)");
   app->add_option("--negligible", d.negligible,
                   "Practical significance: effects that move the predicted pose over a run by less than this "
-                  "fraction of the noise of one piece (<= 1 m or a spot turn) are negligible, never the verdict "
-                  "(default 0.25)")
+                  "fraction of the noise of one piece (<= 1 m or a spot turn), and noise effects that widen the "
+                  "pose spread of the pieces they act on (median per piece type, the type widened most) by less "
+                  "than this fraction, are negligible, never the verdict (default 0.25)")
       ->check(CLI::NonNegativeNumber);
   app->add_option("--max-effects", d.max_explanation_effects, "Most effects in the stepwise explanation (default 4)")
       ->check(CLI::Range(1, 12));

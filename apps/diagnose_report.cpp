@@ -335,15 +335,23 @@ void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
                     ParamsText(e.value("params", nlohmann::json::object()), nlohmann::json::object()),
                     Percent(Number(e, "cumulative_heldout_shrink")), Percent(Number(e, "cumulative_shrink")),
                     fmt::format("{:.2f} mm / {:.2f} mrad", Number(e, "size_mm"), Number(e, "size_mrad")),
-                    fmt::format("{:.2f}{}", Number(e, "relative_size"), e.value("negligible", false) ? " (negligible)" : "")});
+                    // A noise effect's size: the growth of one piece type's spread.
+                    e.contains("size_pieces")
+                        ? fmt::format("+{:.0f}% sd of {} pieces{}", 100.0 * Number(e, "relative_size"),
+                                      e.value("size_pieces", "?"), e.value("negligible", false) ? " (negligible)" : "")
+                        : fmt::format("{:.2f}{}", Number(e, "relative_size"),
+                                      e.value("negligible", false) ? " (negligible)" : "")});
   rep.Table({"step", "effect", "parameters", "gap closed, held-out", "in-sample", "size over a run",
              "size / noise of one piece"},
             rows, 3);
   const auto& v = j.at("verdict");
   rep.Paragraph(fmt::format("{} of the gap stays unexplained on held-out runs. An effect is negligible when its size is "
-                            "below {:.2g} x the noise of one piece (1 m of travel or a spot turn): then it is reported "
-                            "but never the verdict.",
-                            Percent(Number(v, "unexplained_fraction")), Number(v, "negligible_threshold")));
+                            "below {:.2g} x the noise of one piece (1 m of travel or a spot turn), or, for a noise "
+                            "effect, when it widens the pose spread of the pieces it acts on by less than {:.0f}% "
+                            "(median per piece type, the type it widens most): then it is reported but never the "
+                            "verdict.",
+                            Percent(Number(v, "unexplained_fraction")), Number(v, "negligible_threshold"),
+                            100.0 * Number(v, "negligible_threshold")));
 }
 
 /// The largest piece residuals, numbered as in the plot.

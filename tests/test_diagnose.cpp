@@ -556,3 +556,43 @@ TEST_CASE("diagnose: run_time_offset is found, tau_sd recovered", "[diagnose][ne
   // 40 runs: the sd of 40 draws is within ~25 % of tau_sd (3 sigma).
   CHECK_THAT(c->params.at("tau_sd"), WithinRel(0.05, 0.35));
 }
+
+TEST_CASE("diagnose: a noise floor's size is the growth of the spread of the pieces it widens most",
+          "[diagnose][negligible][new-effects]") {
+  // motion_noise_floor adds N(0, sigma^2) to each wheel once per motion, so
+  // a spot turn (one piece from standstill to standstill) gains a heading
+  // sd of sqrt(2) sigma / b; a 2 m leg, split in two pieces, sigma / b per
+  // piece. Against the wheel noise of a 90 deg turn (0.27 m per wheel) a
+  // 2 mm floor widens the spread by more than half; 0.2 mm (fitted at
+  // about 0.5 mm here, seed 74) by about an eighth: significant, negligible.
+  const double b = 0.35;
+  Small s = MakeSmall(74, 10, 20);
+  s.sim.effects.floor_sigma = 0.002;
+  DiagnoseSummary d = Diagnose(Build(s), Fast());
+  INFO(d.verdict_reason);
+  CHECK(d.verdict == "motion_noise_floor");
+  REQUIRE_FALSE(d.explanation.empty());
+  const ExplanationStep& healthy = d.explanation.front();
+  CHECK(healthy.effect == sim::EffectKind::kMotionNoiseFloor);
+  CHECK_FALSE(healthy.negligible);
+  CHECK(healthy.size_pieces == "spot turn");
+  CHECK(healthy.relative_size > 0.5);
+  CHECK_THAT(healthy.size_mrad, WithinRel(1e3 * std::sqrt(2.0) * 0.002 / b, 0.15));
+  const nlohmann::json j = DiagnoseToJson(d);
+  CHECK(j.at("explanation").at(0).at("size_pieces") == "spot turn");
+
+  s.sim.effects.floor_sigma = 0.0002;
+  const CampaignData tiny = Build(s);
+  DiagnoseOptions all = Fast();
+  all.negligible = 0.0;  // significant: named when every size counts
+  d = Diagnose(tiny, all);
+  INFO(d.verdict_reason);
+  CHECK(d.verdict == "motion_noise_floor");
+  d = Diagnose(tiny, Fast());
+  CHECK(d.verdict == "none");
+  REQUIRE_FALSE(d.explanation.empty());
+  CHECK(d.explanation.front().effect == sim::EffectKind::kMotionNoiseFloor);
+  CHECK(d.explanation.front().negligible);
+  CHECK(d.explanation.front().relative_size < 0.25);
+  CHECK(d.explanation.front().size_mrad < 1e3 * std::sqrt(2.0) * 0.001 / b);
+}

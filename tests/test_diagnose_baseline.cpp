@@ -188,6 +188,11 @@ TEST_CASE("diagnose --baseline: wheel noise given x2 and x0.5 is named, the rati
     CHECK_FALSE(s->negligible);
     CHECK_THAT(s->params.at("ratio_L"), WithinRel(1.0 / factor, 0.25));
     CHECK_THAT(s->params.at("ratio_R"), WithinRel(1.0 / factor, 0.25));
+    // The evidence is the likelihood, not the mean gap it does not change.
+    const std::string text = DiagnoseReport(d);
+    CHECK(text.find("evidence for wheel_noise_error: very strong evidence: runs not used to fit it are") !=
+          std::string::npos);
+    CHECK(text.find("not where they lie on average") != std::string::npos);
   }
 }
 

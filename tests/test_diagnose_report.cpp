@@ -100,6 +100,12 @@ TEST_CASE("report text: units, p-values, evidence in words, impossible fits", "[
   CHECK(EvidenceInWords(3.0, 2.0, 0.3).rfind("positive evidence", 0) == 0);
   CHECK(EvidenceInWords(-1.0, -3.0, -0.1).rfind("no evidence", 0) == 0);
   CHECK(EvidenceInWords(31.4, 29.4, 0.87).find("87%") != std::string::npos);
+  // A noise effect leads with the likelihood: e^20 = 4.85e8; the mean gap
+  // is not what it changes.
+  const std::string noise = EvidenceInWords(20.0, 18.0, 0.0, true);
+  CHECK(noise.rfind("very strong evidence: runs not used to fit it are 4.85e+08 times more probable with it "
+                    "(+20.0 nats held out; +18.0 after", 0) == 0);
+  CHECK(noise.find("not where they lie on average") != std::string::npos);
   // Impossible values are symptoms; plausible ones are not flagged.
   CHECK(UnphysicalFit("turn_scrub", {{"k", -0.2}}, 20).find("negative turn scrub") != std::string::npos);
   CHECK(UnphysicalFit("turn_scrub", {{"k", 0.05}}, 20).empty());

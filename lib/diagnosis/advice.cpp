@@ -46,7 +46,7 @@ std::string FormatPValue(double p) {
   return p < 1e-12 ? std::string("< 1e-12") : fmt::format("{:.3g}", p);
 }
 
-std::string EvidenceInWords(double gain, double evidence, double heldout_shrink) {
+std::string EvidenceInWords(double gain, double evidence, double heldout_shrink, bool noise_effect) {
   if (!std::isfinite(gain) || !std::isfinite(evidence)) return "not measured";
   const char* grade = evidence < 0.0   ? "no evidence"
                       : evidence < 1.0 ? "weak evidence"
@@ -55,6 +55,12 @@ std::string EvidenceInWords(double gain, double evidence, double heldout_shrink)
                                        : "very strong evidence";
   std::string odds = gain > 700.0 ? "overwhelmingly"
                                   : gain > 0.0 ? fmt::format("{:.3g} times", std::exp(gain)) : std::string("not");
+  if (noise_effect)
+    return fmt::format("{}: runs not used to fit it are {} more probable with it ({:+.1f} nats held out; {:+.1f} "
+                       "after the penalty for its parameters). It changes how widely the poses scatter, not where "
+                       "they lie on average, so the likelihood is its evidence; the gap score, which weighs the mean "
+                       "residuals too, closes by {:.0f}% with it on those runs",
+                       grade, odds, gain, evidence, 100.0 * std::max(heldout_shrink, 0.0));
   return fmt::format("{}: on runs not used to fit it the effect closes {:.0f}% of the gap, and those runs are {} more "
                      "probable with it ({:+.1f} nats; {:+.1f} after the penalty for its parameters)",
                      grade, 100.0 * std::max(heldout_shrink, 0.0), odds, gain, evidence);

@@ -33,7 +33,12 @@ std::string FormatPValue(double p);
 /// complexity penalty; `heldout_shrink`: fraction of the gap closed held
 /// out. Grades on the evidence in nats (Kass & Raftery 1995, on ln B):
 /// < 0 none, < 1 weak, < 3 positive, < 5 strong, else very strong.
-std::string EvidenceInWords(double heldout_gain_nats, double evidence_nats, double heldout_shrink);
+/// `noise_effect` (IsNoiseEffect: correlated_noise, bump_outliers,
+/// standstill_motion, motion_noise_floor, run_time_offset,
+/// wheel_noise_error): the sentence leads with the held-out likelihood and
+/// says the mean gap is not what such an effect changes.
+std::string EvidenceInWords(double heldout_gain_nats, double evidence_nats, double heldout_shrink,
+                            bool noise_effect = false);
 
 /// Why a fitted effect is physically impossible or implausible (empty when
 /// it is not): a negative or >= 1 turn scrub, a correlation at +-1, a wheel

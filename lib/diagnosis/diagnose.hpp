@@ -97,8 +97,9 @@ struct DiagnoseOptions {
   bool likelihood_tests = true;
   /// Practical significance: an effect whose size (explanation.hpp: how far
   /// it moves the predicted pose over a run, relative to the scatter of one
-  /// piece's motion under the baseline) is below this is negligible and
-  /// never named in the verdict. Default 0.25.
+  /// piece's motion under the explained model; for a noise effect how much
+  /// it widens the pose spread of the pieces it acts on, per piece type) is
+  /// below this is negligible and never named in the verdict. Default 0.25.
   double negligible = 0.25;
   /// Most effects in the stepwise explanation (>= 1). Default 4.
   int max_explanation_effects = 4;

@@ -135,6 +135,9 @@ std::map<std::string, double> ParamsOf(sim::EffectKind e, const SetFit& f) {
   return out;
 }
 
+/// Fewest pieces of one type whose median sizes a noise effect (Size).
+constexpr std::size_t kMinPiecesPerType = 5;
+
 double Median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -199,28 +202,46 @@ void Size(const CampaignData& c, const MeanModel& model, const BaselineFit& base
     return;
   }
   if (IsNoiseEffect(e)) {
-    // Variance components: how much they widen the noise of the pieces
-    // they act on (median over those pieces of the relative growth of the
-    // position and heading standard deviations, the larger counts), and
-    // their own standard deviation there [mm, mrad].
+    // Variance components act on some pieces only (a noise floor at the
+    // starts and stops of motions, settling at standstills) and matter
+    // most where the wheel noise is small: on short pieces. So the size is
+    // taken per piece type: for each type, the median over its pieces the
+    // effect acts on of the relative growth of the predicted position and
+    // heading sd (the larger counts), and its own sd there [mm, mrad]; the
+    // type where that median is largest counts (types with fewer than
+    // kMinPiecesPerType such pieces only when no type has that many).
     NoiseParams without = f.noise;
     if (e == sim::EffectKind::kStandstillMotion) without.stand_xy2 = without.stand_th2 = 0.0;
     if (e == sim::EffectKind::kMotionNoiseFloor) without.floor_s2 = 0.0;
     if (e == sim::EffectKind::kRunTimeOffset) without.run_tau2 = 0.0;
-    std::vector<double> rel, pos, head;
+    struct Spread {
+      std::vector<double> rel, pos, head;
+    };
+    std::map<PieceType, Spread> by_type;
     for (std::size_t j = 0; j < bases.size(); ++j) {
       const Eigen::Matrix3d A = PieceCovariance(bases[j], f.noise), B0 = PieceCovariance(bases[j], without);
       const double dp = A(0, 0) + A(1, 1) - B0(0, 0) - B0(1, 1), dh = A(2, 2) - B0(2, 2);
       if (!(dp > 0.0 || dh > 0.0)) continue;
       const double rp = std::sqrt((A(0, 0) + A(1, 1)) / std::max(B0(0, 0) + B0(1, 1), 1e-300)) - 1.0;
       const double rh = std::sqrt(A(2, 2) / std::max(B0(2, 2), 1e-300)) - 1.0;
-      rel.push_back(std::max(rp, rh));
-      pos.push_back(std::sqrt(std::max(dp, 0.0)));
-      head.push_back(std::sqrt(std::max(dh, 0.0)));
+      Spread& t = by_type[c.pieces[j].type];
+      t.rel.push_back(std::max(rp, rh));
+      t.pos.push_back(std::sqrt(std::max(dp, 0.0)));
+      t.head.push_back(std::sqrt(std::max(dh, 0.0)));
     }
-    s.relative_size = Median(rel);
-    s.size_mm = 1e3 * Median(pos);
-    s.size_mrad = 1e3 * Median(head);
+    std::size_t most = 0;
+    for (const auto& [type, t] : by_type) most = std::max(most, t.rel.size());
+    s.relative_size = -1.0;
+    for (const auto& [type, t] : by_type) {
+      if (t.rel.size() < std::min(most, kMinPiecesPerType)) continue;
+      const double r = Median(t.rel);
+      if (r <= s.relative_size) continue;
+      s.relative_size = r;
+      s.size_mm = 1e3 * Median(t.pos);
+      s.size_mrad = 1e3 * Median(t.head);
+      s.size_pieces = PieceTypeToString(type);
+    }
+    s.relative_size = std::max(s.relative_size, 0.0);
     return;
   }
   // Removing an effect sets its parameters back to the baseline's (0 for

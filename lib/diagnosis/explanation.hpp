@@ -17,10 +17,15 @@
 // the noise the diagnosis compares with: the baseline's scatter of one
 // piece's relative motion (wheel noise over a piece of up to 1 m or a spot
 // turn, plus the ground truth's noise at both ends; RMS over the pieces;
-// position and heading separately, the larger ratio counts). For the noise
-// effects it is the relative change of the wheel-noise standard deviation
-// they cause (wheel_noise_error: |k_fit / k_given - 1|, the wheel
-// further off). Below `negligible` (default 0.25: a quarter of the noise) an
+// position and heading separately, the larger ratio counts). A noise
+// effect changes the spread, not the mean, and matters most on short
+// pieces, so its size is measured on the pieces the campaign has: per
+// piece type, the median relative growth of the predicted pose sd of the
+// pieces it acts on, the type where it is largest (standstill_motion,
+// motion_noise_floor, run_time_offset; `size_pieces` names the type);
+// the relative growth of the wheel-noise sd for correlated_noise and
+// bump_outliers; and for wheel_noise_error |k_fit / k_given - 1|, the
+// wheel further off. Below `negligible` (default 0.25: a quarter of the noise) an
 // effect is negligible: reported, never named in the verdict, however
 // significant.
 #pragma once
@@ -60,6 +65,10 @@ struct ExplanationStep {
   /// Practical size (see the file comment), at the last step's joint fit.
   double size_mm = 0.0, size_mrad = 0.0;
   double relative_size = 0.0;
+  /// Noise effects: the piece type whose spread the effect widens most
+  /// ("straight", "spot turn", ...), where size_mm, size_mrad and
+  /// relative_size are measured; empty for the others.
+  std::string size_pieces;
   bool negligible = false;
 };
 

@@ -59,6 +59,7 @@ nlohmann::json ExplanationJson(const DiagnoseSummary& s) {
                      {"size_mrad", Num(e.size_mrad)},
                      {"relative_size", Num(e.relative_size)},
                      {"negligible", e.negligible}});
+    if (!e.size_pieces.empty()) steps.back()["size_pieces"] = e.size_pieces;
   }
   return steps;
 }
@@ -234,18 +235,24 @@ void ExplanationSection(TextReport& o, const DiagnoseSummary& s) {
     o.line("");
     o.line(fmt::format("   Stepwise explanation (effects added one at a time, fitted jointly; stops: {}):",
                        s.explanation_stop));
-    o.line("    step effect                 cumulative shrink  held-out   size (mm / mrad, x scatter)  parameters");
+    o.line("    step effect                 cumulative shrink  held-out   size (mm / mrad, relative)   parameters");
     int k = 0;
     for (const auto& e : s.explanation) {
       std::string params;
       for (const auto& [n, v] : e.params) params += FormatParam(n, v) + "  ";
-      o.line(fmt::format("    {:>4} {:<22} {:>17.0f}% {:>8.0f}%   {:>7.2f} / {:>6.2f}, x {:<5.2f}{}  {}", ++k,
+      // A noise effect's size is the growth of the spread of one piece type
+      // (explanation.hpp), printed as such.
+      const std::string rel = e.size_pieces.empty()
+                                  ? fmt::format("x {:<5.2f}", e.relative_size)
+                                  : fmt::format("+{:.0f}% sd of {} pieces", 100.0 * e.relative_size, e.size_pieces);
+      o.line(fmt::format("    {:>4} {:<22} {:>17.0f}% {:>8.0f}%   {:>7.2f} / {:>6.2f}, {}{}  {}", ++k,
                          sim::EffectToString(e.effect), 100.0 * e.cumulative_shrink, 100.0 * e.cumulative_heldout_shrink,
-                         e.size_mm, e.size_mrad, e.relative_size, e.negligible ? " (negligible)" : "", params));
+                         e.size_mm, e.size_mrad, rel, e.negligible ? " (negligible)" : "", params));
     }
     o.line(fmt::format("    unexplained on held-out runs: {:.0f}%; negligible = size below {:.2g} x the noise of one "
-                       "piece (<= 1 m of travel or a spot turn)",
-                       100.0 * s.unexplained_fraction, s.negligible_threshold));
+                       "piece (<= 1 m of travel or a spot turn); for a noise effect, widening the pose spread of the "
+                       "pieces it acts on by less than {:.0f}% (median per piece type, the type it widens most)",
+                       100.0 * s.unexplained_fraction, s.negligible_threshold, 100.0 * s.negligible_threshold));
   }
   o.line("");
 }
@@ -258,7 +265,7 @@ void VerdictSection(TextReport& o, const DiagnoseSummary& s) {
   for (const auto& n : s.notes) o.line("  note: " + n);
   if (const Candidate* w = Winner(s); w && s.verdict != "none")
     o.line(std::string("  evidence for ") + sim::EffectToString(w->effect) + ": " +
-           EvidenceInWords(w->heldout_loglik_gain, w->evidence, w->heldout_shrink));
+           EvidenceInWords(w->heldout_loglik_gain, w->evidence, w->heldout_shrink, IsNoiseEffect(w->effect)));
   o.line("");
   o.line("What to do next:");
   for (std::size_t i = 0; i < s.next_steps.size(); ++i) o.line(fmt::format("  {}. {}", i + 1, s.next_steps[i]));
