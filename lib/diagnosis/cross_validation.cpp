@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 
 #include "diagnosis/mean_fit.hpp"
+#include "diagnosis/run_block.hpp"
 
 namespace umbmark::diag {
 
@@ -28,8 +29,11 @@ void ScoresFor(const std::vector<double>& eps, const std::vector<PieceBases>& ba
   const std::vector<Scores> s = PieceScores(sub_e, sub_b, sub, n);
   for (std::size_t k = 0; k < idx.size(); ++k) {
     out[idx[k]] = s[k];
-    ll[idx[k]] = PieceLogLik(&sub_e[3 * k], sub[k].components, sub_b[k], n);
+    ll[idx[k]] = HasRunBlocks(n) ? 0.0 : PieceLogLik(&sub_e[3 * k], sub[k].components, sub_b[k], n);
   }
+  // Folds hold whole runs, so run_time_offset's run blocks are complete:
+  // the fold's block log-likelihood is booked on its first piece.
+  if (HasRunBlocks(n) && !idx.empty()) ll[idx.front()] = BlockLogLik(sub_e, sub_b, sub, n);
 }
 
 }  // namespace
@@ -85,10 +89,7 @@ CrossValidation CrossValidate(const CampaignData& c, const std::vector<PieceBase
 
 double TotalLogLik(const CampaignData& c, const std::vector<PieceBases>& bases, const std::vector<double>& eps,
                    const NoiseParams& n) {
-  double ll = 0.0;
-  for (std::size_t j = 0; j < c.pieces.size(); ++j)
-    ll += PieceLogLik(&eps[3 * j], c.pieces[j].components, bases[j], n);
-  return ll;
+  return BlockLogLik(eps, bases, c.pieces, n);
 }
 
 }  // namespace umbmark::diag

@@ -8,6 +8,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
 
+#include "diagnosis/run_block.hpp"
 #include "stats/distributions.hpp"
 
 namespace umbmark::diag {
@@ -55,18 +56,22 @@ std::vector<Scores> PieceScores(const std::vector<double>& eps, const std::vecto
                                 const std::vector<Piece>& pieces, const NoiseParams& noise) {
   std::vector<Scores> out(pieces.size());
   const bool bumps = noise.bump_rate > 0.0 && noise.bump_s2 > 0.0;
+  // run_time_offset: each piece given the earlier pieces of its run.
+  const bool block = HasRunBlocks(noise);
+  const std::vector<Innovation> innovations =
+      block ? RunInnovations(eps, bases, pieces, noise) : std::vector<Innovation>{};
   for (std::size_t j = 0; j < pieces.size(); ++j) {
-    const double* e = &eps[3 * j];
+    const double* e = block ? innovations[j].v.data() : &eps[3 * j];
+    const Eigen::Matrix3d C = block ? innovations[j].S : PieceCovariance(bases[j], noise);
     if (pieces[j].components == 2) {
-      const Eigen::Matrix2d C = PieceCovariance(bases[j], noise).topLeftCorner<2, 2>();
-      Eigen::LLT<Eigen::Matrix2d> llt(C);
+      Eigen::LLT<Eigen::Matrix2d> llt(C.topLeftCorner<2, 2>());
       const Eigen::Vector2d w = llt.matrixL().solve(Eigen::Vector2d(e[0], e[1]));
       out[j] = {kNan, w[0], w[1]};
       continue;
     }
     const Eigen::Vector3d ep(e[2], e[0], e[1]);
     if (!bumps) {
-      Eigen::LLT<Eigen::Matrix3d> llt(Permute(PieceCovariance(bases[j], noise)));
+      Eigen::LLT<Eigen::Matrix3d> llt(Permute(C));
       const Eigen::Vector3d w = llt.matrixL().solve(ep);
       out[j] = {w[0], w[1], w[2]};
       continue;

@@ -311,34 +311,53 @@ void QuantisationAndSlip(const DiagRun& r, const Piece& pc, const PiecePropagati
   if (pc.ends_at_standstill) B.F += 0.5 * pp.G_last * pp.G_last.transpose();
 }
 
-/// run_time_offset's levers: d eps / d tau on either side of p's tau. The
-/// pose is not smooth in time where a motion starts or stops (a lag shows
-/// the motion, a lead the standstill), so with tau_i symmetric about 0 the
-/// second moment is tau_sd^2 (J+ J+^T + J- J-^T) / 2.
+/// run_time_offset's levers: d eps / d tau on either side of p's tau, as
+/// secants over one ground-truth sample interval h (the median over the
+/// campaign). The pose is not smooth in time where a motion starts or stops
+/// (a lag shows the motion, a lead the standstill), and the samples next to
+/// such a boundary respond to tau only once |tau| exceeds their distance to
+/// it, which lies anywhere within one interval: a derivative at tau = 0
+/// (1 ms) is zero there, the secant over h carries the onset. With tau_i
+/// symmetric about 0 the second moment is tau_sd^2 (J+ J+^T + J- J-^T) / 2.
 class TimeOffsetLevers {
  public:
-  TimeOffsetLevers(const MeanModel& model, const ParamVector& p) {
+  TimeOffsetLevers(const CampaignData& campaign, const MeanModel& model, const ParamVector& p)
+      : step_(SampleInterval(campaign)) {
     model.Residuals(p, eps0_);
     ParamVector pt = p;
-    pt[kParamTau] = p[kParamTau] + kStep;
+    pt[kParamTau] = p[kParamTau] + step_;
     model.Residuals(pt, plus_);
-    pt[kParamTau] = p[kParamTau] - kStep;
+    pt[kParamTau] = p[kParamTau] - step_;
     model.Residuals(pt, minus_);
   }
 
-  /// T of piece j (zero when a difference is not finite).
-  Eigen::Matrix3d Basis(std::size_t j) const {
+  /// T and the levers of piece j (zero when a difference is not finite).
+  void Set(std::size_t j, PieceBases& B) const {
     Eigen::Vector3d jp, jm;
     for (int k = 0; k < 3; ++k) {
-      jp[k] = (plus_[3 * j + k] - eps0_[3 * j + k]) / kStep;
-      jm[k] = (eps0_[3 * j + k] - minus_[3 * j + k]) / kStep;
+      jp[k] = (plus_[3 * j + k] - eps0_[3 * j + k]) / step_;
+      jm[k] = (eps0_[3 * j + k] - minus_[3 * j + k]) / step_;
     }
-    if (jp.allFinite() && jm.allFinite()) return 0.5 * (jp * jp.transpose() + jm * jm.transpose());
-    return Eigen::Matrix3d::Zero();
+    if (!(jp.allFinite() && jm.allFinite())) return;
+    B.T = 0.5 * (jp * jp.transpose() + jm * jm.transpose());
+    B.tau_lever_pos = jp;
+    B.tau_lever_neg = jm;
   }
 
  private:
-  static constexpr double kStep = 1e-3;  // s
+  /// Median interval between ground-truth samples of the logged runs [s]
+  /// (1 ms without any).
+  static double SampleInterval(const CampaignData& c) {
+    std::vector<double> dt;
+    for (const DiagRun& r : c.runs)
+      for (std::size_t i = 1; i < r.t.size(); ++i)
+        if (r.has_gt[i] && r.has_gt[i - 1] && r.t[i] > r.t[i - 1]) dt.push_back(r.t[i] - r.t[i - 1]);
+    if (dt.empty()) return 1e-3;
+    std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
+    return std::max(dt[dt.size() / 2], 1e-3);
+  }
+
+  double step_;
   std::vector<double> eps0_, plus_, minus_;
 };
 
@@ -358,7 +377,7 @@ std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanMod
   std::vector<PieceBases> out(campaign.pieces.size());
   const std::vector<Pose2> motion = model.PredictedPieceMotion(p);
   const BasesGeometry geometry = Geometry(campaign, p);
-  const TimeOffsetLevers tau(model, p);
+  const TimeOffsetLevers tau(campaign, model, p);
   for (std::size_t j = 0; j < campaign.pieces.size(); ++j) {
     const Piece& pc = campaign.pieces[j];
     const DiagRun& r = campaign.runs[pc.run];
@@ -374,7 +393,7 @@ std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanMod
       B.S_xy = Eigen::Vector3d(1.0, 1.0, 0.0).asDiagonal();
       B.S_theta(2, 2) = 1.0;
     }
-    B.T = tau.Basis(j);
+    tau.Set(j, B);
     GroundTruthBases(pc, motion[j], B);
   }
   return out;

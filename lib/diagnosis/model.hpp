@@ -107,9 +107,11 @@ struct PieceBases {
   /// piece ends where the robot settles (isotropic in position, any frame).
   Eigen::Matrix3d S_xy = Eigen::Matrix3d::Zero(), S_theta = Eigen::Matrix3d::Zero();
   /// run_time_offset: tau_sd^2 T, T = (J+ J+^T + J- J-^T) / 2 with J+-
-  /// = d eps / d tau on either side (the pieces of a run share tau_i;
-  /// their correlation is left out).
+  /// = d eps / d tau on either side (tau_lever_pos, tau_lever_neg): each
+  /// piece's second moment. The pieces of a run share tau_i: their
+  /// correlation is the run block of run_block.hpp.
   Eigen::Matrix3d T = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d tau_lever_pos = Eigen::Vector3d::Zero(), tau_lever_neg = Eigen::Vector3d::Zero();
 };
 
 /// Bases of every piece, along the path predicted for `p` (the shape of a
