@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "diagnosis/mean_fit.hpp"
+#include "diagnosis/run_block.hpp"
 #include "core/parallel_for.hpp"
 #include "stats/distributions.hpp"
 
@@ -232,21 +233,28 @@ void FitNoiseEffect(const Shared& x, sim::EffectKind kind, Candidate& cd) {
   EnableNoiseEffect(kind, cf);
   PieceNoiseFitOptions cf_fold = x.fold_fit;
   EnableNoiseEffect(kind, cf_fold);
-  const NoiseParams ne = corr ? FitPieceNoise(x.b.eps, x.b.bases, c.pieces, {}, x.b.noise, cf)
-                              : FitBumps(x.b.eps, x.b.bases, c.pieces, {}, x.b.noise, /*start_only=*/false,
-                                                 cf.fit_wheel_noise);
+  NoiseParams ne = corr ? FitPieceNoise(x.b.eps, x.b.bases, c.pieces, {}, x.b.noise, cf)
+                        : FitBumps(x.b.eps, x.b.bases, c.pieces, {}, x.b.noise, /*start_only=*/false,
+                                   cf.fit_wheel_noise);
+  // run_time_offset: its levers at the fitted tau_sd (run_block.hpp).
+  std::vector<PieceBases> rescaled;
+  if (kind == sim::EffectKind::kRunTimeOffset)
+    rescaled = RescaleTimeLevers(x.model, x.b.p, x.b.bases, ne, [&](const std::vector<PieceBases>& bs, const NoiseParams& s) {
+      return FitPieceNoise(x.b.eps, bs, c.pieces, {}, s, cf);
+    });
+  const std::vector<PieceBases>& bases = rescaled.empty() ? x.b.bases : rescaled;
   cd.params = NoiseEffectParams(kind, ne);
   // A variance at its boundary 0 under the baseline: Wilks' chi^2 is
   // conservative there (the true null is a 50:50 mixture), so the test
   // keeps its level.
-  if (corr) LikelihoodRatioTest(cd, TotalLogLik(c, x.b.bases, x.b.eps, ne), x.ll_base);
-  const GapSummary ga = ComputeGap(c, PieceScores(x.b.eps, x.b.bases, c.pieces, ne), x.options.gap);
+  if (corr) LikelihoodRatioTest(cd, TotalLogLik(c, bases, x.b.eps, ne), x.ll_base);
+  const GapSummary ga = ComputeGap(c, PieceScores(x.b.eps, bases, c.pieces, ne), x.options.gap);
   cd.gap_after = ga.score;
   cd.gap_by_kind = ga.by_kind;
   const CrossValidation cv = CrossValidate(
-      c, x.b.bases, x.folds, x.b.eps, x.b.D, x.b.W, [&](const std::vector<double>& e, const std::vector<char>& use) {
-        return corr ? FitPieceNoise(e, x.b.bases, c.pieces, use, ne, cf_fold)
-                    : FitBumps(e, x.b.bases, c.pieces, use, ne, /*start_only=*/true, cf_fold.fit_wheel_noise);
+      c, bases, x.folds, x.b.eps, x.b.D, x.b.W, [&](const std::vector<double>& e, const std::vector<char>& use) {
+        return corr ? FitPieceNoise(e, bases, c.pieces, use, ne, cf_fold)
+                    : FitBumps(e, bases, c.pieces, use, ne, /*start_only=*/true, cf_fold.fit_wheel_noise);
       });
   cd.heldout_loglik_gain = cv.loglik - x.cv_ll_base;
   const double gcv = ComputeGap(c, cv.scores, x.options.gap).score;

@@ -9,6 +9,7 @@
 
 #include "core/angles.hpp"
 #include "diagnosis/mean_fit.hpp"
+#include "diagnosis/run_block.hpp"
 #include "core/parallel_for.hpp"
 
 namespace umbmark::diag {
@@ -24,6 +25,9 @@ struct SetFit {
   ParamVector p{};
   NoiseParams noise;
   double gap_after = 0.0, heldout_gap = 0.0, cv_loglik = 0.0;
+  /// run_time_offset in the set: the bases with its levers at the fitted
+  /// tau_sd (run_block.hpp); else empty (the mean part's).
+  std::vector<PieceBases> rescaled;
 };
 
 /// The mean parameters a set of effects fits: the baseline's free ones
@@ -63,19 +67,26 @@ MeanPart FitMeanPart(const CampaignData& c, const MeanModel& model, const Baseli
 
 /// warm: the chosen set's noise when it already has bumps (the bump fit
 /// then refits from there alone; else the multi-start from the baseline).
-SetFit FitSet(const CampaignData& c, const BaselineFit& b, const Folds& folds, const std::vector<sim::EffectKind>& set,
-              const MeanPart& mean, const GapOptions& gap, const NoiseParams* warm = nullptr) {
+SetFit FitSet(const CampaignData& c, const MeanModel& model, const BaselineFit& b, const Folds& folds,
+              const std::vector<sim::EffectKind>& set, const MeanPart& mean, const GapOptions& gap,
+              const NoiseParams* warm = nullptr) {
   const bool bumps = Contains(set, sim::EffectKind::kBumpOutliers);
   const MeanFit& mf = mean.mf;
-  const std::vector<PieceBases>& bases = mean.scrub ? mean.scrub_bases : b.bases;
+  const std::vector<PieceBases>& mean_bases = mean.scrub ? mean.scrub_bases : b.bases;
   PieceNoiseFitOptions nf = b.noise_fit;
   for (sim::EffectKind e : set) EnableNoiseEffect(e, nf);
   SetFit out;
   out.p = mf.p;
   // Bumps and rho together: the bump mixture (its fit has no rho).
-  out.noise = bumps ? (warm ? FitBumps(mf.eps, bases, c.pieces, {}, *warm, /*start_only=*/true, nf.fit_wheel_noise)
-                             : FitBumps(mf.eps, bases, c.pieces, {}, b.noise, /*start_only=*/false, nf.fit_wheel_noise))
-                    : FitPieceNoise(mf.eps, bases, c.pieces, {}, b.noise, nf);
+  out.noise = bumps ? (warm ? FitBumps(mf.eps, mean_bases, c.pieces, {}, *warm, /*start_only=*/true, nf.fit_wheel_noise)
+                             : FitBumps(mf.eps, mean_bases, c.pieces, {}, b.noise, /*start_only=*/false, nf.fit_wheel_noise))
+                    : FitPieceNoise(mf.eps, mean_bases, c.pieces, {}, b.noise, nf);
+  if (!bumps && Contains(set, sim::EffectKind::kRunTimeOffset))
+    out.rescaled = RescaleTimeLevers(model, mf.p, mean_bases, out.noise,
+                                     [&](const std::vector<PieceBases>& bs, const NoiseParams& s) {
+                                       return FitPieceNoise(mf.eps, bs, c.pieces, {}, s, nf);
+                                     });
+  const std::vector<PieceBases>& bases = out.rescaled.empty() ? mean_bases : out.rescaled;
   const std::vector<Eigen::Matrix3d> W = Whiteners(bases, c.pieces, out.noise);
   out.gap_after = ComputeGap(c, PieceScores(mf.eps, bases, c.pieces, out.noise), gap).score;
   PieceNoiseFitOptions fold_fit = nf;
@@ -289,7 +300,7 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
   Explanation ex;
   MeanPartCache means(c, model, b, options.threads, known);
   means.Prepare({{}});
-  const SetFit base = FitSet(c, b, folds, {}, means.Get({}), options.gap);
+  const SetFit base = FitSet(c, model, b, folds, {}, means.Get({}), options.gap);
   const double gap_before = Gap(gap_score, null_median), gap_cv_before = Gap(base.heldout_gap, null_median);
   std::vector<sim::EffectKind> chosen;
   std::vector<SetFit> fits;
@@ -312,7 +323,7 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
     std::vector<sim::EffectKind> set = chosen;
     set.push_back(e);
     means.Prepare({set});
-    add(e, FitSet(c, b, folds, set, means.Get(set), options.gap));
+    add(e, FitSet(c, model, b, folds, set, means.Get(set), options.gap));
     progress.Add();
   }
   // Candidates worth trying: every identifiable one, also those that lost
@@ -350,7 +361,7 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
     std::vector<SetFit> trial(remaining.size());
     ParallelFor(options.threads, static_cast<int>(remaining.size()), [&](int i) {
       const auto& set = sets[static_cast<std::size_t>(i)];
-      trial[static_cast<std::size_t>(i)] = FitSet(c, b, folds, set, means.Get(set), options.gap, warm);
+      trial[static_cast<std::size_t>(i)] = FitSet(c, model, b, folds, set, means.Get(set), options.gap, warm);
       progress.Add();
     });
     std::size_t best = 0;
@@ -370,7 +381,9 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
   }
   progress.Finish();
   ex.gap_left = current.gap_after > null_quantile;
-  const std::vector<PieceBases>& last_bases = means.Get(chosen).scrub ? means.Get(chosen).scrub_bases : b.bases;
+  const std::vector<PieceBases>& last_bases = !current.rescaled.empty()  ? current.rescaled
+                                              : means.Get(chosen).scrub ? means.Get(chosen).scrub_bases
+                                                                        : b.bases;
   const PieceScatter scatter = Scatter(c, last_bases, current.noise);
   for (ExplanationStep& s : ex.steps) {
     Size(c, model, b, last_bases, scatter, current, s.effect, s);

@@ -319,10 +319,21 @@ void QuantisationAndSlip(const DiagRun& r, const Piece& pc, const PiecePropagati
 /// it, which lies anywhere within one interval: a derivative at tau = 0
 /// (1 ms) is zero there, the secant over h carries the onset. With tau_i
 /// symmetric about 0 the second moment is tau_sd^2 (J+ J+^T + J- J-^T) / 2.
+/// Median interval between ground-truth samples of the logged runs [s]
+/// (1 ms without any).
+double SampleInterval(const CampaignData& c) {
+  std::vector<double> dt;
+  for (const DiagRun& r : c.runs)
+    for (std::size_t i = 1; i < r.t.size(); ++i)
+      if (r.has_gt[i] && r.has_gt[i - 1] && r.t[i] > r.t[i - 1]) dt.push_back(r.t[i] - r.t[i - 1]);
+  if (dt.empty()) return 1e-3;
+  std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
+  return std::max(dt[dt.size() / 2], 1e-3);
+}
+
 class TimeOffsetLevers {
  public:
-  TimeOffsetLevers(const CampaignData& campaign, const MeanModel& model, const ParamVector& p)
-      : step_(SampleInterval(campaign)) {
+  TimeOffsetLevers(const MeanModel& model, const ParamVector& p, double step) : step_(step) {
     model.Residuals(p, eps0_);
     ParamVector pt = p;
     pt[kParamTau] = p[kParamTau] + step_;
@@ -345,18 +356,6 @@ class TimeOffsetLevers {
   }
 
  private:
-  /// Median interval between ground-truth samples of the logged runs [s]
-  /// (1 ms without any).
-  static double SampleInterval(const CampaignData& c) {
-    std::vector<double> dt;
-    for (const DiagRun& r : c.runs)
-      for (std::size_t i = 1; i < r.t.size(); ++i)
-        if (r.has_gt[i] && r.has_gt[i - 1] && r.t[i] > r.t[i - 1]) dt.push_back(r.t[i] - r.t[i - 1]);
-    if (dt.empty()) return 1e-3;
-    std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
-    return std::max(dt[dt.size() / 2], 1e-3);
-  }
-
   double step_;
   std::vector<double> eps0_, plus_, minus_;
 };
@@ -377,7 +376,7 @@ std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanMod
   std::vector<PieceBases> out(campaign.pieces.size());
   const std::vector<Pose2> motion = model.PredictedPieceMotion(p);
   const BasesGeometry geometry = Geometry(campaign, p);
-  const TimeOffsetLevers tau(campaign, model, p);
+  const TimeOffsetLevers tau(model, p, SampleInterval(campaign));
   for (std::size_t j = 0; j < campaign.pieces.size(); ++j) {
     const Piece& pc = campaign.pieces[j];
     const DiagRun& r = campaign.runs[pc.run];
@@ -397,6 +396,11 @@ std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanMod
     GroundTruthBases(pc, motion[j], B);
   }
   return out;
+}
+
+void SetTimeOffsetLevers(const MeanModel& model, const ParamVector& p, double step, std::vector<PieceBases>& bases) {
+  const TimeOffsetLevers tau(model, p, std::max(step, 1e-3));
+  for (std::size_t j = 0; j < bases.size(); ++j) tau.Set(j, bases[j]);
 }
 
 }  // namespace umbmark::diag

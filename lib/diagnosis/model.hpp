@@ -118,4 +118,10 @@ struct PieceBases {
 /// piece barely depends on the parameters; the baseline fit is used).
 std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanModel& model, const ParamVector& p);
 
+/// Re-takes run_time_offset's levers (T, tau_lever_pos, tau_lever_neg) of
+/// every piece as secants over +-`step` seconds (at least 1 ms) at `p`.
+/// ComputeBases uses one ground-truth sample interval; the fit of tau_sd
+/// re-takes them at its own scale (run_block.hpp).
+void SetTimeOffsetLevers(const MeanModel& model, const ParamVector& p, double step, std::vector<PieceBases>& bases);
+
 }  // namespace umbmark::diag

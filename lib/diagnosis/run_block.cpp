@@ -156,4 +156,13 @@ double FitRunTau2(const std::vector<double>& eps, const std::vector<PieceBases>&
   return -best.f > ll0 ? std::exp(2.0 * best.x) : 0.0;
 }
 
+std::vector<PieceBases> RescaleTimeLevers(const MeanModel& model, const ParamVector& p, std::vector<PieceBases> bases,
+                                          NoiseParams& n, const NoiseRefit& refit) {
+  for (int pass = 0; pass < 2 && n.run_tau2 > 0.0; ++pass) {
+    SetTimeOffsetLevers(model, p, std::sqrt(n.run_tau2), bases);
+    n = refit(bases, n);
+  }
+  return bases;
+}
+
 }  // namespace umbmark::diag

@@ -27,6 +27,7 @@
 // N(0, 1) under the model.
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -61,5 +62,16 @@ std::vector<Innovation> RunInnovations(const std::vector<double>& eps, const std
 /// no used piece has a lever).
 double FitRunTau2(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
                   const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& n);
+
+/// run_time_offset at its own scale: ComputeBases takes the levers over one
+/// sample interval, but a sample near a motion's start or stop responds to
+/// tau only beyond its distance to it, so the slope that matters is the
+/// secant over the offsets the runs have. Starting from the fit `n` on
+/// `bases`, the levers are re-taken over +-tau_sd (at p) and the noise
+/// refitted by `refit`, twice; returns the bases the fit ends on (`n`
+/// updated). Unchanged when n.run_tau2 is 0.
+using NoiseRefit = std::function<NoiseParams(const std::vector<PieceBases>& bases, const NoiseParams& start)>;
+std::vector<PieceBases> RescaleTimeLevers(const MeanModel& model, const ParamVector& p, std::vector<PieceBases> bases,
+                                          NoiseParams& n, const NoiseRefit& refit);
 
 }  // namespace umbmark::diag
