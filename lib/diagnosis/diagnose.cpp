@@ -14,6 +14,7 @@
 #include "diagnosis/baseline.hpp"
 #include "diagnosis/candidates.hpp"
 #include "diagnosis/cross_validation.hpp"
+#include "diagnosis/design_check.hpp"
 #include "diagnosis/explanation.hpp"
 #include "diagnosis/null_distribution.hpp"
 #include "diagnosis/return_check.hpp"
@@ -238,6 +239,11 @@ DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) 
   out.verdict = std::move(v.verdict);
   out.verdict_reason = std::move(v.reason);
   out.indistinguishable = std::move(v.indistinguishable);
+  // What this design cannot separate (turn_scrub from E_b without arcs).
+  for (const Candidate& cd : out.candidates)
+    if (cd.effect == sim::EffectKind::kTurnScrub)
+      if (std::string n = TurnScrubDesignNote(c, cd.identifiable && !cd.weak, base.p[kParamEb]); !n.empty())
+        out.notes.push_back(std::move(n));
   timer.Lap("verdict");
 
   // 6. Stepwise explanation and practical significance.
