@@ -1,0 +1,70 @@
+// What a campaign's design cannot tell apart (diagnosis/design_check.hpp):
+// a turn scrub on a campaign whose only rotation is spot turns is a
+// wheelbase error (same ground truth), so the diagnosis says `none` with a
+// note that the scrub is inside the fitted wheelbase and which runs to add;
+// with figure-eights (arcs) it names turn_scrub, recovers k, and gives no
+// such note.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <string>
+
+#include "diagnosis/diagnose.hpp"
+#include "support/diag_campaign.hpp"
+
+using namespace umbmark;
+using namespace umbmark::diag;
+using Catch::Matchers::WithinRel;
+
+namespace {
+
+constexpr const char* kScrubNote = "turn_scrub is indistinguishable from the fitted wheelbase";
+
+bool HasScrubNote(const DiagnoseSummary& d) {
+  return std::any_of(d.notes.begin(), d.notes.end(),
+                     [](const std::string& n) { return n.find(kScrubNote) != std::string::npos; });
+}
+
+/// The test campaign with a turn scrub k = 0.05, optionally plus a free
+/// experiment of 4 figure-eights of 1 m radius.
+DiagnoseSummary RunScrub(bool figure_eights) {
+  testing::SmallCampaign s = testing::MakeSmallCampaign(91, 10, 20);
+  s.sim.effects.scrub_k = 0.05;
+  if (figure_eights) {
+    Experiment fr;
+    fr.kind = ExperimentKind::kFree;
+    fr.file = fr.resolved_file = "figure_eight.csv";
+    s.manifest.experiments.push_back(fr);
+    s.sim.free_runs = 4;
+    s.sim.free_radius_m = 1.0;
+  }
+  DiagnoseOptions o;
+  o.null_simulations = 100;
+  o.seed = 1;
+  o.threads = 2;
+  return Diagnose(testing::BuildSmallCampaign(s), o);
+}
+
+}  // namespace
+
+TEST_CASE("design: turn scrub on spot turns only is none, with the note", "[diagnose][design]") {
+  const DiagnoseSummary d = RunScrub(false);
+  INFO(d.verdict_reason);
+  CHECK(d.verdict == "none");
+  CHECK(HasScrubNote(d));
+  // The scrub is inside the fitted wheelbase: E_b / (1 - k) with the
+  // simulated E_b = 1.012 and k = 0.05 is 1.0653.
+  CHECK_THAT(d.baseline.E_b, WithinRel(1.012 / (1.0 - 0.05), 0.002));
+}
+
+TEST_CASE("design: with figure-eights the turn scrub is named, without the note", "[diagnose][design]") {
+  const DiagnoseSummary d = RunScrub(true);
+  INFO(d.verdict_reason);
+  CHECK(d.verdict == "turn_scrub");
+  CHECK_FALSE(HasScrubNote(d));
+  const auto it = std::find_if(d.candidates.begin(), d.candidates.end(),
+                               [](const Candidate& c) { return c.effect == sim::EffectKind::kTurnScrub; });
+  REQUIRE(it != d.candidates.end());
+  // 40 runs x 8 spot turns + 4 figure-eights: k = 0.0486 here; within 10 %.
+  CHECK_THAT(it->params.at("k"), WithinRel(0.05, 0.10));
+}
