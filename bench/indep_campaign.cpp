@@ -14,14 +14,19 @@
 //     gentle S-curves in wheel travel);
 //   - a fixed 1 kHz physics step with the wheel noise drawn per step,
 //     independent of the sample rate;
-//   - its own random streams (std::mt19937_64, one per campaign).
+//   - its own random streams (std::mt19937_64, one per campaign);
+//   - optionally free paths (`--free N` runs, experiment kind `free`): curved
+//     paths made of stretches that start from and end at standstill, each
+//     stretch two or three arcs of different curvature driven back to back
+//     in one direction (forward or backward), ended on the odometry's path
+//     length, with a stop of at least 0.5 s between stretches.
 //
-// Writes DIR/campaign.toml, DIR/square.csv, DIR/fwd_back.csv (trajectory
-// CSVs with ticks and ground truth, formats.md) and DIR/../truth.json
-// beside the campaign (never inside it).
+// Writes DIR/campaign.toml, DIR/square.csv, DIR/fwd_back.csv (and
+// DIR/free.csv with --free) (trajectory CSVs with ticks and ground truth,
+// formats.md) and DIR/../truth.json beside the campaign (never inside it).
 //
 // Usage: indep_campaign --out DIR --seed S [--effect NAME:k=v,...]
-//   [--rate HZ] [--ticks N] [--pause S] [--accel A] [--heading-hold K]
+//   [--rate HZ] [--ticks N] [--pause S] [--accel A] [--heading-hold K] [--free N]
 //   [--side M] [--distance M] [--speed V] [--turn-rate W] [--kl K] [--kr K]
 //   [--E-d X] [--E-b X] [--gt-sigma-xy M] [--gt-sigma-theta R]
 //   [--wheelbase M] [--diameter M]
@@ -53,7 +58,7 @@ struct Options {
   std::string out;
   std::uint64_t seed = 1;
   std::map<std::string, std::map<std::string, double>> effects;
-  double rate_hz = 20.0, ticks = 4096.0, pause_s = 1.0, accel = 0.0, heading_hold = 0.0;
+  double rate_hz = 20.0, ticks = 4096.0, pause_s = 1.0, accel = 0.0, heading_hold = 0.0, free_runs = 0.0;
   double side_m = 3.0, distance_m = 3.0, speed = 0.3, turn_rate = 1.0;
   double k_L = 1e-3, k_R = 1e-3, E_d = 1.0, E_b = 1.0, gt_xy = 3e-4, gt_th = 1e-3;
   double wheelbase = 0.4, diameter = 0.1;
@@ -113,6 +118,28 @@ class Robot {
       if (left <= 0.0) break;
       w = Profile(w, left, o_.turn_rate, 0.02);
       Step(0.0, dir * w);
+    }
+  }
+  /// Drives one stretch of a free path from standstill to standstill: arcs
+  /// (path length [m] > 0, curvature [1/m]) back to back, forward (dir = +1)
+  /// or backward (-1), each ended when the odometry's path length reaches
+  /// its length; the speed profile brakes only for the stretch's end.
+  void Stretch(const std::vector<std::array<double, 2>>& arcs, double dir) {
+    // castor_kick: a start from standstill, + forward, - backward (an arc
+    // drives forward or backward like a leg: the sign of the axle speed).
+    th_ += dir * Effect(o_, "castor_kick", "kappa");
+    double total = 0.0;
+    for (const auto& a : arcs) total += a[0];
+    double v = 0.0, done_before = 0.0;
+    for (const auto& a : arcs) {
+      double done = 0.0;
+      for (int guard = 0; guard < 10'000'000 && done < a[0]; ++guard) {
+        v = Profile(v, total - done_before - done, o_.speed, 0.01);
+        const double x0 = ox_, y0 = oy_;
+        Step(dir * v, dir * v * a[1]);
+        done += std::hypot(ox_ - x0, oy_ - y0);
+      }
+      done_before += done;
     }
   }
   void Pause(double seconds) {
@@ -216,7 +243,7 @@ Options Parse(int argc, char** argv) {
       {"--distance", &o.distance_m}, {"--speed", &o.speed},    {"--turn-rate", &o.turn_rate},
       {"--kl", &o.k_L},           {"--kr", &o.k_R},            {"--E-d", &o.E_d},
       {"--E-b", &o.E_b},          {"--gt-sigma-xy", &o.gt_xy}, {"--gt-sigma-theta", &o.gt_th},
-      {"--wheelbase", &o.wheelbase}, {"--diameter", &o.diameter}};
+      {"--wheelbase", &o.wheelbase}, {"--diameter", &o.diameter}, {"--free", &o.free_runs}};
   for (int i = 1; i < argc; ++i) {
     const std::string k = argv[i];
     if (i + 1 >= argc) {
@@ -294,8 +321,25 @@ int main(int argc, char** argv) {
     robot.Pause(end_pause);
     fwd_back.emplace_back("fwd_back", robot.Finish());
   }
+  // Free paths: pause, three stretches (70 % forward) of two or three arcs
+  // each (0.5-1.5 m, radius >= 0.8 m either way or straight), stops between.
+  std::vector<std::pair<std::string, std::vector<Sample>>> free_paths;
+  const double stop_pause = std::max(o.pause_s, 0.5);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  for (int r = 0; r < static_cast<int>(o.free_runs); ++r) {
+    Robot robot(o, g);
+    robot.Pause(end_pause);
+    for (int s = 0; s < 3; ++s) {
+      std::vector<std::array<double, 2>> arcs(u01(g) < 0.5 ? 2 : 3);
+      for (auto& a : arcs) a = {0.5 + u01(g), (2.0 * u01(g) - 1.0) / 0.8};
+      robot.Stretch(arcs, u01(g) < 0.7 ? 1.0 : -1.0);
+      robot.Pause(s == 2 ? end_pause : stop_pause);
+    }
+    free_paths.emplace_back("free", robot.Finish());
+  }
   WriteRuns(o.out + "/square.csv", squares);
   WriteRuns(o.out + "/fwd_back.csv", fwd_back);
+  if (!free_paths.empty()) WriteRuns(o.out + "/free.csv", free_paths);
   std::ofstream m(o.out + "/campaign.toml");
   m << fmt::format(
       "# written by bench/indep_campaign (independent generator)\n[robot]\nwheelbase_m = {}\n"
@@ -303,6 +347,7 @@ int main(int argc, char** argv) {
       "sigma_xy_m = {}\nsigma_theta_rad = {}\n\n[[experiment]]\nkind = \"square\"\nside_m = {}\nfile = \"square.csv\"\n\n"
       "[[experiment]]\nkind = \"back_and_forth\"\ndistance_m = {}\nfile = \"fwd_back.csv\"\n",
       o.wheelbase, o.diameter, o.diameter, o.ticks, o.gt_xy, o.gt_th, o.side_m, o.distance_m);
+  if (!free_paths.empty()) m << "\n[[experiment]]\nkind = \"free\"\nfile = \"free.csv\"\n";
   std::ofstream t(std::filesystem::path(o.out).parent_path() / "truth.json");
   t << fmt::format("{{\"seed\": {}, \"E_d\": {}, \"E_b\": {}, \"k_L\": {}, \"k_R\": {}, \"effects\": {{", o.seed, o.E_d,
                    o.E_b, o.k_L, o.k_R);
@@ -318,8 +363,8 @@ int main(int argc, char** argv) {
     first = false;
   }
   t << fmt::format("}}, \"design\": {{\"rate_hz\": {}, \"ticks\": {}, \"pause_s\": {}, \"accel\": {}, "
-                   "\"heading_hold\": {}}}}}\n",
-                   o.rate_hz, o.ticks, o.pause_s, o.accel, o.heading_hold);
+                   "\"heading_hold\": {}, \"free_runs\": {}}}}}\n",
+                   o.rate_hz, o.ticks, o.pause_s, o.accel, o.heading_hold, o.free_runs);
   if (!m || !t) {
     fmt::print(stderr, "indep_campaign: cannot write into {}\n", o.out);
     return 1;

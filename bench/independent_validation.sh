@@ -15,6 +15,8 @@
 #            per revolution; pauses between motions 0 or 1 s;
 #   controller  acceleration limit none or 0.3-1 m/s^2 (and rad/s^2);
 #            heading hold in the legs none or K = 1-3 1/s
+#   free paths  none or 10 runs (experiment kind `free`: curved stretches
+#            from standstill to standstill, indep_campaign --free)
 #   classes  none; negligible (500 ticks/rev and one of: marker offset
 #            0.1-0.8 mm, time offset 1-2 ms, scale error 0.5-2e-4; target
 #            `none`); single effects at f = 3-5 times the noise of one
@@ -25,23 +27,29 @@
 #            outside effects (gt_yaw_misalignment 5-20 mrad, floor_slope
 #            0.2-1 %; target `unexplained`).
 #
-# Usage: bench/independent_validation.sh [BUILD_DIR] [N] [SEED]
+# Usage: bench/independent_validation.sh [BUILD_DIR] [N] [SEED] [PROFILE]
 #   N campaigns per single/outside class, 2N clean and 2N negligible.
+#   PROFILE `castor_free`: N castor-kick campaigns only, all with free paths,
+#   acceleration limits, 10 or 20 Hz and 500 ticks/rev (the issue's case).
+#   With BEFORE=/path/to/umbmark in the environment every campaign is also
+#   diagnosed by that executable (a baseline on the same campaigns).
 set -euo pipefail
 
 BUILD=${1:-build}
 N=${2:-3}
 SEED=${3:-4242}
+PROFILE=${4:-default}
 UMBMARK="$BUILD/umbmark"
 GEN="$BUILD/indep_campaign"
-for exe in "$UMBMARK" "$GEN"; do
+BEFORE=${BEFORE:-}
+for exe in "$UMBMARK" "$GEN" ${BEFORE:+"$BEFORE"}; do
   [[ -x "$exe" ]] || { echo "missing $exe (build the umbmark and indep_campaign targets)" >&2; exit 2; }
 done
 OUT=$(mktemp -d "${TMPDIR:-/tmp}/umbmark-indep.XXXXXX")
-echo "seed $SEED, $N per class; campaigns in $OUT"
+echo "seed $SEED, $N per class, profile $PROFILE; campaigns in $OUT"
 
 # One line per campaign: case class design generator-arguments.
-awk -v n="$N" -v seed="$SEED" '
+awk -v n="$N" -v seed="$SEED" -v profile="$PROFILE" '
 function U(a, b) { return a + (b - a) * rand() }
 function S() { return rand() < 0.5 ? -1 : 1 }
 function LU(a, b) { return exp(U(log(a), log(b))) }
@@ -51,6 +59,7 @@ BEGIN {
   id = 0
   for (c = 1; c <= 9; ++c) {
     count = (cls[c] == "none" || cls[c] == "negligible") ? 2 * n : n
+    if (profile == "castor_free" && cls[c] != "castor_kick") count = 0
     for (i = 0; i < count; ++i) {
       b = U(0.3, 0.5); d = U(0.08, 0.15); kl = LU(5e-4, 2e-3); kr = LU(5e-4, 2e-3)
       gxy = U(2e-4, 5e-4); gth = U(1e-3, 2e-3); side = U(2, 3); dist = U(2, 4); v = U(0.2, 0.4); w = U(0.6, 1.2)
@@ -61,6 +70,8 @@ BEGIN {
       hold = rand() < 0.5 ? 0 : U(1, 3)
       ed = 1 + S() * U(0, 0.005); eb = 1 + S() * U(0, 0.02)
       f = U(3, 5); k2 = (kl * kl + kr * kr) / 2
+      free = rand() < 0.5 ? 0 : 10
+      if (profile == "castor_free") { free = 10; accel = U(0.3, 1.0); rate = rand() < 0.5 ? 10 : 20; ticks = 500 }
       eff = ""
       if (cls[c] == "negligible") {
         ticks = 500; pick = int(rand() * 3)
@@ -75,42 +86,50 @@ BEGIN {
       if (cls[c] == "direction_asymmetry") eff = sprintf("direction_asymmetry:a=%.6g", S() * f * sqrt(k2 * dist / 2) / dist)
       if (cls[c] == "gt_yaw_misalignment") eff = sprintf("gt_yaw_misalignment:delta=%.6g", S() * U(0.005, 0.02))
       if (cls[c] == "floor_slope") eff = sprintf("floor_slope:g=%.6g,dir=%.6g", U(0.002, 0.01), U(0, 2 * pi))
-      design = sprintf("%dHz/%dticks/%s/%s/%s", rate, ticks, pause ? "pauses" : "no-pauses", accel > 0 ? "accel" : "no-accel", hold > 0 ? "hold" : "no-hold")
-      printf "%03d %s %s --seed %d --wheelbase %.6g --diameter %.6g --kl %.6g --kr %.6g --gt-sigma-xy %.6g --gt-sigma-theta %.6g --side %.6g --distance %.6g --speed %.6g --turn-rate %.6g --rate %d --ticks %d --pause %d --accel %.6g --heading-hold %.6g --E-d %.8g --E-b %.8g%s\n", \
-        id, cls[c], design, seed * 1000 + id, b, d, kl, kr, gxy, gth, side, dist, v, w, rate, ticks, pause, accel, hold, ed, eb, eff == "" ? "" : " --effect " eff
+      design = sprintf("%dHz/%dticks/%s/%s/%s/%s", rate, ticks, pause ? "pauses" : "no-pauses", accel > 0 ? "accel" : "no-accel", hold > 0 ? "hold" : "no-hold", free ? "free" : "no-free")
+      printf "%03d %s %s --seed %d --wheelbase %.6g --diameter %.6g --kl %.6g --kr %.6g --gt-sigma-xy %.6g --gt-sigma-theta %.6g --side %.6g --distance %.6g --speed %.6g --turn-rate %.6g --rate %d --ticks %d --pause %d --accel %.6g --heading-hold %.6g --free %d --E-d %.8g --E-b %.8g%s\n", \
+        id, cls[c], design, seed * 1000 + id, b, d, kl, kr, gxy, gth, side, dist, v, w, rate, ticks, pause, accel, hold, free, ed, eb, eff == "" ? "" : " --effect " eff
       ++id
     }
   }
 }' > "$OUT/cases.txt"
 
-declare -A total right dtotal dright
+verdict_of() { tr -d '\n ' < "$1" | sed -n 's/.*"verdict":{"effect":"\([a-z_]*\)".*/\1/p'; }
+declare -A total right dtotal dright bright bdright
 start=$(date +%s.%N)
 while read -r id cls design args; do
   dir="$OUT/${id}_$cls"
   # shellcheck disable=SC2086
   "$GEN" --out "$dir/campaign" $args
   "$UMBMARK" diagnose "$dir/campaign/campaign.toml" --json "$dir/diagnosis.json" > "$dir/report.txt"
-  verdict=$(tr -d '\n ' < "$dir/diagnosis.json" | sed -n 's/.*"verdict":{"effect":"\([a-z_]*\)".*/\1/p')
+  verdict=$(verdict_of "$dir/diagnosis.json")
   expected=$cls
   [[ $cls == negligible ]] && expected=none
   [[ $cls == gt_yaw_misalignment || $cls == floor_slope ]] && expected=unexplained
   ok=0; [[ "$verdict" == "$expected" ]] && ok=1
-  total[$cls]=$(( ${total[$cls]:-0} + 1 )); right[$cls]=$(( ${right[$cls]:-0} + ok ))
+  bok=0; bverdict=""
+  if [[ -n "$BEFORE" ]]; then
+    "$BEFORE" diagnose "$dir/campaign/campaign.toml" --json "$dir/diagnosis_before.json" > "$dir/report_before.txt"
+    bverdict=$(verdict_of "$dir/diagnosis_before.json")
+    [[ "$bverdict" == "$expected" ]] && bok=1
+  fi
+  total[$cls]=$(( ${total[$cls]:-0} + 1 )); right[$cls]=$(( ${right[$cls]:-0} + ok )); bright[$cls]=$(( ${bright[$cls]:-0} + bok ))
   for part in ${design//\// }; do
-    dtotal[$part]=$(( ${dtotal[$part]:-0} + 1 )); dright[$part]=$(( ${dright[$part]:-0} + ok ))
+    dtotal[$part]=$(( ${dtotal[$part]:-0} + 1 )); dright[$part]=$(( ${dright[$part]:-0} + ok )); bdright[$part]=$(( ${bdright[$part]:-0} + bok ))
   done
-  printf '%s %-20s %-40s -> %-20s %s\n' "$id" "$cls" "$design" "$verdict" "$([[ $ok == 1 ]] && echo ok || echo WRONG)"
+  printf '%s %-20s %-48s -> %-20s %s%s\n' "$id" "$cls" "$design" "$verdict" "$([[ $ok == 1 ]] && echo ok || echo WRONG)" \
+    "${BEFORE:+ (before: $bverdict)}"
 done < "$OUT/cases.txt"
 end=$(date +%s.%N)
 
 echo
-echo "per class (right = verdict none / the effect / unexplained for outside effects):"
+echo "per class (right = verdict none / the effect / unexplained for outside effects)${BEFORE:+; before = $BEFORE}:"
 for c in none negligible scale_error castor_kick gt_offset time_offset direction_asymmetry gt_yaw_misalignment floor_slope; do
-  [[ -n "${total[$c]:-}" ]] && printf '  %-20s %d/%d\n' "$c" "${right[$c]}" "${total[$c]}"
+  [[ -n "${total[$c]:-}" ]] && printf '  %-20s %d/%d%s\n' "$c" "${right[$c]}" "${total[$c]}" "${BEFORE:+   before ${bright[$c]}/${total[$c]}}"
 done
 echo "per design factor (all classes):"
 for p in $(printf '%s\n' "${!dtotal[@]}" | sort); do
-  printf '  %-12s %d/%d\n' "$p" "${dright[$p]}" "${dtotal[$p]}"
+  printf '  %-12s %d/%d%s\n' "$p" "${dright[$p]}" "${dtotal[$p]}" "${BEFORE:+   before ${bdright[$p]}/${dtotal[$p]}}"
 done
 n_all=$(wc -l < "$OUT/cases.txt")
 echo "time per campaign (generate + diagnose): $(awk -v s="$start" -v e="$end" -v n="$n_all" 'BEGIN { printf "%.2f s", (e - s) / n }')"

@@ -102,7 +102,7 @@ void QuantisationPhase(const std::vector<std::int64_t>& ticks, const std::vector
 }
 
 /// Interval classes, castor kicks and active windows from the motions.
-void AnnotateIntervals(DiagRun& r) {
+void AnnotateIntervals(DiagRun& r, int min_stand_intervals) {
   const std::size_t intervals = r.t.empty() ? 0 : r.t.size() - 1;
   r.interval_class.assign(intervals, -1);
   r.kick.assign(intervals, 0);
@@ -113,8 +113,13 @@ void AnnotateIntervals(DiagRun& r) {
     for (std::size_t i = m.first_interval; i <= m.last_interval; ++i)
       r.interval_class[i] = static_cast<signed char>(m.cls);
     // castor_kick: only a start from standstill (the run's first motion, or
-    // one after at least one still interval); spot turns excluded.
-    const bool from_standstill = k == 0 || r.motions[k - 1].last_interval + 1 < m.first_interval;
+    // one after a standstill); spot turns excluded. A standstill is what
+    // separates motions (effects_motion.hpp): min_stand_intervals still
+    // intervals or more. A shorter still stretch between two motions (a
+    // turn's last count, then a leg's first count a sample later under
+    // acceleration limits) is a junction: the robot did not pause there.
+    const bool from_standstill =
+        k == 0 || m.first_interval - r.motions[k - 1].last_interval > static_cast<std::size_t>(min_stand_intervals);
     if (from_standstill && m.cls != sim::MotionClass::kTurn)
       r.kick[m.first_interval] = static_cast<signed char>(m.sign);
     if (m.last_interval > m.first_interval) {
@@ -225,6 +230,11 @@ std::string SubsetName(ExperimentKind kind, const DiagRun& run, PieceType type, 
   return group.empty() ? what : group + ", " + what;
 }
 
+/// First sample of a motion from standstill as a piece sees it: the last
+/// sample whose counts read still (the sample before the first moving
+/// interval), or the run's first sample.
+std::size_t StartSample(const sim::MotionSegment& m) { return m.FirstSample() > 0 ? m.FirstSample() - 1 : 0; }
+
 void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, const PieceOptions& o,
                          SubsetTable& subsets) {
   const DiagRun& r = c.runs[run_index];
@@ -275,7 +285,15 @@ void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, co
     // out of the pieces.
     const bool joined_before = mi > 0 && r.motions[mi - 1].last_interval + 1 == m.first_interval;
     const bool joined_after = mi + 1 < r.motions.size() && m.last_interval + 1 == r.motions[mi + 1].first_interval;
-    const std::size_t s0 = m.FirstSample() + (joined_before ? 1 : 0);
+    // A motion from standstill starts one sample before its first count:
+    // the robot starts moving before the encoders show it (by up to a tick
+    // of travel; tens of ms with acceleration limits and coarse encoders),
+    // so the last sample that reads still may already show the motion and
+    // the castor kick of its start (contract: the kick is at the start of
+    // the motion, not at its first count). PieceOptions::start_before_first_count.
+    const std::size_t s0 = joined_before               ? m.FirstSample() + 1
+                           : o.start_before_first_count ? StartSample(m)
+                                                        : m.FirstSample();
     const std::size_t s1 = m.EndSample() - (joined_after ? 1 : 0);
     if (s1 <= s0 || s1 <= cur || s0 >= g1) {
       if (joined_after) cur = std::max(cur, std::min(m.EndSample() + 1, g1));
@@ -444,8 +462,8 @@ class CampaignBuilder {
 
   /// Finds the intervals and junctions of `r` (wheel travel, times, motions
   /// and quantisation set), appends it to the campaign and returns its fold.
-  int AddRun(DiagRun&& r) {
-    AnnotateIntervals(r);
+  int AddRun(DiagRun&& r, int min_stand_intervals) {
+    AnnotateIntervals(r, min_stand_intervals);
     FindJunctions(r);
     const int fold = FoldOf(r.direction);
     c_.runs.push_back(std::move(r));
@@ -470,7 +488,7 @@ class CampaignBuilder {
       r.motions = sim::SegmentMotions(r.left, r.right, manifest_.robot.wheelbase_m, mo);
       r.q_sd_left.assign(r.t.size(), 0.0);
       r.q_sd_right.assign(r.t.size(), 0.0);
-      const int fold = AddRun(std::move(r));
+      const int fold = AddRun(std::move(r), mo.min_stand_intervals);
       const DiagRun& run = c_.runs.back();
       Piece p;
       p.run = static_cast<int>(c_.runs.size()) - 1;
@@ -516,7 +534,7 @@ class CampaignBuilder {
         r.q_sd_left.assign(r.t.size(), 0.0);
         r.q_sd_right.assign(r.t.size(), 0.0);
       }
-      const int fold = AddRun(std::move(r));
+      const int fold = AddRun(std::move(r), mo.min_stand_intervals);
       const std::size_t before = c_.pieces.size();
       AddTrajectoryPieces(c_, static_cast<int>(c_.runs.size()) - 1, ex.kind, options_, subsets_);
       for (std::size_t k = before; k < c_.pieces.size(); ++k) c_.pieces[k].fold = fold;

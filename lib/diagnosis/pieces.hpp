@@ -137,6 +137,12 @@ struct PieceOptions {
   /// Measure motions from / to the mean ground-truth pose of the adjacent
   /// standstills (see Piece). Default true.
   bool average_standstills = true;
+  /// A motion from standstill starts at the last sample whose encoder counts
+  /// read still, one before its first moving interval: the robot (and the
+  /// castor kick of contract's castor_kick) may move before the first count
+  /// arrives. False: at the first moving interval (before this session;
+  /// kept for comparison). Default true.
+  bool start_before_first_count = true;
   sim::MotionOptions motion;  ///< stand_eps_m is set from the encoder tick
 
   std::string Check() const;
