@@ -36,6 +36,8 @@ std::string PieceOptions::Check() const {
   if (!(max_piece_length_m > 0.0)) return fmt::format("max_piece_length_m = {} must be > 0", max_piece_length_m);
   if (!(max_piece_angle_rad > 0.0)) return fmt::format("max_piece_angle_rad = {} must be > 0", max_piece_angle_rad);
   if (folds < 2) return fmt::format("folds = {} must be >= 2", folds);
+  if (!(start_lead_fraction > 0.0))
+    return fmt::format("start_lead_fraction = {} must be > 0", start_lead_fraction);
   if (auto e = motion.Check(); !e.empty()) return "motion: " + e;
   return {};
 }
@@ -230,13 +232,27 @@ std::string SubsetName(ExperimentKind kind, const DiagRun& run, PieceType type, 
   return group.empty() ? what : group + ", " + what;
 }
 
-/// First sample of a motion from standstill as a piece sees it: the last
-/// sample whose counts read still (the sample before the first moving
-/// interval), or the run's first sample.
-std::size_t StartSample(const sim::MotionSegment& m) { return m.FirstSample() > 0 ? m.FirstSample() - 1 : 0; }
+/// Whether a castor-kick start (a straight or arc motion from standstill)
+/// may have begun before the last sample whose counts read still, i.e. the
+/// kick may already show there. The robot starts before its first count:
+/// under constant acceleration from rest the first of the n counts of the
+/// first moving interval (the faster wheel's) comes after the fraction
+/// 1 / sqrt(n) of the time since the start, so the start precedes that
+/// sample by at most dt / (sqrt(n) - 1) (at constant speed dt / (n - 1)).
+/// The start is ambiguous when that bound exceeds lead_fraction of the
+/// interval dt (tick_*_m: metres per count; 0 when the run gives
+/// distances, whose resolution is unknown: not ambiguous).
+bool KickStartAmbiguous(const DiagRun& r, const sim::MotionSegment& m, double tick_left_m, double tick_right_m,
+                        double lead_fraction) {
+  const std::size_t i = m.first_interval;
+  if (r.kick[i] == 0 || i == 0 || !(tick_left_m > 0.0 && tick_right_m > 0.0)) return false;
+  const double n = std::max(std::abs(r.left[i + 1] - r.left[i]) / tick_left_m,
+                            std::abs(r.right[i + 1] - r.right[i]) / tick_right_m);
+  return std::sqrt(n) - 1.0 < 1.0 / lead_fraction;
+}
 
 void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, const PieceOptions& o,
-                         SubsetTable& subsets) {
+                         SubsetTable& subsets, double tick_left_m, double tick_right_m) {
   const DiagRun& r = c.runs[run_index];
   const std::size_t n = r.t.size();
   std::size_t g0 = n, g1 = 0;
@@ -285,15 +301,16 @@ void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, co
     // out of the pieces.
     const bool joined_before = mi > 0 && r.motions[mi - 1].last_interval + 1 == m.first_interval;
     const bool joined_after = mi + 1 < r.motions.size() && m.last_interval + 1 == r.motions[mi + 1].first_interval;
-    // A motion from standstill starts one sample before its first count:
-    // the robot starts moving before the encoders show it (by up to a tick
-    // of travel; tens of ms with acceleration limits and coarse encoders),
-    // so the last sample that reads still may already show the motion and
-    // the castor kick of its start (contract: the kick is at the start of
-    // the motion, not at its first count). PieceOptions::start_before_first_count.
-    const std::size_t s0 = joined_before               ? m.FirstSample() + 1
-                           : o.start_before_first_count ? StartSample(m)
-                                                        : m.FirstSample();
+    // The castor kick happens at the motion's start (contract), and the
+    // robot starts before its first count (tens of ms with acceleration
+    // limits and coarse encoders): when the encoders do not locate the
+    // start (KickStartAmbiguous), the last sample that reads still may
+    // already show the kick, so the motion's first piece starts one sample
+    // earlier and that sample leaves the standstill
+    // (PieceOptions::start_before_first_count).
+    const bool early = !joined_before && o.start_before_first_count &&
+                       KickStartAmbiguous(r, m, tick_left_m, tick_right_m, o.start_lead_fraction);
+    const std::size_t s0 = joined_before ? m.FirstSample() + 1 : early ? m.FirstSample() - 1 : m.FirstSample();
     const std::size_t s1 = m.EndSample() - (joined_after ? 1 : 0);
     if (s1 <= s0 || s1 <= cur || s0 >= g1) {
       if (joined_after) cur = std::max(cur, std::min(m.EndSample() + 1, g1));
@@ -536,7 +553,9 @@ class CampaignBuilder {
       }
       const int fold = AddRun(std::move(r), mo.min_stand_intervals);
       const std::size_t before = c_.pieces.size();
-      AddTrajectoryPieces(c_, static_cast<int>(c_.runs.size()) - 1, ex.kind, options_, subsets_);
+      AddTrajectoryPieces(c_, static_cast<int>(c_.runs.size()) - 1, ex.kind, options_, subsets_,
+                          tr.has_ticks() ? robot.MetresPerTickLeft() : 0.0,
+                          tr.has_ticks() ? robot.MetresPerTickRight() : 0.0);
       for (std::size_t k = before; k < c_.pieces.size(); ++k) c_.pieces[k].fold = fold;
     }
   }

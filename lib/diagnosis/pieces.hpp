@@ -137,12 +137,18 @@ struct PieceOptions {
   /// Measure motions from / to the mean ground-truth pose of the adjacent
   /// standstills (see Piece). Default true.
   bool average_standstills = true;
-  /// A motion from standstill starts at the last sample whose encoder counts
-  /// read still, one before its first moving interval: the robot (and the
-  /// castor kick of contract's castor_kick) may move before the first count
-  /// arrives. False: at the first moving interval (before this session;
-  /// kept for comparison). Default true.
+  /// A straight or arc motion from standstill whose start the encoders do
+  /// not locate (its first count may come more than start_lead_fraction of
+  /// a sample interval after the start, see pieces.cpp KickStartAmbiguous)
+  /// starts at the last sample whose counts read still, one before its
+  /// first moving interval: the castor kick (contract: at the start of the
+  /// motion) may already show there. False: every motion starts at its
+  /// first moving interval (the placement before; kept for comparison).
+  /// Default true.
   bool start_before_first_count = true;
+  /// See start_before_first_count (> 0). Default 0.1: with counts of the
+  /// faster wheel n < 121 in the first moving interval.
+  double start_lead_fraction = 0.1;
   sim::MotionOptions motion;  ///< stand_eps_m is set from the encoder tick
 
   std::string Check() const;
