@@ -234,21 +234,29 @@ std::string SubsetName(ExperimentKind kind, const DiagRun& run, PieceType type, 
 
 /// Whether a castor-kick start (a straight or arc motion from standstill)
 /// may have begun before the last sample whose counts read still, i.e. the
-/// kick may already show there. The robot starts before its first count:
-/// under constant acceleration from rest the first of the n counts of the
-/// first moving interval (the faster wheel's) comes after the fraction
-/// 1 / sqrt(n) of the time since the start, so the start precedes that
-/// sample by at most dt / (sqrt(n) - 1) (at constant speed dt / (n - 1)).
-/// The start is ambiguous when that bound exceeds lead_fraction of the
-/// interval dt (tick_*_m: metres per count; 0 when the run gives
-/// distances, whose resolution is unknown: not ambiguous).
+/// kick may already show there. The robot starts before its first count.
+/// At constant speed (as commanded, no acceleration limit) the start lies
+/// inside the first moving interval, a tick's time before the first count.
+/// Under acceleration from rest it can lie a good part of a sample earlier:
+/// the first of the n counts of the first moving interval (the faster
+/// wheel's) comes after the fraction 1 / sqrt(n) of the time since the
+/// start (constant acceleration), so the start precedes the sample by up to
+/// dt / (sqrt(n) - 1). Ambiguous: the speed still rises after the first
+/// moving interval (counts of both wheels in the next two intervals; more
+/// than 5 % and two counts of quantisation) and that bound exceeds
+/// lead_fraction of dt. tick_*_m: metres per count (0 when the run gives
+/// distances, whose resolution is unknown: never ambiguous).
 bool KickStartAmbiguous(const DiagRun& r, const sim::MotionSegment& m, double tick_left_m, double tick_right_m,
                         double lead_fraction) {
   const std::size_t i = m.first_interval;
   if (r.kick[i] == 0 || i == 0 || !(tick_left_m > 0.0 && tick_right_m > 0.0)) return false;
+  auto counts = [&](std::size_t k) {
+    return std::abs(r.left[k + 1] - r.left[k]) / tick_left_m + std::abs(r.right[k + 1] - r.right[k]) / tick_right_m;
+  };
+  const bool rising = m.last_interval < i + 2 || counts(i + 2) > 1.05 * counts(i + 1) + 2.0;
   const double n = std::max(std::abs(r.left[i + 1] - r.left[i]) / tick_left_m,
                             std::abs(r.right[i + 1] - r.right[i]) / tick_right_m);
-  return std::sqrt(n) - 1.0 < 1.0 / lead_fraction;
+  return rising && std::sqrt(n) - 1.0 < 1.0 / lead_fraction;
 }
 
 void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, const PieceOptions& o,
