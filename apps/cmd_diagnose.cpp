@@ -76,14 +76,19 @@ int RunDiagnose(DiagnoseCliOptions o) {
     throw InputError(o.manifest, why);
   }
   const diag::CampaignData campaign = diag::LoadCampaign(o.manifest, o.diag.pieces);
-  // Degenerate trajectory data (evaluation/data_warnings.hpp), per file.
+  // Degenerate data (evaluation/data_warnings.hpp), per file: trajectories
+  // and return errors.
   std::vector<std::string> warnings;
   for (const auto& file : campaign.files) {
-    const auto* t = std::get_if<TrajectoryData>(&file);
-    if (t == nullptr) continue;
-    TrajectoryDataCheck check(campaign.robot);
-    for (const auto& run : t->runs) check.Add(run);
-    for (auto& w : check.Warnings(t->path)) warnings.push_back(std::move(w));
+    if (const auto* t = std::get_if<TrajectoryData>(&file)) {
+      TrajectoryDataCheck check(campaign.robot);
+      for (const auto& run : t->runs) check.Add(run);
+      for (auto& w : check.Warnings(t->path)) warnings.push_back(std::move(w));
+    } else if (const auto* e = std::get_if<EndpointData>(&file)) {
+      EndpointDataCheck check;
+      for (const auto& run : e->runs) check.Add(run);
+      for (auto& w : check.Warnings(e->path)) warnings.push_back(std::move(w));
+    }
   }
   if (!o.baseline.empty()) {
     diag::GivenModel g;

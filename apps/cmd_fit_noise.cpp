@@ -281,7 +281,10 @@ std::string PlotSvg(const WheelNoiseFitSummary& s) {
   return io::SvgDocument(3 * (size + 90) + 60, bottom + 10, parts);
 }
 
-std::string FitNoiseReportHtml(const std::vector<std::string>& inputs, const WheelNoiseFitSummary& s, const std::string& svg) {
+/// The HTML page; `warnings`, `notes`: the JSON's (shown as in the text).
+std::string FitNoiseReportHtml(const std::vector<std::string>& inputs, const WheelNoiseFitSummary& s,
+                               const std::string& svg, const std::vector<std::string>& warnings,
+                               const std::vector<std::string>& notes) {
   std::string subject;
   for (const auto& i : inputs) subject += (subject.empty() ? "" : ", ") + i;
   io::HtmlReport rep("umbmark fit-noise", subject);
@@ -297,6 +300,11 @@ std::string FitNoiseReportHtml(const std::vector<std::string>& inputs, const Whe
   if (flagged) steps.push_back("An element with |z| > 3 is not explained by white wheel noise: run `umbmark diagnose` on the campaign.");
   if (s.runs < 20) steps.push_back("Intervals are wide with few runs: 20 or more runs per group narrow them.");
   rep.NextSteps(steps);
+  rep.Warnings(warnings);
+  if (!notes.empty()) {
+    rep.Heading("Notes");
+    for (const auto& n : notes) rep.Paragraph(n);
+  }
   rep.Heading("Systematic mean per group");
   std::vector<std::vector<std::string>> rows;
   for (std::size_t g = 0; g < s.groups.size(); ++g)
@@ -382,6 +390,21 @@ std::vector<std::string> Warnings(const Loaded& data, const FitResult& f) {
   return warnings;
 }
 
+/// What the reader should know about the systematic errors' estimate
+/// (text, JSON `notes`, HTML).
+std::vector<std::string> Notes(const FitResult& f) {
+  std::vector<std::string> notes;
+  if (!f.estimate) return notes;
+  if (f.estimate->E_d_determined && f.estimate->E_d_se > 0.5 * WheelNoiseFitOptions{}.E_d_prior_sigma)
+    notes.push_back(fmt::format("the scatter of this design barely shows E_d (+- {:.4f}, near the prior's {}); the "
+                                "intervals include that uncertainty: give --params CAL.json for narrower ones",
+                                f.estimate->E_d_se, WheelNoiseFitOptions{}.E_d_prior_sigma));
+  if (!f.estimate->E_b_determined)
+    notes.push_back("this design (no turns) does not show E_b; k is relative to the recorded wheelbase (a wheelbase "
+                    "off by x % moves k by up to x %): give --params CAL.json from `umbmark calibrate`");
+  return notes;
+}
+
 /// The JSON document (contract keys first).
 nlohmann::json ResultJson(const FitNoiseOptions& o, const Loaded& data, const FitResult& f) {
   const WheelNoiseFitSummary& s = f.s;
@@ -434,6 +457,7 @@ nlohmann::json ResultJson(const FitNoiseOptions& o, const Loaded& data, const Fi
   }
   j["likelihood_passes"] = s.likelihood_passes;
   j["warnings"] = Warnings(data, f);
+  j["notes"] = Notes(f);
   return j;
 }
 
@@ -456,13 +480,7 @@ void PrintText(const FitNoiseOptions& o, const Loaded& data, const FitResult& f,
                                           : std::string(" (from the means; see the warning)"),
                e.E_b,
                f.estimate->E_b_determined ? fmt::format(" +- {:.5f} (from the means)", f.estimate->E_b_se) : "");
-    if (f.estimate->E_d_determined && f.estimate->E_d_se > 0.5 * WheelNoiseFitOptions{}.E_d_prior_sigma)
-      fmt::print("  note: the scatter of this design barely shows E_d (+- {:.4f}, near the prior's {}); the intervals "
-                 "include that uncertainty: give --params CAL.json for narrower ones\n",
-                 f.estimate->E_d_se, WheelNoiseFitOptions{}.E_d_prior_sigma);
-    if (!f.estimate->E_b_determined)
-      fmt::print("  note: this design (no turns) does not show E_b; k is relative to the recorded wheelbase "
-                 "(a wheelbase off by x % moves k by up to x %): give --params CAL.json from `umbmark calibrate`\n");
+    for (const auto& n : j["notes"]) fmt::print("  note: {}\n", n.get<std::string>());
   } else if (f.source == "params") {
     fmt::print("  systematic errors from {}\n", o.params_json);
   } else {
@@ -498,7 +516,7 @@ std::vector<std::string> WriteOutputs(const FitNoiseOptions& o, const Loaded& da
     written.push_back(o.plot + " (plot)");
   }
   if (!o.report.empty()) {
-    CommandOutputs().Write(o.report, FitNoiseReportHtml(o.inputs, s, svg));
+    CommandOutputs().Write(o.report, FitNoiseReportHtml(o.inputs, s, svg, j["warnings"], j["notes"]));
     written.push_back(o.report + " (HTML report)");
   }
   if (o.ros2.empty()) return written;

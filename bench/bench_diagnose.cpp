@@ -142,6 +142,9 @@ struct Case {
   /// what the verdict must name (`expected` empty: `none`).
   std::optional<diag::GivenModel> given;
   std::vector<std::string> expected;
+  /// base_noise_left / base_noise_right: the wheel whose k is wrong ('L',
+  /// 'R'); wheel_noise_error counts only with that wheel's ratio the one off.
+  char wrong_wheel = 0;
   std::uint64_t seed = 0;
   sim::CampaignSimOptions sim;
   Manifest manifest;
@@ -166,6 +169,8 @@ double LogU(std::mt19937_64& g, double lo, double hi) { return std::exp(U(g, std
 ///   base_wheelbase         wheelbase +-0.5-2 % (1-12 mm)
 ///   base_ratio             D_R/D_L +-1000-5000 ppm, mean diameter kept
 ///   base_noise             k_L, k_R both x2 or both x0.5
+///   base_noise_left        k_L alone x2 or x0.5 (k_R right)
+///   base_noise_right       k_R alone x2 or x0.5 (k_L right)
 ///   base_wheelbase_castor  base_wheelbase + castor_kick kappa +-0.005-0.02 rad
 ///   base_ratio_gt_offset   base_ratio + gt_offset |(dx, dy)| 0.01-0.05 m
 /// -- and the verdict must name every wrong parameter and effect.
@@ -196,6 +201,12 @@ void MakeBaselineCase(std::mt19937_64& g, Case& c) {
     const double f = U(g, 0.0, 1.0) < 0.5 ? 2.0 : 0.5;
     m.k_L *= f;
     m.k_R *= f;
+    c.expected.push_back("wheel_noise_error");
+  }
+  if (t == "base_noise_left" || t == "base_noise_right") {
+    const double f = U(g, 0.0, 1.0) < 0.5 ? 2.0 : 0.5;
+    c.wrong_wheel = t == "base_noise_left" ? 'L' : 'R';
+    (c.wrong_wheel == 'L' ? m.k_L : m.k_R) *= f;
     c.expected.push_back("wheel_noise_error");
   }
   sim::Effects& fx = c.sim.effects;
@@ -342,8 +353,8 @@ int main(int argc, char** argv) {
     classes.push_back("none");
     for (const auto& d : sim::EffectCatalogue())
       if (d.simulated) classes.emplace_back(d.name);
-    for (const char* b : {"base_ok", "base_wheelbase", "base_ratio", "base_noise", "base_wheelbase_castor",
-                          "base_ratio_gt_offset"})
+    for (const char* b : {"base_ok", "base_wheelbase", "base_ratio", "base_noise", "base_noise_left",
+                          "base_noise_right", "base_wheelbase_castor", "base_ratio_gt_offset"})
       classes.emplace_back(b);
   }
   std::vector<Case> cases;
@@ -440,13 +451,27 @@ int main(int argc, char** argv) {
     if (c.given) {
       bool all = true;
       for (const auto& e : c.expected) all = all && named(e.c_str());
+      // One wheel's k wrong: the named wheel_noise_error must put the
+      // error on that wheel (its ratio k_fit / k_given further from 1) and
+      // find the other right (within 25 %, the size below which a noise
+      // error is negligible).
+      if (c.wrong_wheel) {
+        bool wheel = false;
+        for (const auto& e : s.explanation) {
+          if (e.effect != sim::EffectKind::kWheelNoiseError) continue;
+          const double wrong = e.params.at(c.wrong_wheel == 'L' ? "ratio_L" : "ratio_R");
+          const double other = e.params.at(c.wrong_wheel == 'L' ? "ratio_R" : "ratio_L");
+          wheel = std::abs(std::log(wrong)) > std::abs(std::log(other)) && std::abs(other - 1.0) < 0.25;
+        }
+        all = all && wheel;
+      }
       const bool ok = c.expected.empty() ? s.verdict == "none" : all;
       BaselineTally& t = baseline[c.truth];
       ++t.n;
       t.right += ok;
       if (!c.expected.empty()) {
         ++base_wrong;
-        base_wrong_named += named(c.expected.front().c_str());
+        base_wrong_named += c.wrong_wheel ? ok : named(c.expected.front().c_str());
       }
     } else if (c.truth == "negligible") {
       ++negligible;
@@ -474,6 +499,9 @@ int main(int argc, char** argv) {
       }
     }
     nlohmann::json truth = sim::CampaignTruthJson(campaign, c.sim);
+    nlohmann::json explanation = nlohmann::json::array();
+    for (const auto& e : s.explanation)
+      explanation.push_back({{"effect", sim::EffectToString(e.effect)}, {"params", e.params}, {"negligible", e.negligible}});
     records.push_back({{"case", i},
                        {"truth", c.truth},
                        {"verdict", s.verdict},
@@ -482,6 +510,7 @@ int main(int argc, char** argv) {
                        {"expected_verdict", c.expected_verdict},
                        {"right", right},
                        {"expected", c.expected},
+                       {"explanation", explanation},
                        {"p_value", s.p_value},
                        {"score_p_value", s.score_p_value},
                        {"tests_p_value", s.tests_p_value},

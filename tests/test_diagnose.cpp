@@ -18,6 +18,7 @@
 #include "diagnosis/gap_stats.hpp"
 #include "diagnosis/model.hpp"
 #include "diagnosis/piece_noise.hpp"
+#include "evaluation/data_warnings.hpp"
 #include "io/campaign_writer.hpp"
 #include "simulation/campaign_sim.hpp"
 #include "support/diag_campaign.hpp"
@@ -595,4 +596,58 @@ TEST_CASE("diagnose: a noise floor's size is the growth of the spread of the pie
   CHECK(d.explanation.front().negligible);
   CHECK(d.explanation.front().relative_size < 0.25);
   CHECK(d.explanation.front().size_mrad < 1e3 * std::sqrt(2.0) * 0.001 / b);
+}
+
+TEST_CASE("endpoint data check: single runs, copies, all zero", "[diagnose][warnings]") {
+  auto run = [](const char* dir, double ex, double ey, std::optional<double> th) {
+    ReturnError r;
+    r.run = "r";
+    r.direction = dir;
+    r.ex_m = ex;
+    r.ey_m = ey;
+    r.etheta_rad = th;
+    return r;
+  };
+  EndpointDataCheck ok;
+  for (int i = 0; i < 5; ++i) {
+    ok.Add(run("cw", 0.01 + 1e-3 * i, -0.02, 0.01));
+    ok.Add(run("ccw", -0.01, 0.02 + 1e-3 * i, std::nullopt));
+  }
+  CHECK(ok.Warnings("sq.csv").empty());
+  EndpointDataCheck copies;
+  for (int i = 0; i < 5; ++i) copies.Add(run(i % 2 ? "cw" : "ccw", 0.012, -0.004, 0.02));
+  auto w = copies.Warnings("sq.csv");
+  REQUIRE(w.size() == 1);
+  CHECK(w[0] == "sq.csv: all 5 runs end at exactly the same return error (zero scatter): real runs scatter, so check "
+                "the runs are not copies");
+  EndpointDataCheck zero;
+  for (int i = 0; i < 4; ++i) zero.Add(run(i % 2 ? "cw" : "ccw", 0.0, 0.0, std::nullopt));
+  w = zero.Warnings("sq.csv");
+  REQUIRE(w.size() == 1);
+  CHECK(w[0].find("every return error is exactly 0 (4 runs)") != std::string::npos);
+  EndpointDataCheck single;
+  single.Add(run("cw", 0.01, 0.0, 0.0));
+  w = single.Warnings("one.csv");
+  REQUIRE(w.size() == 1);
+  CHECK(w[0].find("one.csv: a single run") == 0);
+}
+
+TEST_CASE("umbmark diagnose: degenerate endpoint files are warned about in the JSON", "[diagnose][cli][warnings]") {
+  using testing::Q;
+  const auto dir = testing::TempDir("diagnose-endpoint-warn");
+  Small s = MakeSmall(83, 1, 10);  // one cw and one ccw square, as return errors
+  s.sim.endpoint_squares = true;
+  const sim::SimulatedCampaign c = sim::SimulateCampaign(s.manifest, s.sim);
+  const std::string manifest = io::WriteCampaign(c.manifest, c.data, (dir / "campaign").string());
+  const auto r = testing::RunCli("diagnose " + Q(manifest) + " --null-sims 20 --folds 2 --json -");
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  REQUIRE(j.contains("warnings"));
+  int single = 0;
+  for (const auto& w : j["warnings"])
+    single += w.get<std::string>().find("only 1 cw run") != std::string::npos ||
+              w.get<std::string>().find("only 1 ccw run") != std::string::npos;
+  CHECK(single == 2);
+  CHECK(r.err.find("warning: ") != std::string::npos);
 }

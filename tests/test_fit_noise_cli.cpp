@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "support/run_cli.hpp"
+#include "io/html_report.hpp"
 
 #include "core/angles.hpp"
 #include "error_models/path_spec.hpp"
@@ -143,6 +144,36 @@ TEST_CASE("fit-noise CLI: endpoint, trajectory and manifest inputs agree; contra
   const auto text_out = Run(fmt::format("fit-noise {} --robot {} --distance 10", c.endpoint.string(), c.robot.string()));
   CHECK(text_out.status == 0);
   CHECK(text_out.out.find("Goodness of fit") != std::string::npos);
+  if (!std::getenv("UMBMARK_KEEP_TEST_FILES")) fs::remove_all(c.dir);
+}
+
+TEST_CASE("fit-noise CLI: the HTML report shows the warnings and notes the text and JSON give",
+          "[fit_noise_cli][report]") {
+  // Trajectories with ground truth but no --meas-sigma: the reference-noise
+  // warning; back-and-forth runs only (no turns): the E_b note.
+  const Campaign c = MakeCampaign();
+  const fs::path html = c.dir / "fn.html", json = c.dir / "fn.json";
+  const auto r = Run(fmt::format("fit-noise {} --robot {} --json {} --report {}", c.trajectory.string(),
+                                 c.robot.string(), json.string(), html.string()));
+  REQUIRE(r.status == 0);
+  std::ifstream jf(json);
+  const nlohmann::json j = nlohmann::json::parse(jf);
+  std::ifstream hf(html);
+  const std::string page((std::istreambuf_iterator<char>(hf)), std::istreambuf_iterator<char>());
+  REQUIRE(j["warnings"].size() >= 1);
+  REQUIRE(j["notes"].size() >= 1);
+  CHECK(j["warnings"][0].get<std::string>().find("reference noise is 0") != std::string::npos);
+  CHECK(j["notes"][0].get<std::string>().find("does not show E_b") != std::string::npos);
+  CHECK(page.find("<h2>Warnings</h2>") != std::string::npos);
+  CHECK(page.find("<h2>Notes</h2>") != std::string::npos);
+  for (const auto& w : j["warnings"]) {
+    CHECK(page.find(io::HtmlEscape(w.get<std::string>())) != std::string::npos);
+    CHECK(r.out.find("WARNING: " + w.get<std::string>()) != std::string::npos);
+  }
+  for (const auto& n : j["notes"]) {
+    CHECK(page.find(io::HtmlEscape(n.get<std::string>())) != std::string::npos);
+    CHECK(r.out.find("note: " + n.get<std::string>()) != std::string::npos);
+  }
   if (!std::getenv("UMBMARK_KEEP_TEST_FILES")) fs::remove_all(c.dir);
 }
 

@@ -259,6 +259,18 @@ void FitNoiseEffect(const Shared& x, sim::EffectKind kind, Candidate& cd) {
   cd.heldout_loglik_gain = cv.loglik - x.cv_ll_base;
   const double gcv = ComputeGap(c, cv.scores, x.options.gap).score;
   cd.heldout_shrink = Shrink(Gap(gcv, x.null_median), x.gap_cv_before);
+  // With the wheel noise given (diagnose --baseline --kl --kr), bumps at
+  // their rate bound are their Gaussian limit: many small travel errors,
+  // rate x sigma_b^2 of variance per metre, i.e. wheel noise growing with
+  // distance, more than the given k. That is a wheel_noise_error (which
+  // names the wheel and the k to set), not bumps.
+  if (kind == sim::EffectKind::kBumpOutliers && !cf.fit_wheel_noise && ne.bump_rate >= 0.95 * kMaxBumpRatePerMetre) {
+    cd.identifiable = false;
+    cd.note = fmt::format("not identifiable here: indistinguishable from wheel_noise_error: fitted at its rate bound "
+                          "({:.2g} per metre of {:.2g} mm), bumps are their Gaussian limit, wheel noise growing "
+                          "with distance, more than the given k",
+                          ne.bump_rate, 1e3 * std::sqrt(ne.bump_s2));
+  }
 }
 
 }  // namespace

@@ -403,13 +403,19 @@ NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBase
   };
   auto cost = [&](const std::vector<double>& x) { return -TotalLogLik(eps, bases, pieces, use, unpack(x)); };
   const std::vector<double> lower = {-60.0, -60.0, std::log(1e-4), std::log(1e-10)};
-  const std::vector<double> upper = {60.0, 60.0, std::log(2.0), std::log(1e-2)};
+  const std::vector<double> upper = {60.0, 60.0, std::log(kMaxBumpRatePerMetre), std::log(1e-2)};
   const double k2 = std::max(0.5 * (start.kL2 + start.kR2), 1e-12);
   std::vector<std::vector<double>> starts = {
       {std::log(std::max(start.kL2, 1e-14) * 0.7), std::log(std::max(start.kR2, 1e-14) * 0.7), std::log(0.2),
        std::log(30.0 * k2)},
       {std::log(std::max(start.kL2, 1e-14) * 0.9), std::log(std::max(start.kR2, 1e-14) * 0.9), std::log(1.0),
        std::log(6.0 * k2)}};
+  // With k_L, k_R given, also start from the Gaussian limit (many bumps
+  // of one metre's wheel noise each): more wheel noise than given is found
+  // there, at the rate bound, and not missed by starts among rare bumps.
+  if (!fit_wheel_noise)
+    starts.push_back({std::log(std::max(start.kL2, 1e-14)), std::log(std::max(start.kR2, 1e-14)),
+                      std::log(kMaxBumpRatePerMetre), std::log(k2)});
   if (start.bump_rate > 0.0 && start.bump_s2 > 0.0) {
     if (start_only) starts.clear();
     starts.insert(starts.begin(), {std::log(start.kL2), std::log(start.kR2), std::log(start.bump_rate),

@@ -48,6 +48,10 @@ struct NoiseParams {
 /// Covariance of piece j (Gaussian part: no bumps).
 Eigen::Matrix3d PieceCovariance(const PieceBases& B, const NoiseParams& n);
 
+/// Largest bump rate FitBumps fits [per metre of wheel travel]: a fit at
+/// this bound is the Gaussian limit of bumps (many small ones: wheel noise).
+inline constexpr double kMaxBumpRatePerMetre = 2.0;
+
 /// Most bumps per piece the mixture distinguishes (the Poisson tail beyond
 /// is lumped into this count).
 inline constexpr int kMaxBumpsPerPiece = 5;

@@ -118,6 +118,9 @@ void Indistinguishable(const CandidateFits& fits, const VerdictOptions& options,
       out.indistinguishable.push_back(fmt::format("{} cannot be told apart from the baseline with these experiments: {}",
                                                   sim::EffectToString(cd.effect),
                                                   cd.note.substr(cd.note.find("indistinguishable"))));
+    else if (!cd.identifiable && cd.note.find("indistinguishable from wheel_noise_error") != std::string::npos)
+      out.indistinguishable.push_back(fmt::format("{} cannot be told apart from {}", sim::EffectToString(cd.effect),
+                                                  cd.note.substr(cd.note.find("wheel_noise_error"))));
     else if (cd.weak && sim::EffectToString(cd.effect) != out.verdict)
       out.indistinguishable.push_back(
           fmt::format("{} can hardly be told apart from the baseline with these experiments: {}",

@@ -20,6 +20,28 @@ std::string Examples(const std::vector<std::string>& ids, std::size_t total) {
   return out;
 }
 
+/// What the number of runs and their spread say, for both kinds of data: a
+/// single run, a single cw or ccw run, and (`copies`) runs that are
+/// bit-for-bit the same.
+void CountWarnings(const std::string& what, std::size_t runs, const std::map<std::string, std::size_t>& square_runs,
+                   bool copies, const char* same_what, std::vector<std::string>& w) {
+  if (runs == 1) {
+    w.push_back(fmt::format("{}: a single run: nothing shows how runs scatter; record 5 or more", what));
+    return;
+  }
+  for (const auto& [dir, count] : square_runs) {
+    if (count == 1) {
+      w.push_back(fmt::format("{}: only 1 {} run: its scatter cannot be estimated; UMBmark asks for 5 per direction",
+                              what, dir));
+    }
+  }
+  if (copies) {
+    w.push_back(fmt::format("{}: all {} runs end at exactly the same {} (zero scatter): real runs scatter, so check "
+                            "the runs are not copies",
+                            what, runs, same_what));
+  }
+}
+
 }  // namespace
 
 void TrajectoryDataCheck::Add(const TrajectoryRun& run) {
@@ -87,22 +109,31 @@ std::vector<std::string> TrajectoryDataCheck::Warnings(const std::string& what) 
                             "measured at those samples only",
                             what, gt_samples_, samples_, 100.0 * static_cast<double>(gt_samples_) / static_cast<double>(samples_)));
   }
-  if (runs_ == 1) {
-    w.push_back(fmt::format("{}: a single run: nothing shows how runs scatter; record 5 or more", what));
-  } else {
-    for (const auto& [dir, count] : square_runs_) {
-      if (count == 1) {
-        w.push_back(fmt::format("{}: only 1 {} run: its scatter cannot be estimated; UMBmark asks for 5 per "
-                                "direction",
-                                what, dir));
-      }
-    }
-    if (all_same_end_ && still_ < runs_) {
-      w.push_back(fmt::format("{}: all {} runs end at exactly the same ground-truth pose (zero scatter): real runs "
-                              "scatter, so check the runs are not copies",
-                              what, runs_));
-    }
+  CountWarnings(what, runs_, square_runs_, all_same_end_ && still_ < runs_, "ground-truth pose", w);
+  return w;
+}
+
+void EndpointDataCheck::Add(const ReturnError& run) {
+  const double e[3] = {run.ex_m, run.ey_m, run.etheta_rad.value_or(0.0)};
+  if (runs_++ == 0) {
+    std::copy(e, e + 3, first_);
+    first_has_theta_ = run.etheta_rad.has_value();
+  } else if (!std::equal(e, e + 3, first_) || first_has_theta_ != run.etheta_rad.has_value()) {
+    all_same_ = false;
   }
+  all_zero_ = all_zero_ && e[0] == 0.0 && e[1] == 0.0 && e[2] == 0.0;
+  if (run.direction == "cw" || run.direction == "ccw") ++square_runs_[run.direction];
+}
+
+std::vector<std::string> EndpointDataCheck::Warnings(const std::string& what) const {
+  std::vector<std::string> w;
+  if (runs_ == 0) return w;
+  if (all_zero_) {
+    w.push_back(fmt::format("{}: every return error is exactly 0 ({} runs): nothing was measured (placeholder "
+                            "values?); record the robot's final pose against its start",
+                            what, runs_));
+  }
+  CountWarnings(what, runs_, square_runs_, all_same_ && !all_zero_, "return error", w);
   return w;
 }
 

@@ -5,6 +5,9 @@
 // whose ground-truth end poses are bit-for-bit identical (copies: zero
 // scatter). Streaming: Add() one run at a time; memory does not grow with
 // the number of runs beyond the handful of example ids it names.
+// EndpointDataCheck does the same for return errors (diagnose's endpoint
+// files): a single run, a single cw or ccw run, identical return errors
+// (copies), every return error exactly 0 (nothing measured).
 #pragma once
 
 #include <cstddef>
@@ -45,6 +48,21 @@ class TrajectoryDataCheck {
   std::map<std::string, std::size_t> square_runs_;  ///< cw, ccw counts
   bool all_same_end_ = true;
   double end_[3] = {0.0, 0.0, 0.0};
+};
+
+class EndpointDataCheck {
+ public:
+  void Add(const ReturnError& run);
+  /// The warnings so far (empty when there is nothing to say); `what` names
+  /// the data in the messages (a file).
+  std::vector<std::string> Warnings(const std::string& what) const;
+
+ private:
+  std::size_t runs_ = 0;
+  std::map<std::string, std::size_t> square_runs_;  ///< cw, ccw counts
+  bool all_same_ = true, all_zero_ = true;
+  double first_[3] = {0.0, 0.0, 0.0};
+  bool first_has_theta_ = false;
 };
 
 }  // namespace umbmark
