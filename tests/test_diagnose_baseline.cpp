@@ -196,6 +196,27 @@ TEST_CASE("diagnose --baseline: wheel noise given x2 and x0.5 is named, the rati
   }
 }
 
+TEST_CASE("diagnose --baseline: one wheel's noise wrong is named on that wheel", "[diagnose][baseline]") {
+  // Only k_L (or only k_R) off, x0.5 or x2: wheel_noise_error with that
+  // wheel's ratio k_fit / k_given near 1/factor and the other near 1, not
+  // bump_outliers (whose Gaussian limit, many small bumps, is the same
+  // extra wheel noise).
+  const sim::SimulatedCampaign sc = Simulate(305);
+  const CampaignData c = BuildCampaign(sc.manifest, sc.data);
+  for (const bool left : {true, false}) {
+    for (const double factor : {0.5, 2.0}) {
+      const DiagnoseSummary d = Diagnose(
+          c, Fast(Given(TrueCal(), left ? factor * kTrueKL : kTrueKL, left ? kTrueKR : factor * kTrueKR)));
+      INFO((left ? "k_L x" : "k_R x") << factor << "\n" << Describe(d));
+      CHECK(d.verdict == "wheel_noise_error");
+      const ExplanationStep* s = Step(d, sim::EffectKind::kWheelNoiseError);
+      REQUIRE(s);
+      CHECK_THAT(s->params.at(left ? "ratio_L" : "ratio_R"), WithinRel(1.0 / factor, 0.25));
+      CHECK_THAT(s->params.at(left ? "ratio_R" : "ratio_L"), WithinAbs(1.0, 0.15));
+    }
+  }
+}
+
 TEST_CASE("umbmark diagnose --baseline: JSON keys, corrections, bad input", "[diagnose][baseline][cli]") {
   using testing::Q;
   const auto dir = testing::TempDir("diagnose-baseline");
