@@ -7,6 +7,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
 
+#include "core/angles.hpp"
 #include "stats/optimize.hpp"
 
 namespace umbmark::diag {
@@ -114,9 +115,13 @@ std::vector<Innovation> RunInnovations(const std::vector<double>& eps, const std
     in.S = PieceCovariance(bases[j], n0);
     if (!block) continue;
     if (pieces[j].run != current) {
+      // w = (max(u, 0), min(u, 0)) for u ~ N(0, tau_sd^2): mean
+      // tau_sd / sqrt(2 pi) (1, -1), variances tau_sd^2 (1/2 - 1/(2 pi)),
+      // covariance tau_sd^2 / (2 pi).
       current = pieces[j].run;
-      m.setZero();
-      V = 0.5 * n.run_tau2 * Eigen::Matrix2d::Identity();
+      const double s2 = n.run_tau2, c = 1.0 / (2.0 * kPi);
+      m = std::sqrt(s2 * c) * Eigen::Vector2d(1.0, -1.0);
+      V << s2 * (0.5 - c), s2 * c, s2 * c, s2 * (0.5 - c);
     }
     const int d = pieces[j].components;
     Eigen::Matrix<double, 3, 2> G;

@@ -21,10 +21,11 @@
 // the block only adds what ties the pieces of a run together.
 //
 // Scores (gap_stats.hpp) under the block: the innovations of a Kalman filter
-// along the run over w = (u+, u-) ~ N(0, tau_sd^2 / 2 I), e_j = [J-, J+]_j w
-// + n_j (the Gaussian with the same second moments): piece j is scored
-// given the run's earlier pieces, so the scores are again independent
-// N(0, 1) under the model.
+// along the run over w = (max(u, 0), min(u, 0)), e_j = [J-, J+]_j w + n_j,
+// with w Gaussian of w's true mean and covariance (the one-sided slopes give
+// e a mean: tau_sd / sqrt(2 pi) (J- - J+)): piece j is scored given the
+// run's earlier pieces, so the scores are again independent N(0, 1) under
+// the model (to second moments).
 #pragma once
 
 #include <functional>
