@@ -8,7 +8,6 @@
 #include <Eigen/Dense>
 
 #include "core/angles.hpp"
-#include "stats/optimize.hpp"
 
 namespace umbmark::diag {
 
@@ -140,25 +139,6 @@ std::vector<Innovation> RunInnovations(const std::vector<double>& eps, const std
     V = 0.5 * (V + V.transpose()).eval();
   }
   return out;
-}
-
-double FitRunTau2(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
-                  const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& n) {
-  bool levers = false;
-  for (std::size_t j = 0; j < pieces.size() && !levers; ++j)
-    levers = Used(&use, j) && (bases[j].tau_lever_pos.squaredNorm() + bases[j].tau_lever_neg.squaredNorm() > 0.0);
-  if (!levers) return 0.0;
-  const std::vector<RunSums> sums = Sums(eps, bases, pieces, n, &use);
-  auto cost = [&](double log_sd) {
-    const double s2 = std::exp(2.0 * log_sd);
-    double ll = 0.0;
-    for (const RunSums& r : sums) ll += RunLogLik(r, s2);
-    return -ll;
-  };
-  const ScalarMinimum best = MinimizeBrent(cost, std::log(1e-4), std::log(1.0));
-  double ll0 = 0.0;
-  for (const RunSums& r : sums) ll0 += r.ll0;
-  return -best.f > ll0 ? std::exp(2.0 * best.x) : 0.0;
 }
 
 std::vector<PieceBases> RescaleTimeLevers(const MeanModel& model, const ParamVector& p, std::vector<PieceBases> bases,

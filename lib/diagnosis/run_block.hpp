@@ -58,12 +58,6 @@ struct Innovation {
 std::vector<Innovation> RunInnovations(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
                                        const std::vector<Piece>& pieces, const NoiseParams& n);
 
-/// tau_sd^2 maximising BlockLogLik with the other noise parameters of `n`
-/// held (Brent on log tau_sd over 0.1 ms - 1 s, against tau_sd = 0; 0 when
-/// no used piece has a lever).
-double FitRunTau2(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
-                  const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& n);
-
 /// run_time_offset at its own scale: ComputeBases takes the levers over one
 /// sample interval, but a sample near a motion's start or stop responds to
 /// tau only beyond its distance to it, so the slope that matters is the
