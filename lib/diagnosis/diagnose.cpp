@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -18,6 +19,7 @@
 #include "diagnosis/explanation.hpp"
 #include "diagnosis/null_distribution.hpp"
 #include "diagnosis/return_check.hpp"
+#include "diagnosis/stop_model.hpp"
 #include "diagnosis/verdict.hpp"
 #include "diagnosis/where.hpp"
 
@@ -116,6 +118,44 @@ void DescribeGivenModel(const CampaignData& c, const GivenModel& given, Diagnose
   }
 }
 
+/// The baseline under the stop reading (stop_model.hpp) the runs support:
+/// both readings are fitted when the campaign has joint stops with encoder
+/// counts, and the one with the higher likelihood is kept (same free
+/// parameters in both). `model` refers to `*body` or to the recorded
+/// campaign; a StopChoice is not copied.
+struct StopChoice {
+  std::unique_ptr<CampaignData> body;  ///< the body reading, when chosen
+  std::unique_ptr<MeanModel> model;
+  BaselineFit base;
+  bool compared = false;
+  double loglik_margin = 0.0;  ///< chosen minus the other [nats]
+};
+
+BaselineFit FitStart(const CampaignData& c, const MeanModel& model, const BaselineStart& start,
+                     const DiagnoseOptions& options) {
+  return options.given ? FitGivenBaseline(c, model, *options.given) : FitBaseline(c, model, start, BaselineFitOptions{});
+}
+
+StopChoice ChooseStopModel(const CampaignData& recorded, const BaselineStart& start, const DiagnoseOptions& options) {
+  StopChoice out;
+  out.model = std::make_unique<MeanModel>(recorded);
+  out.base = FitStart(recorded, *out.model, start, options);
+  if (!HasJointStops(recorded)) return out;
+  auto body = std::make_unique<CampaignData>(WithBodyStops(recorded));
+  auto body_model = std::make_unique<MeanModel>(*body);
+  BaselineFit body_base = FitStart(*body, *body_model, start, options);
+  const double ll_edge = TotalLogLik(recorded, out.base.bases, out.base.eps, out.base.noise);
+  const double ll_body = TotalLogLik(*body, body_base.bases, body_base.eps, body_base.noise);
+  out.compared = std::isfinite(ll_edge) && std::isfinite(ll_body);
+  if (out.compared && ll_body > ll_edge) {
+    out.body = std::move(body);
+    out.model = std::move(body_model);
+    out.base = std::move(body_base);
+  }
+  out.loglik_margin = out.compared ? std::abs(ll_body - ll_edge) : 0.0;
+  return out;
+}
+
 /// The verdict's effects from the explanation: its non-negligible effects.
 /// A single-effect verdict whose effect is negligible becomes `none`; an
 /// `unexplained` gap that the explanation closes (no significant gap left,
@@ -169,34 +209,41 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, Diagnose
 // The diagnosis as its numbered stages, each a call into its own file. About
 // 95 lines because each stage's options are filled from DiagnoseOptions here,
 // in place, so that every route of a user's option is visible in one place.
-DiagnoseSummary Diagnose(const CampaignData& c, const DiagnoseOptions& options) {
+DiagnoseSummary Diagnose(const CampaignData& recorded, const DiagnoseOptions& options) {
   if (auto e = options.Check(); !e.empty()) throw InvalidOptions("diagnose: " + e);
   DiagnoseSummary out;
   out.alpha = options.alpha;
   out.seed = options.seed;
-  for (std::size_t e = 0; e < c.experiments.size(); ++e)
-    out.experiment_labels.push_back(
-        fmt::format("{} ({}, {})", e + 1, ExperimentKindToString(c.experiments[e].kind), c.experiments[e].file));
+  for (std::size_t e = 0; e < recorded.experiments.size(); ++e)
+    out.experiment_labels.push_back(fmt::format("{} ({}, {})", e + 1,
+                                                ExperimentKindToString(recorded.experiments[e].kind),
+                                                recorded.experiments[e].file));
   StageTimer timer;
-  const MeanModel model(c);
 
   // 1. Baseline: fitted to the runs, or the user's model.
   BaselineStart start;
   if (options.given) {
-    start.p = GivenParams(c.robot, options.given->params);
+    start.p = GivenParams(recorded.robot, options.given->params);
     start.description = fmt::format("given model ({})", options.given->source);
   } else {
-    start = StartBaseline(c, options.use_refine);
+    start = StartBaseline(recorded, options.use_refine);
     out.notes = start.notes;
     timer.Lap("refined calibration (start)");
   }
-  const BaselineFit base =
-      options.given ? FitGivenBaseline(c, model, *options.given) : FitBaseline(c, model, start, BaselineFitOptions{});
+  StopChoice stops = ChooseStopModel(recorded, start, options);
+  const CampaignData& c = stops.body ? *stops.body : recorded;
+  const MeanModel& model = *stops.model;
+  const BaselineFit base = std::move(stops.base);
+  out.stop_model = c.stop_model;
+  if (stops.compared)
+    out.notes.push_back(fmt::format("encoder stops: {} (log-likelihood {:+.1f} against the other reading)",
+                                    StopModelToString(c.stop_model), stops.loglik_margin));
+  timer.Lap("baseline fit and stop reading");
   out.notes.insert(out.notes.end(), base.notes.begin(), base.notes.end());
   const ReturnCheck returns = CheckReturns(c, model, base);
   out.baseline = Summarise(c, start, base, returns);
   out.baseline.given = options.given;
-  timer.Lap("baseline fit and predictions");
+  timer.Lap("baseline predictions");
 
   // 2. Where, and the gap's null distribution.
   const GapSummary gap = ComputeGap(c, PieceScores(base.eps, base.bases, c.pieces, base.noise), options.gap);

@@ -183,6 +183,8 @@ struct DiagnoseSummary {
   std::vector<std::pair<std::string, double>> timings;  ///< stage, seconds
   std::vector<std::string> experiment_labels;
   std::vector<std::string> notes;
+  /// The reading of the encoder stops the diagnosis used (stop_model.hpp).
+  StopModel stop_model = StopModel::kWheelEdge;
   /// What to do next, for a person (advice.hpp).
   std::vector<std::string> next_steps;
   std::uint64_t seed = 0;

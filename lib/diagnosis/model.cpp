@@ -307,6 +307,13 @@ void QuantisationAndSlip(const DiagRun& r, const Piece& pc, const PiecePropagati
     B.Q += va[w] * pp.M_start.col(w) * pp.M_start.col(w).transpose() +
            vb[w] * pp.G_last.col(w) * pp.G_last.col(w).transpose();
   }
+  // The two wheels' count errors at a joint stop are correlated under the
+  // body stop reading (stop_model.hpp).
+  if (turned[0] && turned[1]) {
+    const double ca = r.q_cov_lr[pc.a], cb = r.q_cov_lr[pc.b];
+    B.Q += ca * (pp.M_start.col(0) * pp.M_start.col(1).transpose() + pp.M_start.col(1) * pp.M_start.col(0).transpose()) +
+           cb * (pp.G_last.col(0) * pp.G_last.col(1).transpose() + pp.G_last.col(1) * pp.G_last.col(0).transpose());
+  }
   if (pc.starts_from_standstill) B.F += 0.5 * pp.M_start * pp.M_start.transpose();
   if (pc.ends_at_standstill) B.F += 0.5 * pp.G_last * pp.G_last.transpose();
 }

@@ -10,6 +10,7 @@
 #include <Eigen/Dense>
 
 #include "diagnosis/mean_fit.hpp"
+#include "diagnosis/stop_model.hpp"
 #include "core/parallel_for.hpp"
 #include "simulation/rng.hpp"
 
@@ -75,8 +76,18 @@ double SimulateNull(const CampaignData& c, const BaselineFit& ctx, const NullOpt
       nb.x = sw * sxy * normal();
       nb.y = sw * sxy * normal();
       nb.t = sw * sth * normal();
-      nb.ql = draw_counts_left || !carry ? (gen.Uniform() - 0.5) * kSqrt12 * run.q_sd_left[lo] : carry->ql;
-      nb.qr = draw_counts_right || !carry ? (gen.Uniform() - 0.5) * kSqrt12 * run.q_sd_right[lo] : carry->qr;
+      if (run.q_cov_lr[lo] != 0.0) {
+        // A joint stop in the body reading: the two wheels' rests are drawn
+        // together (stop_model.hpp); q is minus the travel error (e -= quant_end q).
+        const double coin = gen.Uniform(), u = gen.Uniform();
+        const auto [el, er] =
+            DrawBodyStop(coin, u, run.stop_dir_left[lo], run.stop_dir_right[lo], c.tick_left_m, c.tick_right_m);
+        nb.ql = draw_counts_left || !carry ? -el : carry->ql;
+        nb.qr = draw_counts_right || !carry ? -er : carry->qr;
+      } else {
+        nb.ql = draw_counts_left || !carry ? (gen.Uniform() - 0.5) * kSqrt12 * run.q_sd_left[lo] : carry->ql;
+        nb.qr = draw_counts_right || !carry ? (gen.Uniform() - 0.5) * kSqrt12 * run.q_sd_right[lo] : carry->qr;
+      }
       boundaries.emplace(key, nb);
       return nb;
     };

@@ -52,11 +52,18 @@ double IntervalTravel(const DiagRun& r, std::size_t i) {
 
 /// Expected fraction of a tick beyond the count (see DiagRun::q_sd_left)
 /// and the remaining quantisation sd, for one wheel of a run with counts.
+/// stop_dir / stop_motion: the direction (+1 forward, -1 backward) of the
+/// stop the sample rests after and that motion's index (0 / -1 while
+/// moving or before the first motion).
 void QuantisationPhase(const std::vector<std::int64_t>& ticks, const std::vector<sim::MotionSegment>& motions,
-                       double tick_m, std::vector<double>& cum_m, std::vector<double>& sd_m) {
+                       double tick_m, std::vector<double>& cum_m, std::vector<double>& sd_m,
+                       std::vector<signed char>& stop_dir, std::vector<int>& stop_motion) {
   const std::size_t n = ticks.size();
   cum_m.resize(n);
   sd_m.assign(n, 0.0);
+  stop_dir.assign(n, 0);
+  stop_motion.assign(n, -1);
+  int last_motion = -1;
   std::vector<double> phase(n, 0.5);
   const double unknown = tick_m / std::sqrt(12.0);
   int last_dir = 0;  // direction of the last movement before the current standstill
@@ -68,6 +75,7 @@ void QuantisationPhase(const std::vector<std::int64_t>& ticks, const std::vector
         const std::int64_t d = ticks[k] - ticks[k - 1];
         if (d != 0) {
           last_dir = d > 0 ? 1 : -1;
+          last_motion = static_cast<int>(next);
           break;
         }
       }
@@ -84,6 +92,8 @@ void QuantisationPhase(const std::vector<std::int64_t>& ticks, const std::vector
       // A stop ends a motion at the sample after its last moving interval,
       // so the motion's own end sample is stopped too.
       phase[i] = last_dir > 0 ? 0.0 : 1.0;
+      stop_dir[i] = static_cast<signed char>(last_dir);
+      stop_motion[i] = last_motion;
     }
     if (!moving && next < motions.size() && i == motions[next].EndSample()) {
       int dir = 0;
@@ -97,6 +107,8 @@ void QuantisationPhase(const std::vector<std::int64_t>& ticks, const std::vector
       if (dir != 0) {
         phase[i] = dir > 0 ? 0.0 : 1.0;
         sd_m[i] = 0.0;
+        stop_dir[i] = static_cast<signed char>(dir);
+        stop_motion[i] = static_cast<int>(next);
       }
     }
     cum_m[i] = (static_cast<double>(ticks[i] - ticks[0]) + phase[i]) * tick_m;
@@ -189,6 +201,15 @@ void FindJunctions(DiagRun& r) {
     r.junctions.push_back(j);
   }
 }
+
+}  // namespace
+
+void AnnotateRun(DiagRun& r) {
+  AnnotateIntervals(r, r.min_stand_intervals);
+  FindJunctions(r);
+}
+
+namespace {
 
 /// The sample with ground truth in [lo, hi] nearest to `want`; nullopt when
 /// there is none.
@@ -488,8 +509,11 @@ class CampaignBuilder {
   /// Finds the intervals and junctions of `r` (wheel travel, times, motions
   /// and quantisation set), appends it to the campaign and returns its fold.
   int AddRun(DiagRun&& r, int min_stand_intervals) {
-    AnnotateIntervals(r, min_stand_intervals);
-    FindJunctions(r);
+    r.min_stand_intervals = min_stand_intervals;
+    r.q_cov_lr.assign(r.t.size(), 0.0);
+    if (r.stop_dir_left.empty()) r.stop_dir_left.assign(r.t.size(), 0);
+    if (r.stop_dir_right.empty()) r.stop_dir_right.assign(r.t.size(), 0);
+    AnnotateRun(r);
     const int fold = FoldOf(r.direction);
     c_.runs.push_back(std::move(r));
     return fold;
@@ -553,8 +577,14 @@ class CampaignBuilder {
       if (tr.has_ticks()) mo.stand_eps_m = 0.5 * std::min(robot.MetresPerTickLeft(), robot.MetresPerTickRight());
       r.motions = sim::SegmentMotions(r.left, r.right, robot.wheelbase_m, mo);
       if (tr.has_ticks()) {
-        QuantisationPhase(tr.ticks_left, r.motions, robot.MetresPerTickLeft(), r.left, r.q_sd_left);
-        QuantisationPhase(tr.ticks_right, r.motions, robot.MetresPerTickRight(), r.right, r.q_sd_right);
+        std::vector<int> motion_left, motion_right;
+        QuantisationPhase(tr.ticks_left, r.motions, robot.MetresPerTickLeft(), r.left, r.q_sd_left, r.stop_dir_left,
+                          motion_left);
+        QuantisationPhase(tr.ticks_right, r.motions, robot.MetresPerTickRight(), r.right, r.q_sd_right,
+                          r.stop_dir_right, motion_right);
+        // A joint stop: both wheels rest after the same motion (stop_model.hpp).
+        for (std::size_t i = 0; i < r.t.size(); ++i)
+          if (motion_left[i] != motion_right[i]) r.stop_dir_left[i] = r.stop_dir_right[i] = 0;
       } else {
         r.q_sd_left.assign(r.t.size(), 0.0);
         r.q_sd_right.assign(r.t.size(), 0.0);

@@ -33,6 +33,13 @@
 namespace umbmark::diag {
 
 enum class PieceType { kStraight, kTurn, kArc, kStand, kReturn };
+
+/// How a wheel rests within its encoder tick after the controller stops a
+/// motion (docs/diagnosis.md, "Stops"; stop_model.hpp).
+enum class StopModel {
+  kWheelEdge,  ///< each wheel stopped on its own tick (per-wheel count targets)
+  kBody,       ///< the robot stopped on its odometry: one wheel on its tick, the other anywhere in its tick
+};
 const char* PieceTypeToString(PieceType t);
 
 struct Piece {
@@ -110,6 +117,14 @@ struct DiagRun {
   /// (unknown start phase); q_sd_* is the standard deviation of what is left
   /// [m]: tick / sqrt(12), or 0 after a stop.
   std::vector<double> q_sd_left, q_sd_right;
+  /// Covariance of the two wheels' count errors [m^2] (non-zero only at a
+  /// joint stop under the body stop model, stop_model.hpp).
+  std::vector<double> q_cov_lr;
+  /// At a joint stop (both wheels rest after the same motion): each wheel's
+  /// direction in that motion (+1 forward, -1 backward), else 0.
+  std::vector<signed char> stop_dir_left, stop_dir_right;
+  /// Still intervals that separate motions (castor kicks; MotionOptions).
+  int min_stand_intervals = 2;
   bool has_heading = true;  ///< endpoint runs: etheta_rad measured
 };
 
@@ -160,6 +175,8 @@ struct CampaignData {
   std::optional<GroundTruthNoise> ground_truth;
   /// Nominal metres per tick (0 when the runs give distances): quantisation.
   double tick_left_m = 0.0, tick_right_m = 0.0;
+  /// The stop reading the runs' quantisation follows (stop_model.hpp).
+  StopModel stop_model = StopModel::kWheelEdge;
   std::vector<ExperimentInfo> experiments;
   std::vector<DiagRun> runs;
   std::vector<Piece> pieces;
@@ -168,6 +185,10 @@ struct CampaignData {
   /// The experiments' data as read (the refined calibration works on them).
   std::vector<std::variant<EndpointData, TrajectoryData>> files;
 };
+
+/// Interval classes, castor kicks, active windows and junctions of a run
+/// from its motions and wheel travel (again after the travel changes).
+void AnnotateRun(DiagRun& r);
 
 /// Builds the diagnosis' view of a loaded campaign. `files[i]` is experiment
 /// i's data (io::ReadRunFile). Throws InputError when a run cannot be used
