@@ -40,6 +40,7 @@ enum class StopModel {
   kWheelEdge,  ///< each wheel stopped on its own tick (per-wheel count targets)
   kBody,       ///< the robot stopped on its odometry: one wheel on its tick, the other anywhere in its tick
 };
+
 const char* PieceTypeToString(PieceType t);
 
 struct Piece {
@@ -115,7 +116,8 @@ struct DiagRun {
   /// 0 after a stop moving forward (p = T), 1 after a stop moving backward
   /// (p just below T + 1), 1/2 while moving or before the first motion
   /// (unknown start phase); q_sd_* is the standard deviation of what is left
-  /// [m]: tick / sqrt(12), or 0 after a stop.
+  /// [m]: tick / sqrt(12), or 0 after a stop. This is the tick-exact
+  /// reading of the stop; WithBodyStops (stop_model.hpp) makes the other.
   std::vector<double> q_sd_left, q_sd_right;
   /// Covariance of the two wheels' count errors [m^2] (non-zero only at a
   /// joint stop under the body stop model, stop_model.hpp).
