@@ -41,7 +41,8 @@ std::vector<int> MeanParamsOf(const std::vector<int>& free, const std::vector<si
 }
 
 /// The mean part of a set's fit. It depends only on the mean parameters
-/// (always weighted by the baseline's W), so every set with the same mean
+/// (always weighted by the baseline's W; Explain's note for a given wheel
+/// noise), so every set with the same mean
 /// parameters -- the chosen set plus one noise effect, say -- shares it:
 /// Explain computes it once per distinct parameter list (the same call, so
 /// the same numbers).
@@ -298,7 +299,23 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
                     const std::vector<sim::EffectKind>& first, double gap_score, double null_median,
                     double null_quantile, const ExplanationOptions& options) {
   Explanation ex;
-  MeanPartCache means(c, model, b, options.threads, known);
+  // Against a given model with its wheel noise (--kl, --kr) the baseline's
+  // weights are the given noise's, off by as much as wheel_noise_error
+  // says (x15 on the June campaign): a mean effect fitted with them is
+  // fitted to the wrong weights (a castor kick of 11 mrad where 0.5 fits).
+  // There the mean parts are weighted with the wheel noise refitted to the
+  // baseline's residuals, and the candidates' mean fits (weighted the
+  // given way) are not reused.
+  const bool given_noise = !b.noise_fit.fit_wheel_noise;
+  BaselineFit weighted;
+  const std::map<std::vector<int>, MeanFit> not_known;
+  if (given_noise) {
+    weighted = b;
+    PieceNoiseFitOptions nf = b.noise_fit;
+    nf.fit_wheel_noise = true;
+    weighted.W = Whiteners(b.bases, c.pieces, FitPieceNoise(b.eps, b.bases, c.pieces, {}, b.noise, nf));
+  }
+  MeanPartCache means(c, model, given_noise ? weighted : b, options.threads, given_noise ? not_known : known);
   means.Prepare({{}});
   const SetFit base = FitSet(c, model, b, folds, {}, means.Get({}), options.gap);
   const double gap_before = Gap(gap_score, null_median), gap_cv_before = Gap(base.heldout_gap, null_median);
