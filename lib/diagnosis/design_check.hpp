@@ -30,7 +30,9 @@ std::string CampaignDesignProblem(const Manifest& manifest);
 /// pieces, no arc pieces) and turn_scrub is therefore not separately
 /// identifiable (`scrub_separable` false: the candidate is not, or only
 /// weakly, identifiable): that a turn scrub, if any, is inside the fitted
-/// wheelbase E_b (`E_b`) and which run to add. Empty otherwise.
+/// wheelbase E_b (`E_b`) and which run to add. Empty otherwise. (Diagnose
+/// leaves it out when a weakly identifiable scrub is named on its own
+/// held-out evidence: the spot turns' small forward motion, E_d far from 1.)
 std::string TurnScrubDesignNote(const CampaignData& campaign, bool scrub_separable, double E_b);
 
 }  // namespace umbmark::diag

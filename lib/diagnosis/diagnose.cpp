@@ -286,11 +286,6 @@ DiagnoseSummary Diagnose(const CampaignData& recorded, const DiagnoseOptions& op
   out.verdict = std::move(v.verdict);
   out.verdict_reason = std::move(v.reason);
   out.indistinguishable = std::move(v.indistinguishable);
-  // What this design cannot separate (turn_scrub from E_b without arcs).
-  for (const Candidate& cd : out.candidates)
-    if (cd.effect == sim::EffectKind::kTurnScrub)
-      if (std::string n = TurnScrubDesignNote(c, cd.identifiable && !cd.weak, base.p[kParamEb]); !n.empty())
-        out.notes.push_back(std::move(n));
   timer.Lap("verdict");
 
   // 6. Stepwise explanation and practical significance.
@@ -312,6 +307,14 @@ DiagnoseSummary Diagnose(const CampaignData& recorded, const DiagnoseOptions& op
     NameEffects(ex, options, out);
     timer.Lap("stepwise explanation");
   }
+  // What this design cannot separate (turn_scrub from E_b without arcs),
+  // unless a weakly identifiable scrub was named on its own evidence.
+  const bool scrub_named = std::find(out.verdict_effects.begin(), out.verdict_effects.end(), "turn_scrub") !=
+                           out.verdict_effects.end();
+  for (const Candidate& cd : out.candidates)
+    if (cd.effect == sim::EffectKind::kTurnScrub && !scrub_named)
+      if (std::string n = TurnScrubDesignNote(c, cd.identifiable && !cd.weak, base.p[kParamEb]); !n.empty())
+        out.notes.push_back(std::move(n));
   if (options.given) DescribeGivenModel(c, *options.given, out);
   if (options.progress) options.progress(1000.0, 1000.0);
   out.next_steps = AdviseNextSteps(c, out);
