@@ -38,11 +38,7 @@ DiagnoseSummary RunScrub(bool figure_eights) {
     s.sim.free_runs = 4;
     s.sim.free_radius_m = 1.0;
   }
-  DiagnoseOptions o;
-  o.null_simulations = 100;
-  o.seed = 1;
-  o.threads = 2;
-  return Diagnose(testing::BuildSmallCampaign(s), o);
+  return testing::DiagnoseSmallCampaign(s);
 }
 
 }  // namespace

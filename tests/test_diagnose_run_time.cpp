@@ -113,14 +113,6 @@ double RealisedTauRms(std::uint64_t seed, int runs, double tau_sd) {
   return std::sqrt(sum2 / runs);
 }
 
-DiagnoseSummary Run(const testing::SmallCampaign& s) {
-  DiagnoseOptions o;
-  o.null_simulations = 100;
-  o.seed = 1;
-  o.threads = 2;
-  return Diagnose(testing::BuildSmallCampaign(s), o);
-}
-
 }  // namespace
 
 TEST_CASE("run block: equal levers give the dense Gaussian N(0, C0 + tau_sd^2 g g^T)", "[diagnose][run-block]") {
@@ -201,7 +193,7 @@ TEST_CASE("diagnose: run_time_offset named, tau_sd within 20 %, not a time_offse
   testing::SmallCampaign s = testing::MakeSmallCampaign(84, 10, 20);
   s.sim.sample_rate_hz = 25.0;
   s.sim.effects.run_tau_sd = 0.04;
-  const DiagnoseSummary d = Run(s);
+  const DiagnoseSummary d = testing::DiagnoseSmallCampaign(s);
   INFO(d.verdict_reason);
   CHECK(d.verdict == "run_time_offset");
   CHECK_FALSE(Named(d, "time_offset"));
@@ -221,7 +213,7 @@ TEST_CASE("diagnose: a fixed time_offset is not named run_time_offset", "[diagno
   testing::SmallCampaign s = testing::MakeSmallCampaign(82, 10, 20);
   s.sim.sample_rate_hz = 25.0;
   s.sim.effects.time_tau = 0.04;
-  const DiagnoseSummary d = Run(s);
+  const DiagnoseSummary d = testing::DiagnoseSmallCampaign(s);
   INFO(d.verdict_reason);
   CHECK(d.verdict == "time_offset");
   CHECK_FALSE(Named(d, "run_time_offset"));

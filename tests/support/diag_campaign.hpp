@@ -8,6 +8,7 @@
 
 #include <cstdint>
 
+#include "diagnosis/diagnose.hpp"
 #include "diagnosis/pieces.hpp"
 #include "simulation/campaign_sim.hpp"
 
@@ -42,6 +43,15 @@ inline SmallCampaign MakeSmallCampaign(std::uint64_t seed, int square_runs = 5, 
 inline diag::CampaignData BuildSmallCampaign(const SmallCampaign& s) {
   const sim::SimulatedCampaign c = sim::SimulateCampaign(s.manifest, s.sim);
   return diag::BuildCampaign(c.manifest, c.data);
+}
+
+/// Diagnoses the campaign with 100 null simulations, seed 1, 2 threads.
+inline diag::DiagnoseSummary DiagnoseSmallCampaign(const SmallCampaign& s) {
+  diag::DiagnoseOptions o;
+  o.null_simulations = 100;
+  o.seed = 1;
+  o.threads = 2;
+  return diag::Diagnose(BuildSmallCampaign(s), o);
 }
 
 }  // namespace umbmark::testing
