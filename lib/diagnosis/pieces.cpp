@@ -253,9 +253,13 @@ std::string SubsetName(ExperimentKind kind, const DiagRun& run, PieceType type, 
   return group.empty() ? what : group + ", " + what;
 }
 
-/// Whether a castor-kick start (a straight or arc motion from standstill)
-/// may have begun before the last sample whose counts read still, i.e. the
-/// kick may already show there. The robot starts before its first count.
+/// Whether motion mi, a start from standstill, may have begun before the
+/// last sample whose counts read still, i.e. the robot's first motion (and a
+/// castor kick, for a straight or arc start) may already show there. The
+/// robot starts before its first count. Spot turns too: the rotation before
+/// a turn's first count otherwise lands in the standstill before it, as a
+/// heading bias with the turn's sign (measured on the independent
+/// generator's 500 counts/rev campaigns with acceleration limits).
 /// At constant speed (as commanded, no acceleration limit) the start lies
 /// inside the first moving interval, a tick's time before the first count.
 /// Under acceleration from rest it can lie a good part of a sample earlier:
@@ -267,10 +271,14 @@ std::string SubsetName(ExperimentKind kind, const DiagRun& run, PieceType type, 
 /// than 5 % and two counts of quantisation) and that bound exceeds
 /// lead_fraction of dt. tick_*_m: metres per count (0 when the run gives
 /// distances, whose resolution is unknown: never ambiguous).
-bool KickStartAmbiguous(const DiagRun& r, const sim::MotionSegment& m, double tick_left_m, double tick_right_m,
-                        double lead_fraction) {
+bool StartAmbiguous(const DiagRun& r, std::size_t mi, double tick_left_m, double tick_right_m,
+                    double lead_fraction) {
+  const sim::MotionSegment& m = r.motions[mi];
   const std::size_t i = m.first_interval;
-  if (r.kick[i] == 0 || i == 0 || !(tick_left_m > 0.0 && tick_right_m > 0.0)) return false;
+  // From standstill, as AnnotateIntervals reads it for the castor kick.
+  const bool from_standstill =
+      mi == 0 || i - r.motions[mi - 1].last_interval > static_cast<std::size_t>(r.min_stand_intervals);
+  if (!from_standstill || i == 0 || !(tick_left_m > 0.0 && tick_right_m > 0.0)) return false;
   auto counts = [&](std::size_t k) {
     return std::abs(r.left[k + 1] - r.left[k]) / tick_left_m + std::abs(r.right[k + 1] - r.right[k]) / tick_right_m;
   };
@@ -278,6 +286,25 @@ bool KickStartAmbiguous(const DiagRun& r, const sim::MotionSegment& m, double ti
   const double n = std::max(std::abs(r.left[i + 1] - r.left[i]) / tick_left_m,
                             std::abs(r.right[i + 1] - r.right[i]) / tick_right_m);
   return rising && std::sqrt(n) - 1.0 < 1.0 / lead_fraction;
+}
+
+/// The mirror of StartAmbiguous at a motion's end: decelerating into the
+/// stop, the robot still moves after its last count (the last sub-tick of
+/// the stop), up to dt / (sqrt(n) - 1) past the first sample that reads
+/// still (n: the faster wheel's counts in the last moving interval).
+/// Ambiguous when the speed still falls into the last moving interval and
+/// that bound exceeds lead_fraction of dt; never for distance input.
+bool StopAmbiguous(const DiagRun& r, std::size_t mi, double tick_left_m, double tick_right_m, double lead_fraction) {
+  const sim::MotionSegment& m = r.motions[mi];
+  const std::size_t i = m.last_interval;
+  if (!(tick_left_m > 0.0 && tick_right_m > 0.0) || m.EndSample() + 1 >= r.t.size()) return false;
+  auto counts = [&](std::size_t k) {
+    return std::abs(r.left[k + 1] - r.left[k]) / tick_left_m + std::abs(r.right[k + 1] - r.right[k]) / tick_right_m;
+  };
+  const bool falling = i < m.first_interval + 2 || counts(i - 2) > 1.05 * counts(i - 1) + 2.0;
+  const double n = std::max(std::abs(r.left[i + 1] - r.left[i]) / tick_left_m,
+                            std::abs(r.right[i + 1] - r.right[i]) / tick_right_m);
+  return falling && std::sqrt(n) - 1.0 < 1.0 / lead_fraction;
 }
 
 void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, const PieceOptions& o,
@@ -333,14 +360,16 @@ void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, co
     // The castor kick happens at the motion's start (contract), and the
     // robot starts before its first count (tens of ms with acceleration
     // limits and coarse encoders): when the encoders do not locate the
-    // start (KickStartAmbiguous), the last sample that reads still may
+    // start (StartAmbiguous), the last sample that reads still may
     // already show the kick, so the motion's first piece starts one sample
     // earlier and that sample leaves the standstill
     // (PieceOptions::start_before_first_count).
     const bool early = !joined_before && o.start_before_first_count &&
-                       KickStartAmbiguous(r, m, tick_left_m, tick_right_m, o.start_lead_fraction);
+                       StartAmbiguous(r, mi, tick_left_m, tick_right_m, o.start_lead_fraction);
     const std::size_t s0 = joined_before ? m.FirstSample() + 1 : early ? m.FirstSample() - 1 : m.FirstSample();
-    const std::size_t s1 = m.EndSample() - (joined_after ? 1 : 0);
+    const bool late = !joined_after && o.start_before_first_count &&
+                      StopAmbiguous(r, mi, tick_left_m, tick_right_m, o.start_lead_fraction);
+    const std::size_t s1 = m.EndSample() - (joined_after ? 1 : 0) + (late ? 1 : 0);
     if (s1 <= s0 || s1 <= cur || s0 >= g1) {
       if (joined_after) cur = std::max(cur, std::min(m.EndSample() + 1, g1));
       continue;

@@ -154,9 +154,9 @@ struct PieceOptions {
   /// Measure motions from / to the mean ground-truth pose of the adjacent
   /// standstills (see Piece). Default true.
   bool average_standstills = true;
-  /// A straight or arc motion from standstill whose start the encoders do
+  /// A motion from standstill whose start the encoders do
   /// not locate (its first count may come more than start_lead_fraction of
-  /// a sample interval after the start, see pieces.cpp KickStartAmbiguous)
+  /// a sample interval after the start, see pieces.cpp StartAmbiguous)
   /// starts at the last sample whose counts read still, one before its
   /// first moving interval: the castor kick (contract: at the start of the
   /// motion) may already show there. False: every motion starts at its
