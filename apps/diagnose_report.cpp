@@ -330,7 +330,11 @@ void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
   rep.Heading("The explanation: effects added one at a time, fitted jointly");
   std::vector<std::vector<std::string>> rows;
   int k = 0;
-  for (const auto& e : ex)
+  for (const auto& e : ex) {
+    // An impossible fit is marked as what it is: a symptom, never named.
+    const std::string flag = e.contains("unphysical")         ? " (impossible value: a symptom)"
+                             : e.value("negligible", false) ? " (negligible)"
+                                                            : "";
     rows.push_back({fmt::format("{}", ++k), e.value("effect", "?"),
                     ParamsText(e.value("params", nlohmann::json::object()), nlohmann::json::object()),
                     Percent(Number(e, "cumulative_heldout_shrink")), Percent(Number(e, "cumulative_shrink")),
@@ -338,9 +342,9 @@ void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
                     // A noise effect's size: the growth of one piece type's spread.
                     e.contains("size_pieces")
                         ? fmt::format("+{:.0f}% sd of {} pieces{}", 100.0 * Number(e, "relative_size"),
-                                      e.value("size_pieces", "?"), e.value("negligible", false) ? " (negligible)" : "")
-                        : fmt::format("{:.2f}{}", Number(e, "relative_size"),
-                                      e.value("negligible", false) ? " (negligible)" : "")});
+                                      e.value("size_pieces", "?"), flag)
+                        : fmt::format("{:.2f}{}", Number(e, "relative_size"), flag)});
+  }
   rep.Table({"step", "effect", "parameters", "gap closed, held-out", "in-sample", "size over a run",
              "size / noise of one piece"},
             rows, 3);

@@ -25,11 +25,11 @@ bool HasScrubNote(const DiagnoseSummary& d) {
                      [](const std::string& n) { return n.find(kScrubNote) != std::string::npos; });
 }
 
-/// The test campaign with a turn scrub k = 0.05, optionally plus a free
-/// experiment of 4 figure-eights of 1 m radius.
-DiagnoseSummary RunScrub(bool figure_eights) {
+/// The test campaign with a turn scrub k (default 0.05), optionally plus a
+/// free experiment of 4 figure-eights of 1 m radius.
+DiagnoseSummary RunScrub(bool figure_eights, double k = 0.05) {
   testing::SmallCampaign s = testing::MakeSmallCampaign(91, 10, 20);
-  s.sim.effects.scrub_k = 0.05;
+  s.sim.effects.scrub_k = k;
   if (figure_eights) {
     Experiment fr;
     fr.kind = ExperimentKind::kFree;
@@ -63,4 +63,19 @@ TEST_CASE("design: with figure-eights the turn scrub is named, without the note"
   REQUIRE(it != d.candidates.end());
   // 40 runs x 8 spot turns + 4 figure-eights: k = 0.0486 here; within 10 %.
   CHECK_THAT(it->params.at("k"), WithinRel(0.05, 0.10));
+}
+
+// A negative scrub (heading gained in spot turns) is no physical scrub: the
+// explanation may still fit it (it closes the gap), but an effect at an
+// impossible value is a symptom of something else and is never named.
+TEST_CASE("design: a turn scrub fitted at an impossible value is not named", "[diagnose][design]") {
+  const DiagnoseSummary d = RunScrub(true, -0.05);
+  INFO(d.verdict_reason);
+  CHECK(d.verdict == "unexplained");
+  CHECK(std::find(d.verdict_effects.begin(), d.verdict_effects.end(), "turn_scrub") == d.verdict_effects.end());
+  const auto it = std::find_if(d.explanation.begin(), d.explanation.end(),
+                               [](const ExplanationStep& e) { return e.effect == sim::EffectKind::kTurnScrub; });
+  REQUIRE(it != d.explanation.end());
+  CHECK_THAT(it->params.at("k"), WithinRel(-0.05, 0.10));
+  CHECK(d.verdict_reason.find("impossible values") != std::string::npos);
 }

@@ -156,22 +156,34 @@ StopChoice ChooseStopModel(const CampaignData& recorded, const BaselineStart& st
   return out;
 }
 
-/// The verdict's effects from the explanation: its non-negligible effects.
+/// The verdict's effects from the explanation: its effects that are neither
+/// negligible nor fitted at impossible values (advice.hpp UnphysicalFit,
+/// e.g. a negative turn scrub: a symptom of something else, never a cause).
 /// A single-effect verdict whose effect is negligible becomes `none`; an
 /// `unexplained` gap that the explanation closes (no significant gap left,
 /// held-out shrink >= min_heldout_shrink) is named by its effects.
-void NameEffects(const Explanation& ex, const DiagnoseOptions& options, DiagnoseSummary& out) {
-  std::vector<std::string> named, negligible;
-  for (const ExplanationStep& s : ex.steps)
-    (s.negligible ? negligible : named).push_back(sim::EffectToString(s.effect));
+void NameEffects(const Explanation& ex, const DiagnoseOptions& options, int runs, DiagnoseSummary& out) {
+  std::vector<std::string> named, negligible, impossible;
+  for (const ExplanationStep& s : ex.steps) {
+    const std::string name = sim::EffectToString(s.effect);
+    if (!UnphysicalFit(name, s.params, runs, {}).empty())
+      impossible.push_back(name);
+    else
+      (s.negligible ? negligible : named).push_back(name);
+  }
   const double heldout = ex.steps.empty() ? 0.0 : ex.steps.back().cumulative_heldout_shrink;
   out.unexplained_fraction = std::clamp(1.0 - heldout, 0.0, 1.0);
-  const std::string negligible_text =
+  std::string negligible_text =
       negligible.empty() ? std::string()
                          : fmt::format("; negligible in practice (size below {:.2g} x the noise of one piece): {}",
                                        options.negligible, fmt::join(negligible, ", "));
+  if (!impossible.empty())
+    negligible_text += fmt::format("; fitted at impossible values (a symptom, not named): {}", fmt::join(impossible, ", "));
   if (out.verdict == "unexplained") {
-    if (!ex.steps.empty() && !ex.gap_left && heldout >= options.min_heldout_shrink) {
+    if (!ex.steps.empty() && !ex.gap_left && heldout >= options.min_heldout_shrink && !impossible.empty() &&
+        named.empty()) {
+      out.verdict_reason += negligible_text;  // closed only with a symptom's help: still unexplained
+    } else if (!ex.steps.empty() && !ex.gap_left && heldout >= options.min_heldout_shrink) {
       if (named.empty()) {
         out.verdict = "none";
         out.verdict_reason = "the significant gap is closed by effects too small to matter" + negligible_text;
@@ -186,7 +198,12 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, Diagnose
       out.verdict_reason += negligible_text;
     }
   } else if (!ex.steps.empty()) {
-    if (named.empty()) {
+    if (named.empty() && !impossible.empty()) {
+      out.verdict_reason = fmt::format("the gap is significant, but {} closes it only at impossible values (a "
+                                       "symptom of something else): {}{}",
+                                       out.verdict, out.verdict_reason, negligible_text);
+      out.verdict = "unexplained";
+    } else if (named.empty()) {
       out.verdict_reason = fmt::format("the gap is significant, but {} is too small to matter (relative size {:.2g} < "
                                        "{:.2g}): {}",
                                        out.verdict, ex.steps.front().relative_size, options.negligible,
@@ -304,7 +321,7 @@ DiagnoseSummary Diagnose(const CampaignData& recorded, const DiagnoseOptions& op
                                    out.null_median, out.null_quantile_alpha, eo);
     out.explanation = ex.steps;
     out.explanation_stop = ex.stop_reason;
-    NameEffects(ex, options, out);
+    NameEffects(ex, options, static_cast<int>(c.runs.size()), out);
     timer.Lap("stepwise explanation");
   }
   // What this design cannot separate (turn_scrub from E_b without arcs),

@@ -22,7 +22,8 @@
 // pieces, so its size is measured on the pieces the campaign has: per
 // piece type, the median relative growth of the predicted pose sd of the
 // pieces it acts on, the type where it is largest (standstill_motion,
-// motion_noise_floor, run_time_offset; `size_pieces` names the type);
+// motion_noise_floor; `size_pieces` names the type); run_time_offset is
+// sized as a fixed time_offset of tau_sd (a run with the typical offset);
 // the relative growth of the wheel-noise sd for correlated_noise and
 // bump_outliers; and for wheel_noise_error |k_fit / k_given - 1|, the
 // wheel further off. Below `negligible` (default 0.25: a quarter of the noise) an

@@ -60,6 +60,9 @@ nlohmann::json ExplanationJson(const DiagnoseSummary& s) {
                      {"relative_size", Num(e.relative_size)},
                      {"negligible", e.negligible}});
     if (!e.size_pieces.empty()) steps.back()["size_pieces"] = e.size_pieces;
+    // An impossible fit is a symptom, never named (diagnose.cpp NameEffects).
+    if (auto why = UnphysicalFit(sim::EffectToString(e.effect), e.params, s.baseline.runs, {}); !why.empty())
+      steps.back()["unphysical"] = std::move(why);
   }
   return steps;
 }
@@ -247,7 +250,12 @@ void ExplanationSection(TextReport& o, const DiagnoseSummary& s) {
                                   : fmt::format("+{:.0f}% sd of {} pieces", 100.0 * e.relative_size, e.size_pieces);
       o.line(fmt::format("    {:>4} {:<22} {:>17.0f}% {:>8.0f}%   {:>7.2f} / {:>6.2f}, {}{}  {}", ++k,
                          sim::EffectToString(e.effect), 100.0 * e.cumulative_shrink, 100.0 * e.cumulative_heldout_shrink,
-                         e.size_mm, e.size_mrad, rel, e.negligible ? " (negligible)" : "", params));
+                         e.size_mm, e.size_mrad, rel,
+                         !UnphysicalFit(sim::EffectToString(e.effect), e.params, s.baseline.runs, {}).empty()
+                             ? " (impossible value: a symptom)"
+                         : e.negligible ? " (negligible)"
+                                        : "",
+                         params));
     }
     o.line(fmt::format("    unexplained on held-out runs: {:.0f}%; negligible = size below {:.2g} x the noise of one "
                        "piece (<= 1 m of travel or a spot turn); for a noise effect, widening the pose spread of the "
