@@ -221,10 +221,41 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, int runs
   if (out.verdict == "none") out.unexplained_fraction = 0.0;
 }
 
+/// Stage 6: the stepwise explanation, which effects the verdict names, and
+/// what this design cannot separate (turn_scrub from E_b without arcs),
+/// unless a weakly identifiable scrub was named on its own evidence.
+void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit& base, const Folds& folds,
+                const CandidateFits& fits, const DiagnoseOptions& options, StageTimer& timer, DiagnoseSummary& out) {
+  out.negligible_threshold = options.negligible;
+  if (out.significant) {
+    ExplanationOptions eo;
+    eo.max_effects = options.max_explanation_effects;
+    eo.complexity_penalty_nats = options.complexity_penalty_nats;
+    eo.negligible = options.negligible;
+    eo.threads = options.threads;
+    eo.gap = options.gap;
+    eo.progress = StageProgress(options.progress, 700.0, 1000.0, 1000.0);
+    std::vector<sim::EffectKind> first;
+    if (const auto k = sim::EffectFromString(out.verdict)) first.push_back(*k);
+    const Explanation ex = Explain(c, model, base, folds, out.candidates, fits.mean_fits, first, out.gap_score,
+                                   out.null_median, out.null_quantile_alpha, eo);
+    out.explanation = ex.steps;
+    out.explanation_stop = ex.stop_reason;
+    NameEffects(ex, options, static_cast<int>(c.runs.size()), out);
+    timer.Lap("stepwise explanation");
+  }
+  const bool scrub_named = std::find(out.verdict_effects.begin(), out.verdict_effects.end(), "turn_scrub") !=
+                           out.verdict_effects.end();
+  for (const Candidate& cd : out.candidates)
+    if (cd.effect == sim::EffectKind::kTurnScrub && !scrub_named)
+      if (std::string n = TurnScrubDesignNote(c, cd.identifiable && !cd.weak, base.p[kParamEb]); !n.empty())
+        out.notes.push_back(std::move(n));
+}
+
 }  // namespace
 
 // The diagnosis as its numbered stages, each a call into its own file. About
-// 95 lines because each stage's options are filled from DiagnoseOptions here,
+// 85 lines because each stage's options are filled from DiagnoseOptions here,
 // in place, so that every route of a user's option is visible in one place.
 DiagnoseSummary Diagnose(const CampaignData& recorded, const DiagnoseOptions& options) {
   if (auto e = options.Check(); !e.empty()) throw InvalidOptions("diagnose: " + e);
@@ -306,32 +337,7 @@ DiagnoseSummary Diagnose(const CampaignData& recorded, const DiagnoseOptions& op
   timer.Lap("verdict");
 
   // 6. Stepwise explanation and practical significance.
-  out.negligible_threshold = options.negligible;
-  if (out.significant) {
-    ExplanationOptions eo;
-    eo.max_effects = options.max_explanation_effects;
-    eo.complexity_penalty_nats = options.complexity_penalty_nats;
-    eo.negligible = options.negligible;
-    eo.threads = options.threads;
-    eo.gap = options.gap;
-    eo.progress = StageProgress(options.progress, 700.0, 1000.0, 1000.0);
-    std::vector<sim::EffectKind> first;
-    if (const auto k = sim::EffectFromString(out.verdict)) first.push_back(*k);
-    const Explanation ex = Explain(c, model, base, folds, out.candidates, fits.mean_fits, first, out.gap_score,
-                                   out.null_median, out.null_quantile_alpha, eo);
-    out.explanation = ex.steps;
-    out.explanation_stop = ex.stop_reason;
-    NameEffects(ex, options, static_cast<int>(c.runs.size()), out);
-    timer.Lap("stepwise explanation");
-  }
-  // What this design cannot separate (turn_scrub from E_b without arcs),
-  // unless a weakly identifiable scrub was named on its own evidence.
-  const bool scrub_named = std::find(out.verdict_effects.begin(), out.verdict_effects.end(), "turn_scrub") !=
-                           out.verdict_effects.end();
-  for (const Candidate& cd : out.candidates)
-    if (cd.effect == sim::EffectKind::kTurnScrub && !scrub_named)
-      if (std::string n = TurnScrubDesignNote(c, cd.identifiable && !cd.weak, base.p[kParamEb]); !n.empty())
-        out.notes.push_back(std::move(n));
+  ExplainGap(c, model, base, folds, fits, options, timer, out);
   if (options.given) DescribeGivenModel(c, *options.given, out);
   if (options.progress) options.progress(1000.0, 1000.0);
   out.next_steps = AdviseNextSteps(c, out);
