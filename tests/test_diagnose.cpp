@@ -42,12 +42,7 @@ Small MakeSmall(std::uint64_t seed, int square_runs = 5, int bf_runs = 10, bool 
   const testing::SmallCampaign base = testing::MakeSmallCampaign(seed, square_runs, bf_runs);
   Small s{base.manifest, base.sim};
   if (!ticks) s.manifest.robot.ticks_per_rev.reset();
-  if (free) {
-    Experiment e;
-    e.kind = ExperimentKind::kFree;
-    e.file = e.resolved_file = "free.csv";
-    s.manifest.experiments.push_back(e);
-  }
+  if (free) testing::AddFreeExperiment(s.manifest, "free.csv");
   s.sim.free_runs = 3;
   return s;
 }

@@ -20,6 +20,7 @@
 #include "diagnosis/pieces.hpp"
 #include "io/campaign_writer.hpp"
 #include "simulation/campaign_sim.hpp"
+#include "support/diag_campaign.hpp"
 #include "support/run_cli.hpp"
 
 using namespace umbmark;
@@ -44,10 +45,7 @@ constexpr double kTrueEd = 1.004, kTrueEb = 1.012, kTrueKL = 1.5e-3, kTrueKR = 2
 /// 10 Hz, 0.5 m/s, the true robot above.
 sim::SimulatedCampaign Simulate(std::uint64_t seed) {
   Manifest m = sim::StandardCampaignManifest(Recorded(), 2.0, 2.0, GroundTruthNoise{3e-4, 1.5e-3});
-  Experiment e;
-  e.kind = ExperimentKind::kFree;
-  e.file = e.resolved_file = "free.csv";
-  m.experiments.push_back(e);
+  testing::AddFreeExperiment(m, "free.csv");
   sim::CampaignSimOptions o;
   o.seed = seed;
   o.truth.E_d = kTrueEd;

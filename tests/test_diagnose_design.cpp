@@ -31,10 +31,7 @@ DiagnoseSummary RunScrub(bool figure_eights, double k = 0.05) {
   testing::SmallCampaign s = testing::MakeSmallCampaign(91, 10, 20);
   s.sim.effects.scrub_k = k;
   if (figure_eights) {
-    Experiment fr;
-    fr.kind = ExperimentKind::kFree;
-    fr.file = fr.resolved_file = "figure_eight.csv";
-    s.manifest.experiments.push_back(fr);
+    testing::AddFreeExperiment(s.manifest, "figure_eight.csv");
     s.sim.free_runs = 4;
     s.sim.free_radius_m = 1.0;
   }

@@ -39,6 +39,15 @@ inline SmallCampaign MakeSmallCampaign(std::uint64_t seed, int square_runs = 5, 
   return s;
 }
 
+/// Appends a free experiment (the simulator's arcs or figure-eights) read
+/// from `file` to a manifest.
+inline void AddFreeExperiment(Manifest& m, const char* file) {
+  Experiment e;
+  e.kind = ExperimentKind::kFree;
+  e.file = e.resolved_file = file;
+  m.experiments.push_back(e);
+}
+
 /// Simulates the campaign and builds the diagnosis' view of it.
 inline diag::CampaignData BuildSmallCampaign(const SmallCampaign& s) {
   const sim::SimulatedCampaign c = sim::SimulateCampaign(s.manifest, s.sim);
