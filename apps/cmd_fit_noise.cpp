@@ -281,22 +281,73 @@ std::string PlotSvg(const WheelNoiseFitSummary& s) {
   return io::SvgDocument(3 * (size + 90) + 60, bottom + 10, parts);
 }
 
+/// The fit and the systematic errors it used.
+struct FitResult {
+  WheelNoiseFitSummary s;
+  SystematicErrors systematic;
+  std::string source;                      ///< "estimated", "params" or "none"
+  std::optional<SystematicEstimate> estimate;  ///< when estimated
+  bool kL_determined = true, kR_determined = true;
+};
+
+/// Which experiment would determine an undetermined k (`name` is "k_L" or
+/// "k_R"), as a clause.
+std::string DetermineKExperiment(const FitResult& f, const std::string& name) {
+  const bool other = name == "k_L" ? f.kR_determined : f.kL_determined;
+  // With the other k determined the runs show the total wheel noise but not
+  // how it splits between the wheels: straight runs and spot turns move both
+  // wheels the same distance, and only Cov(x, theta) tells them apart.
+  return other ? "runs in which the two wheels travel different distances (arcs or circles in both directions, pivot "
+                 "turns on each wheel) separate k_L from k_R"
+               : "the wheel noise is below what the reference noise lets these runs show: longer runs (wheel noise "
+                 "grows with distance, the reference noise does not) or a more precise reference would determine it";
+}
+
+/// What bounds an undetermined k: "k_L < x m^1/2 (95 %)", or nothing when
+/// the profile likelihood never falls far enough (the reference noise
+/// swamps the wheel noise).
+std::string KBound(const std::string& name, double upper) {
+  return std::isfinite(upper) ? fmt::format("only bounded: {} < {:.3g} m^1/2 (95 %)", name, upper)
+                              : std::string("not even bounded from above: the likelihood stays flat");
+}
+
+/// What bounds an undetermined k and what would determine it: the JSON
+/// warning (also printed in the text and the HTML).
+std::string UndeterminedK(const FitResult& f, const std::string& name) {
+  const double upper = name == "k_L" ? f.s.k_L_ci[1] : f.s.k_R_ci[1];
+  return fmt::format("{} is not determined by these runs (its estimate sits at the boundary 0), {}; {}", name,
+                     KBound(name, upper), DetermineKExperiment(f, name));
+}
+
 /// The HTML page; `warnings`, `notes`: the JSON's (shown as in the text).
-std::string FitNoiseReportHtml(const std::vector<std::string>& inputs, const WheelNoiseFitSummary& s,
+std::string FitNoiseReportHtml(const std::vector<std::string>& inputs, const FitResult& f,
                                const std::string& svg, const std::vector<std::string>& warnings,
                                const std::vector<std::string>& notes) {
   std::string subject;
   for (const auto& i : inputs) subject += (subject.empty() ? "" : ", ") + i;
+  const WheelNoiseFitSummary& s = f.s;
   io::HtmlReport rep("umbmark fit-noise", subject);
   bool flagged = false;
   for (const auto& g : s.goodness_of_fit) flagged |= std::abs(g.z) > 3.0;
-  rep.Headline(fmt::format("Wheel noise k_L = {:.3g} m^1/2 (95%: {:.3g} to {:.3g}), k_R = {:.3g} m^1/2 (95%: {:.3g} to {:.3g}) "
-                           "from {} runs{}.",
-                           s.k_L, s.k_L_ci[0], s.k_L_ci[1], s.k_R, s.k_R_ci[0], s.k_R_ci[1], s.runs,
+  // An undetermined k has no interval, only an upper bound: "0 to x" would
+  // read as a measured range.
+  auto k_text = [](const char* name, double k, bool determined, const std::array<double, 2>& ci) {
+    return determined ? fmt::format("{} = {:.3g} m^1/2 (95%: {:.3g} to {:.3g})", name, k, ci[0], ci[1])
+                      : fmt::format("{} not determined ({})", name, KBound(name, ci[1]));
+  };
+  const bool all = f.kL_determined && f.kR_determined;
+  rep.Headline(fmt::format("Wheel noise {}, {} from {} runs{}.", k_text("k_L", s.k_L, f.kL_determined, s.k_L_ci),
+                           k_text("k_R", s.k_R, f.kR_determined, s.k_R_ci), s.runs,
                            flagged ? "; the model does not explain every element of the scatter" : ""),
-               flagged ? io::HtmlReport::Level::kWarn : io::HtmlReport::Level::kGood);
-  std::vector<std::string> steps = {
-      "Use k_L, k_R in `umbmark predict` (pose covariance after any path) or in your simulator (wheel travel variance k^2 |travel|)."};
+               flagged || !all ? io::HtmlReport::Level::kWarn : io::HtmlReport::Level::kGood);
+  std::vector<std::string> steps;
+  for (const char* name : {"k_L", "k_R"})
+    if (!(std::string(name) == "k_L" ? f.kL_determined : f.kR_determined))
+      steps.push_back(fmt::format("To determine {}: {}.", name, DetermineKExperiment(f, name)));
+  steps.push_back(all ? "Use k_L, k_R in `umbmark predict` (pose covariance after any path) or in your simulator (wheel "
+                        "travel variance k^2 |travel|)."
+                      : "Until then, an undetermined k's upper bound (where there is one) is the conservative value for "
+                        "`umbmark predict` or your simulator (wheel travel variance k^2 |travel|).");
   if (flagged) steps.push_back("An element with |z| > 3 is not explained by white wheel noise: run `umbmark diagnose` on the campaign.");
   if (s.runs < 20) steps.push_back("Intervals are wide with few runs: 20 or more runs per group narrow them.");
   rep.NextSteps(steps);
@@ -322,15 +373,6 @@ std::string FitNoiseReportHtml(const std::vector<std::string>& inputs, const Whe
                   "about the group's own mean.");
   return rep.Render();
 }
-
-/// The fit and the systematic errors it used.
-struct FitResult {
-  WheelNoiseFitSummary s;
-  SystematicErrors systematic;
-  std::string source;                      ///< "estimated", "params" or "none"
-  std::optional<SystematicEstimate> estimate;  ///< when estimated
-  bool kL_determined = true, kR_determined = true;
-};
 
 /// Step 2: k_L, k_R with the systematic errors estimated jointly (default),
 /// given by --params, or none (a calibrated robot).
@@ -379,14 +421,8 @@ std::vector<std::string> Warnings(const Loaded& data, const FitResult& f) {
         "--params CAL.json from `umbmark calibrate` (or --systematic none for a calibrated robot)",
         kMaxJointEdShift, f.systematic.c_R / f.systematic.c_L));
   }
-  for (const auto& [name, det, ci] :
-       {std::tuple{"k_L", f.kL_determined, f.s.k_L_ci}, std::tuple{"k_R", f.kR_determined, f.s.k_R_ci}}) {
-    if (!det) {
-      warnings.push_back(fmt::format("{} is not determined: the data put it at the boundary 0 and bound it above by "
-                                     "{:.3g} m^1/2 (95 %); more or longer runs would determine it",
-                                     name, ci[1]));
-    }
-  }
+  if (!f.kL_determined) warnings.push_back(UndeterminedK(f, "k_L"));
+  if (!f.kR_determined) warnings.push_back(UndeterminedK(f, "k_R"));
   return warnings;
 }
 
@@ -470,7 +506,9 @@ void PrintText(const FitNoiseOptions& o, const Loaded& data, const FitResult& f,
     if (det) {
       fmt::print("  {} = {:.4g} m^1/2   95% interval [{:.4g}, {:.4g}]\n", name, k, ci[0], ci[1]);
     } else {
-      fmt::print("  {} not determined (at the boundary 0); 95% upper bound {:.4g} m^1/2\n", name, ci[1]);
+      fmt::print("  {} not determined (at the boundary 0); 95% upper bound {} (a bound only: see the warning for the "
+                 "runs that would determine it)\n",
+                 name, std::isfinite(ci[1]) ? fmt::format("{:.4g} m^1/2", ci[1]) : std::string("none"));
     }
   }
   if (f.estimate) {
@@ -506,8 +544,9 @@ void PrintText(const FitNoiseOptions& o, const Loaded& data, const FitResult& f,
 }
 
 /// --plot, --report, --ros2; returns what was written.
-std::vector<std::string> WriteOutputs(const FitNoiseOptions& o, const Loaded& data, const WheelNoiseFitSummary& s,
+std::vector<std::string> WriteOutputs(const FitNoiseOptions& o, const Loaded& data, const FitResult& f,
                                       nlohmann::json& j) {
+  const WheelNoiseFitSummary& s = f.s;
   std::vector<std::string> written;
   std::string svg;
   if (!o.plot.empty() || !o.report.empty()) svg = PlotSvg(s);
@@ -516,7 +555,7 @@ std::vector<std::string> WriteOutputs(const FitNoiseOptions& o, const Loaded& da
     written.push_back(o.plot + " (plot)");
   }
   if (!o.report.empty()) {
-    CommandOutputs().Write(o.report, FitNoiseReportHtml(o.inputs, s, svg, j["warnings"], j["notes"]));
+    CommandOutputs().Write(o.report, FitNoiseReportHtml(o.inputs, f, svg, j["warnings"], j["notes"]));
     written.push_back(o.report + " (HTML report)");
   }
   if (o.ros2.empty()) return written;
@@ -568,7 +607,7 @@ int RunFitNoise(const FitNoiseOptions& o) {
   } else {
     for (const auto& w : j["warnings"]) fmt::print(stderr, "fit-noise: warning: {}\n", w.get<std::string>());
   }
-  std::vector<std::string> written = WriteOutputs(o, data, f.s, j);
+  std::vector<std::string> written = WriteOutputs(o, data, f, j);
   o.json.Emit(j);
   if (!o.json.path.empty() && !o.json.ToStdout()) written.push_back(o.json.path + " (JSON)");
   PrintWritten(written, o.json.PrintText());

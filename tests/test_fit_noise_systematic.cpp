@@ -232,9 +232,34 @@ TEST_CASE("fit-noise CLI: k at the boundary is 'not determined'; --params and --
     CHECK(j["k_L_upper95"].get<double>() > 0.0);
     CHECK(j["k_L_upper95"].get<double>() < kTrueKR);
     CHECK(j["k_R_determined"] == true);
-    const auto text = testing::RunCli(fmt::format("fit-noise {} --robot {} --distance 10 --systematic none --ml", (dir / "zero.csv").string(),
-                                                  (dir / "robot.toml").string()));
-    CHECK(text.out.find("k_L not determined (at the boundary 0); 95% upper bound") != std::string::npos);
+    // Back-and-forth runs move both wheels alike: the warning names the bound
+    // and the runs that would separate k_L from k_R.
+    const double upper = j["k_L_upper95"].get<double>();
+    const std::string bound = fmt::format("only bounded: k_L < {:.3g} m^1/2 (95 %)", upper);
+    REQUIRE(j["warnings"].size() == 1);
+    const std::string warning = j["warnings"][0].get<std::string>();
+    CHECK(warning.find("k_L is not determined by these runs") != std::string::npos);
+    CHECK(warning.find(bound) != std::string::npos);
+    CHECK(warning.find("arcs or circles in both directions, pivot turns on each wheel") != std::string::npos);
+    const auto html = dir / "zero.html";
+    const auto text = testing::RunCli(fmt::format("fit-noise {} --robot {} --distance 10 --systematic none --ml --report {}",
+                                                  (dir / "zero.csv").string(), (dir / "robot.toml").string(), html.string()));
+    REQUIRE(text.status == 0);
+    CHECK(text.out.find(fmt::format("k_L not determined (at the boundary 0); 95% upper bound {:.4g} m^1/2", upper)) !=
+          std::string::npos);
+    CHECK(text.out.find("WARNING: " + warning) != std::string::npos);
+    std::ifstream in(html);
+    const std::string page((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // The headline gives k_R's interval and, for k_L, the bound only (never "0 to ...").
+    CHECK(page.find(fmt::format("k_L not determined (only bounded: k_L &lt; {:.3g} m^1/2 (95 %))", upper)) != std::string::npos);
+    CHECK(page.find(fmt::format("k_R = {:.3g} m^1/2 (95%: {:.3g} to {:.3g})", j["k_R"].get<double>(),
+                                j["k_R_ci95"][0].get<double>(), j["k_R_ci95"][1].get<double>())) != std::string::npos);
+    const auto head = page.find("<section class=\"headline");
+    REQUIRE(head != std::string::npos);
+    const std::string headline = page.substr(head, page.find("</section>", head) - head);
+    CHECK(headline.find("k_L = ") == std::string::npos);
+    CHECK(headline.find("k_L not determined") != std::string::npos);
+    CHECK(page.find("To determine k_L: runs in which the two wheels travel different distances") != std::string::npos);
   }
   fs::remove_all(dir);
 }
