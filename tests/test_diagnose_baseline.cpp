@@ -186,6 +186,13 @@ TEST_CASE("diagnose --baseline: wheel noise given x2 and x0.5 is named, the rati
     CHECK_FALSE(s->negligible);
     CHECK_THAT(s->params.at("ratio_L"), WithinRel(1.0 / factor, 0.25));
     CHECK_THAT(s->params.at("ratio_R"), WithinRel(1.0 / factor, 0.25));
+    // Both wheels off: both k get a correction, one text for both.
+    REQUIRE(d.corrections.size() == 2);
+    CHECK(d.corrections[0].parameter == "k_L");
+    CHECK(d.corrections[1].parameter == "k_R");
+    CHECK_THAT(d.corrections[0].corrected, WithinRel(kTrueKL, 0.25));
+    CHECK_THAT(d.corrections[1].corrected, WithinRel(kTrueKR, 0.25));
+    CHECK(d.corrections[0].text.find("(left) and x") != std::string::npos);
     // The evidence is the likelihood, not the mean gap it does not change.
     const std::string text = DiagnoseReport(d);
     CHECK(text.find("evidence for wheel_noise_error: very strong evidence: runs not used to fit it are") !=
@@ -211,6 +218,19 @@ TEST_CASE("diagnose --baseline: one wheel's noise wrong is named on that wheel",
       REQUIRE(s);
       CHECK_THAT(s->params.at(left ? "ratio_L" : "ratio_R"), WithinRel(1.0 / factor, 0.25));
       CHECK_THAT(s->params.at(left ? "ratio_R" : "ratio_L"), WithinAbs(1.0, 0.15));
+      // The correction names only the wrong wheel's k and keeps the other.
+      REQUIRE(d.corrections.size() == 1);
+      const ParameterCorrection& pc = d.corrections.front();
+      CHECK(pc.parameter == (left ? "k_L" : "k_R"));
+      CHECK(pc.given == Approx(factor * (left ? kTrueKL : kTrueKR)));
+      CHECK_THAT(pc.corrected, WithinRel(left ? kTrueKL : kTrueKR, 0.25));
+      const std::string keep = left ? "k_R" : "k_L";
+      CHECK(pc.text.find(fmt::format("the simulation's {} wheel noise is off by x", left ? "left" : "right")) !=
+            std::string::npos);
+      CHECK(pc.text.find(fmt::format("{} = {:.3g} m^1/2 is consistent with the runs", keep,
+                                     left ? kTrueKR : kTrueKL)) != std::string::npos);
+      CHECK(pc.text.find("set " + keep) == std::string::npos);
+      CHECK(DiagnoseReport(d).find("    " + pc.text + "\n") != std::string::npos);
     }
   }
 }

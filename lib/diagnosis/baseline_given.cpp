@@ -154,7 +154,7 @@ std::map<std::string, double> DescribeGivenParamErrors(sim::EffectKind kind,
 }
 
 std::vector<ParameterCorrection> Corrections(sim::EffectKind kind, const std::map<std::string, double>& d,
-                                             const GivenModel& given) {
+                                             const GivenModel& given, double negligible) {
   std::vector<ParameterCorrection> out;
   const std::string name = sim::EffectToString(kind);
   if (kind == sim::EffectKind::kWheelbaseError) {
@@ -177,12 +177,33 @@ std::vector<ParameterCorrection> Corrections(sim::EffectKind kind, const std::ma
     out.push_back({name, "wheel_diameter_right_m", given.params.wheel_diameter_right_m,
                    Get(d, "wheel_diameter_right_m", 0.0), "m", text});
   } else if (kind == sim::EffectKind::kWheelNoiseError) {
-    const std::string text = fmt::format(
-        "the simulation's wheel noise is off by x{:.2f} (left) and x{:.2f} (right): set k_L = {:.3g}, k_R = {:.3g} "
-        "m^1/2 (were {:.3g}, {:.3g})",
-        Get(d, "ratio_L", 0.0), Get(d, "ratio_R", 0.0), Get(d, "k_L", 0.0), Get(d, "k_R", 0.0), given.k_L, given.k_R);
-    out.push_back({name, "k_L", given.k_L, Get(d, "k_L", 0.0), "m^1/2", text});
-    out.push_back({name, "k_R", given.k_R, Get(d, "k_R", 0.0), "m^1/2", text});
+    // A wheel whose k is within the practical threshold of the given one
+    // (explanation.hpp: |k_fit / k_given - 1| < negligible) is consistent:
+    // only the other wheel's k is to change.
+    struct Wheel {
+      const char* side;
+      const char* key;
+      double given, fit, ratio;
+    };
+    const Wheel wheels[2] = {{"left", "k_L", given.k_L, Get(d, "k_L", 0.0), Get(d, "ratio_L", 0.0)},
+                             {"right", "k_R", given.k_R, Get(d, "k_R", 0.0), Get(d, "ratio_R", 0.0)}};
+    auto off = [&](const Wheel& w) { return !(std::abs(w.ratio - 1.0) < negligible); };
+    std::string text;
+    if (off(wheels[0]) && off(wheels[1])) {
+      text = fmt::format(
+          "the simulation's wheel noise is off by x{:.2f} (left) and x{:.2f} (right): set k_L = {:.3g}, k_R = {:.3g} "
+          "m^1/2 (were {:.3g}, {:.3g})",
+          wheels[0].ratio, wheels[1].ratio, wheels[0].fit, wheels[1].fit, given.k_L, given.k_R);
+    } else {
+      const Wheel& w = off(wheels[0]) ? wheels[0] : wheels[1];
+      const Wheel& ok = off(wheels[0]) ? wheels[1] : wheels[0];
+      text = fmt::format(
+          "the simulation's {} wheel noise is off by x{:.2f}: set {} = {:.3g} m^1/2 (was {:.3g}); {} = {:.3g} m^1/2 is "
+          "consistent with the runs (fitted x{:.2f}, within the negligible {:.0f} %): keep it",
+          w.side, w.ratio, w.key, w.fit, w.given, ok.key, ok.given, ok.ratio, 100.0 * negligible);
+    }
+    for (const Wheel& w : wheels)
+      if (off(w)) out.push_back({name, w.key, w.given, w.fit, "m^1/2", text});
   }
   return out;
 }

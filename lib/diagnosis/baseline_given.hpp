@@ -97,8 +97,10 @@ struct ParameterCorrection {
 };
 
 /// The corrections a named parameter error asks for (from its described
-/// parameters, DescribeGivenParams).
+/// parameters, DescribeGivenParams). For wheel_noise_error only the wheel(s)
+/// whose |k_fit / k_given - 1| reaches `negligible` (the practical threshold,
+/// explanation.hpp) get a correction; the text says the other k is consistent.
 std::vector<ParameterCorrection> Corrections(sim::EffectKind kind, const std::map<std::string, double>& described,
-                                             const GivenModel& given);
+                                             const GivenModel& given, double negligible);
 
 }  // namespace umbmark::diag

@@ -114,7 +114,7 @@ void DescribeGivenModel(const CampaignData& c, const GivenModel& given, Diagnose
     const bool named = std::find(out.verdict_effects.begin(), out.verdict_effects.end(),
                                  sim::EffectToString(s.effect)) != out.verdict_effects.end();
     if (!named || !sim::IsParameterError(s.effect)) continue;
-    for (ParameterCorrection& pc : Corrections(s.effect, s.params, given)) out.corrections.push_back(std::move(pc));
+    for (ParameterCorrection& pc : Corrections(s.effect, s.params, given, out.negligible_threshold)) out.corrections.push_back(std::move(pc));
   }
 }
 
