@@ -168,7 +168,10 @@ Command SetupDiagnose(CLI::App& parent) {
   app->add_option("--seed", d.seed, "Seed of the null simulations (default 1)")->check(SeedValidator());
   app->add_option("--threads", d.threads, "Threads (default 2)")->check(NumberIn(1, 256));
   app->add_option("--where", d.where_top, "Discrepancies listed under 'where' (default 12)")->check(NonNegative());
-  app->add_option("--effects", opts->effects, "Effects to try (default: the contract's nine)")->delimiter(',');
+  app->add_option("--effects", opts->effects,
+                  "Effects to try, comma-separated (default: the contract's twelve; with --baseline also its "
+                  "parameter errors)")
+      ->delimiter(',');
   app->add_option("--plot", opts->plot,
                   "SVG: located discrepancies against the model's 95% band, shrink per candidate and of the explanation");
   app->add_option("--report", opts->report, "Write a self-contained HTML report (verdict, next steps, tables, plots)");

@@ -137,3 +137,56 @@ TEST_CASE("the example files quoted in docs/formats.md are the files in data/exa
   }
   CHECK(checked >= 7);
 }
+
+TEST_CASE("docs/diagnosis.md's option table agrees with `umbmark diagnose --help`", "[examples]") {
+  // Every option of the help is in the page's table, and a numeric default
+  // the help states is the default the table gives.
+  const auto help = RunCli("diagnose --help");
+  REQUIRE(help.status == 0);
+  std::vector<std::string> table;
+  {
+    std::istringstream in(Slurp((kSrc / "docs/diagnosis.md").string()));
+    std::string line;
+    while (std::getline(in, line))
+      if (line.rfind("| `--", 0) == 0) table.push_back(line);
+  }
+  REQUIRE(table.size() >= 15);
+  // Option name -> its help text (CLI11 wraps a long name's text onto the next line).
+  std::vector<std::pair<std::string, std::string>> options;
+  {
+    std::istringstream in(help.out);
+    std::string line;
+    const std::regex opt(R"(^\s+(--[a-z0-9-]+))");
+    std::smatch m;
+    while (std::getline(in, line)) {
+      if (std::regex_search(line, m, opt)) {
+        options.emplace_back(m[1].str(), line);
+      } else if (!options.empty()) {
+        options.back().second += " " + line;
+      }
+    }
+  }
+  REQUIRE(options.size() >= 20);
+  int with_default = 0;
+  for (const auto& [name, text] : options) {
+    if (name == "--help") continue;
+    INFO(name << ": " << text);
+    const std::string cell = "`" + name;
+    const std::string* row = nullptr;
+    for (const auto& r : table) {
+      // The name as a whole word: `--seed N` or `--seed`, in the first cell.
+      const auto at = r.substr(0, r.find(" | ")).find(cell);
+      if (at == std::string::npos) continue;
+      const char next = r[at + cell.size()];
+      if (next == ' ' || next == '`') row = &r;
+    }
+    REQUIRE(row != nullptr);
+    std::smatch d;
+    if (std::regex_search(text, d, std::regex(R"(\(default ([0-9][0-9.e+-]*)[;)])"))) {
+      INFO(*row);
+      CHECK(row->find("| " + d[1].str() + " |") != std::string::npos);
+      ++with_default;
+    }
+  }
+  CHECK(with_default >= 8);
+}
