@@ -1,6 +1,7 @@
 // Motion segmentation (see effects_motion.hpp).
 #include "simulation/effects_motion.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -36,6 +37,81 @@ MotionClass ClassifyMotion(double left_m, double right_m, double wheelbase_m, co
   return MotionClass::kArc;
 }
 
+namespace {
+
+/// Sign of a wheel's travel in interval i (0: still).
+int TravelSign(const std::vector<double>& cum, std::size_t i, double eps) {
+  const double d = cum[i + 1] - cum[i];
+  return d > eps ? 1 : d < -eps ? -1 : 0;
+}
+
+/// Intervals between the two moving intervals of one wheel nearest to
+/// `from` in [lo, hi], searching backward (step -1) or forward (+1); the
+/// smaller over the two wheels (the faster wheel's); 0 when neither wheel
+/// moved in two intervals there.
+std::size_t TickSpacing(const std::vector<double>& cum_left, const std::vector<double>& cum_right, double eps,
+                        std::size_t lo, std::size_t hi, bool backward) {
+  std::size_t best = 0;
+  for (const std::vector<double>* cum : {&cum_left, &cum_right}) {
+    std::size_t found = 0, seen[2] = {0, 0};
+    for (std::size_t n = 0; n <= hi - lo && found < 2; ++n) {
+      const std::size_t i = backward ? hi - n : lo + n;
+      if (TravelSign(*cum, i, eps) != 0) seen[found++] = i;
+    }
+    if (found < 2) continue;
+    const std::size_t s = backward ? seen[0] - seen[1] : seen[1] - seen[0];
+    if (best == 0 || s < best) best = s;
+  }
+  return best;
+}
+
+/// Whether a motion (intervals first..last so far) moves on through the
+/// still stretch [last + 1, k) of at least min_stand_intervals that ends at
+/// moving interval k. A wheel moving at speed v counts a tick every
+/// tick / v seconds, so a still stretch no longer than that is what a
+/// moving wheel shows between two counts; it is no standstill. At 500
+/// ticks/rev and 50 Hz a spot turn from rest (or braking into its end)
+/// under an acceleration limit counts in bursts two or three still samples
+/// apart, and reading those gaps as standstills put turning into the
+/// standstills. The time of one tick there is read from the counts next to
+/// the gap: the spacing (in sample intervals) of the faster wheel's last two
+/// counts before it or first two after it (the motion after the gap up to
+/// its next standstill or reversal), the longer of the two, since the
+/// motion slows into a gap or speeds up out of it. The motion moves through
+/// when no wheel reverses after the gap and the gap lasts no more intervals
+/// than that spacing. A pause as a campaign commands it (a second, or half
+/// of one) lasts many ticks' time even at creep speed: it stays a
+/// standstill. A one-count motion next to a standstill gives no spacing.
+template <class Reverses>
+bool MovesThroughGap(const std::vector<double>& cum_left, const std::vector<double>& cum_right,
+                     const MotionOptions& options, std::size_t first, std::size_t last, std::size_t k,
+                     const Reverses& reverses) {
+  const std::size_t intervals = cum_left.size() - 1;
+  const std::size_t gap = k - (last + 1);
+  const double eps = options.stand_eps_m;
+  auto moving = [&](std::size_t i) {
+    return TravelSign(cum_left, i, eps) != 0 || TravelSign(cum_right, i, eps) != 0;
+  };
+  // The motion after the gap: up to its next still stretch of
+  // min_stand_intervals, the end of the run, or a wheel turning against the
+  // motion's direction (then it is another motion anyway).
+  std::size_t end = k;
+  for (std::size_t q = k, still = 0; q < intervals; ++q) {
+    if (moving(q)) {
+      if (reverses(q)) return false;
+      end = q;
+      still = 0;
+    } else if (++still >= static_cast<std::size_t>(options.min_stand_intervals)) {
+      break;
+    }
+  }
+  const std::size_t before = TickSpacing(cum_left, cum_right, eps, first, last, true);
+  const std::size_t after = TickSpacing(cum_left, cum_right, eps, k, end, false);
+  return gap <= std::max(before, after);
+}
+
+}  // namespace
+
 std::vector<MotionSegment> SegmentMotions(const std::vector<double>& cum_left, const std::vector<double>& cum_right,
                                           double wheelbase_m, const MotionOptions& options) {
   if (auto e = options.Check(); !e.empty()) throw InvalidOptions("MotionOptions: " + e);
@@ -49,11 +125,7 @@ std::vector<MotionSegment> SegmentMotions(const std::vector<double>& cum_left, c
     return std::abs(cum_left[i + 1] - cum_left[i]) > options.stand_eps_m ||
            std::abs(cum_right[i + 1] - cum_right[i]) > options.stand_eps_m;
   };
-  // Sign of a wheel's travel in interval i (0: still).
-  auto sign = [&](const std::vector<double>& cum, std::size_t i) {
-    const double d = cum[i + 1] - cum[i];
-    return d > options.stand_eps_m ? 1 : d < -options.stand_eps_m ? -1 : 0;
-  };
+  auto sign = [&](const std::vector<double>& cum, std::size_t i) { return TravelSign(cum, i, options.stand_eps_m); };
   std::size_t i = 0;
   while (i < intervals) {
     if (!moving(i)) {
@@ -92,8 +164,11 @@ std::vector<MotionSegment> SegmentMotions(const std::vector<double>& cum_left, c
       // A still stretch: long enough to end the motion?
       std::size_t k = j;
       while (k < intervals && !moving(k)) ++k;
-      if (k - j >= static_cast<std::size_t>(options.min_stand_intervals) || k == intervals) break;
-      j = k;  // short gap: the motion continues
+      if (k == intervals) break;
+      if (k - j >= static_cast<std::size_t>(options.min_stand_intervals) &&
+          !MovesThroughGap(cum_left, cum_right, options, m.first_interval, last, k, reverses))
+        break;
+      j = k;  // the motion continues through the gap
     }
     m.last_interval = last;
     m.left_m = cum_left[last + 1] - cum_left[m.first_interval];
