@@ -45,24 +45,25 @@ int TravelSign(const std::vector<double>& cum, std::size_t i, double eps) {
   return d > eps ? 1 : d < -eps ? -1 : 0;
 }
 
-/// Intervals between the two moving intervals of one wheel nearest to
-/// `from` in [lo, hi], searching backward (step -1) or forward (+1); the
-/// smaller over the two wheels (the faster wheel's); 0 when neither wheel
-/// moved in two intervals there.
+/// Intervals between the first two moving intervals of one wheel met when
+/// walking from `from` towards `to` (either direction, both included), for
+/// the first wheel to move twice (the faster one, as a rule); 0 when
+/// neither does. stop(i) ends the walk before interval i.
+template <class Stop>
 std::size_t TickSpacing(const std::vector<double>& cum_left, const std::vector<double>& cum_right, double eps,
-                        std::size_t lo, std::size_t hi, bool backward) {
-  std::size_t best = 0;
-  for (const std::vector<double>* cum : {&cum_left, &cum_right}) {
-    std::size_t found = 0, seen[2] = {0, 0};
-    for (std::size_t n = 0; n <= hi - lo && found < 2; ++n) {
-      const std::size_t i = backward ? hi - n : lo + n;
-      if (TravelSign(*cum, i, eps) != 0) seen[found++] = i;
+                        std::size_t from, std::size_t to, const Stop& stop) {
+  std::size_t seen[2][2] = {{0, 0}, {0, 0}}, found[2] = {0, 0};
+  const std::size_t n = from <= to ? to - from : from - to;
+  for (std::size_t step = 0; step <= n; ++step) {
+    const std::size_t i = from <= to ? from + step : from - step;
+    if (stop(i)) break;
+    for (int w = 0; w < 2; ++w) {
+      if (TravelSign(w == 0 ? cum_left : cum_right, i, eps) == 0) continue;
+      seen[w][found[w]++] = i;
+      if (found[w] == 2) return seen[w][0] > seen[w][1] ? seen[w][0] - seen[w][1] : seen[w][1] - seen[w][0];
     }
-    if (found < 2) continue;
-    const std::size_t s = backward ? seen[0] - seen[1] : seen[1] - seen[0];
-    if (best == 0 || s < best) best = s;
   }
-  return best;
+  return 0;
 }
 
 /// Whether a motion (intervals first..last so far) moves on through the
@@ -74,39 +75,24 @@ std::size_t TickSpacing(const std::vector<double>& cum_left, const std::vector<d
 /// under an acceleration limit counts in bursts two or three still samples
 /// apart, and reading those gaps as standstills put turning into the
 /// standstills. The time of one tick there is read from the counts next to
-/// the gap: the spacing (in sample intervals) of the faster wheel's last two
-/// counts before it or first two after it (the motion after the gap up to
-/// its next standstill or reversal), the longer of the two, since the
-/// motion slows into a gap or speeds up out of it. The motion moves through
-/// when no wheel reverses after the gap and the gap lasts no more intervals
-/// than that spacing. A pause as a campaign commands it (a second, or half
-/// of one) lasts many ticks' time even at creep speed: it stays a
-/// standstill. A one-count motion next to a standstill gives no spacing.
+/// the gap: the spacing (in sample intervals) of a wheel's last two counts
+/// before it in the motion, or its first two after it, the longer of the
+/// two, since a motion slows into a gap or speeds up out of it. The motion
+/// moves through when no wheel reverses at the gap's end and the gap lasts
+/// no more intervals than that spacing. A pause as a campaign commands it
+/// (a second, or half of one) lasts many ticks' time even at creep speed:
+/// it stays a standstill.
 template <class Reverses>
 bool MovesThroughGap(const std::vector<double>& cum_left, const std::vector<double>& cum_right,
                      const MotionOptions& options, std::size_t first, std::size_t last, std::size_t k,
                      const Reverses& reverses) {
+  if (reverses(k)) return false;
   const std::size_t intervals = cum_left.size() - 1;
   const std::size_t gap = k - (last + 1);
   const double eps = options.stand_eps_m;
-  auto moving = [&](std::size_t i) {
-    return TravelSign(cum_left, i, eps) != 0 || TravelSign(cum_right, i, eps) != 0;
-  };
-  // The motion after the gap: up to its next still stretch of
-  // min_stand_intervals, the end of the run, or a wheel turning against the
-  // motion's direction (then it is another motion anyway).
-  std::size_t end = k;
-  for (std::size_t q = k, still = 0; q < intervals; ++q) {
-    if (moving(q)) {
-      if (reverses(q)) return false;
-      end = q;
-      still = 0;
-    } else if (++still >= static_cast<std::size_t>(options.min_stand_intervals)) {
-      break;
-    }
-  }
-  const std::size_t before = TickSpacing(cum_left, cum_right, eps, first, last, true);
-  const std::size_t after = TickSpacing(cum_left, cum_right, eps, k, end, false);
+  const std::size_t before = TickSpacing(cum_left, cum_right, eps, last, first, [](std::size_t) { return false; });
+  // After the gap up to a reversal (the start of another motion).
+  const std::size_t after = TickSpacing(cum_left, cum_right, eps, k, intervals - 1, reverses);
   return gap <= std::max(before, after);
 }
 
@@ -166,7 +152,8 @@ std::vector<MotionSegment> SegmentMotions(const std::vector<double>& cum_left, c
       while (k < intervals && !moving(k)) ++k;
       if (k == intervals) break;
       if (k - j >= static_cast<std::size_t>(options.min_stand_intervals) &&
-          !MovesThroughGap(cum_left, cum_right, options, m.first_interval, last, k, reverses))
+          !(options.move_through_tick_gaps &&
+            MovesThroughGap(cum_left, cum_right, options, m.first_interval, last, k, reverses)))
         break;
       j = k;  // the motion continues through the gap
     }

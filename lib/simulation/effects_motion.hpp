@@ -53,6 +53,11 @@ struct MotionOptions {
   double stand_eps_m = 1e-9;
   /// Shortest still stretch (intervals) that separates two motions. Default 2.
   int min_stand_intervals = 2;
+  /// A longer still stretch is no standstill when the wheels move on
+  /// through it at a speed where one tick takes as long (see the file
+  /// comment). False: every still stretch of min_stand_intervals ends the
+  /// motion (the reading before; kept for comparison). Default true.
+  bool move_through_tick_gaps = true;
   /// See the file comment. Defaults 0.1 rad and 0.1.
   double straight_max_rad = 0.1;
   double turn_max_ratio = 0.1;
