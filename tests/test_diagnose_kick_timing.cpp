@@ -36,45 +36,7 @@ using Catch::Matchers::WithinRel;
 
 namespace {
 
-constexpr double kPi = testing::kAccelPi;
 constexpr double kKappa = testing::kAccelKappa;
-
-/// 6 cw + 6 ccw squares of 2 m and 12 back-and-forth runs of 2 m, 1 s
-/// pauses between motions (72 kicks).
-std::vector<std::variant<EndpointData, TrajectoryData>> LaggingCampaign(std::uint64_t seed) {
-  std::mt19937_64 g(seed);
-  TrajectoryData squares, fwd_back;
-  for (int r = 0; r < 12; ++r) {
-    const bool cw = r % 2 == 0;
-    testing::AccelRobot robot(g, std::to_string(r + 1), cw ? "cw" : "ccw");
-    robot.Pause(1.0);
-    for (int leg = 0; leg < 4; ++leg) {
-      robot.Leg(2.0);
-      robot.Pause(1.0);
-      robot.Turn(cw ? -0.5 * kPi : 0.5 * kPi);
-      robot.Pause(1.0);
-    }
-    squares.runs.push_back(robot.Finish());
-  }
-  for (int r = 0; r < 12; ++r) {
-    testing::AccelRobot robot(g, std::to_string(r + 1), "fwd_back");
-    robot.Pause(1.0);
-    robot.Leg(2.0);
-    robot.Pause(1.0);
-    robot.Leg(-2.0);
-    robot.Pause(1.0);
-    fwd_back.runs.push_back(robot.Finish());
-  }
-  return {squares, fwd_back};
-}
-
-Manifest LaggingManifest() {
-  RobotParams r;
-  r.wheelbase_m = testing::kAccelWheelbase;
-  r.wheel_diameter_left_m = r.wheel_diameter_right_m = testing::kAccelDiameter;
-  r.ticks_per_rev = testing::kAccelTicks;
-  return sim::StandardCampaignManifest(r, 2.0, 2.0, GroundTruthNoise{3e-4, 1.5e-3});
-}
 
 DiagnoseSummary DiagnoseWith(const PieceOptions& pieces) {
   DiagnoseOptions o;
@@ -82,7 +44,7 @@ DiagnoseSummary DiagnoseWith(const PieceOptions& pieces) {
   o.seed = 1;
   o.threads = 2;
   o.pieces = pieces;
-  return Diagnose(BuildCampaign(LaggingManifest(), LaggingCampaign(12012), pieces), o);
+  return Diagnose(BuildCampaign(testing::AccelManifest(), testing::AccelCampaign(12012, kKappa, 20), pieces), o);
 }
 
 double FittedKappa(const DiagnoseSummary& d) {

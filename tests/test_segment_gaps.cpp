@@ -9,11 +9,12 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
-#include <utility>
+#include <cstdint>
 #include <random>
 #include <string>
-#include <variant>
+#include <utility>
 #include <vector>
 
 #include "diagnosis/diagnose.hpp"
@@ -64,41 +65,8 @@ int InnerGaps(const TrajectoryRun& r, std::size_t lo, std::size_t hi, std::size_
   return gaps;
 }
 
-/// A clean campaign (no effect) at 50 Hz: 6 cw + 6 ccw squares of 2 m and
-/// 12 back-and-forth runs of 2 m, 1 s pauses between motions.
-std::vector<std::variant<EndpointData, TrajectoryData>> CleanCampaign(std::uint64_t seed) {
-  std::mt19937_64 g(seed);
-  TrajectoryData squares, fwd_back;
-  for (int r = 0; r < 12; ++r) {
-    const bool cw = r % 2 == 0;
-    AccelRobot robot(g, std::to_string(r + 1), cw ? "cw" : "ccw", 0.0, kRate);
-    robot.Pause(1.0);
-    for (int leg = 0; leg < 4; ++leg) {
-      robot.Leg(2.0);
-      robot.Pause(1.0);
-      robot.Turn(cw ? -kQuarter : kQuarter);
-      robot.Pause(1.0);
-    }
-    squares.runs.push_back(robot.Finish());
-  }
-  for (int r = 0; r < 12; ++r) {
-    AccelRobot robot(g, std::to_string(r + 1), "fwd_back", 0.0, kRate);
-    robot.Pause(1.0);
-    robot.Leg(2.0);
-    robot.Pause(1.0);
-    robot.Leg(-2.0);
-    robot.Pause(1.0);
-    fwd_back.runs.push_back(robot.Finish());
-  }
-  return {squares, fwd_back};
-}
-
+/// The campaign of accel_robot.hpp without an effect (kappa = 0) at 50 Hz.
 DiagnoseSummary DiagnoseClean(bool move_through_tick_gaps) {
-  RobotParams r;
-  r.wheelbase_m = testing::kAccelWheelbase;
-  r.wheel_diameter_left_m = r.wheel_diameter_right_m = testing::kAccelDiameter;
-  r.ticks_per_rev = testing::kAccelTicks;
-  const Manifest m = sim::StandardCampaignManifest(r, 2.0, 2.0, GroundTruthNoise{3e-4, 1.5e-3});
   PieceOptions pieces;
   pieces.motion.move_through_tick_gaps = move_through_tick_gaps;
   DiagnoseOptions o;
@@ -106,7 +74,7 @@ DiagnoseSummary DiagnoseClean(bool move_through_tick_gaps) {
   o.seed = 1;
   o.threads = 2;
   o.pieces = pieces;
-  return Diagnose(BuildCampaign(m, CleanCampaign(5050), pieces), o);
+  return Diagnose(BuildCampaign(testing::AccelManifest(), testing::AccelCampaign(5050, 0.0, kRate), pieces), o);
 }
 
 }  // namespace

@@ -22,7 +22,12 @@
 #include <string>
 #include <utility>
 
+#include <variant>
+#include <vector>
+
 #include "core/runs.hpp"
+#include "io/manifest.hpp"
+#include "simulation/campaign_sim.hpp"
 
 namespace umbmark::testing {
 
@@ -131,5 +136,46 @@ class AccelRobot {
   double x_ = 0.0, y_ = 0.0, th_ = 0.0;
   long steps_ = 0;
 };
+
+/// 6 cw + 6 ccw squares of 2 m and 12 back-and-forth runs of 2 m, 1 s
+/// pauses between motions (72 starts of a leg), castor kick kappa, samples
+/// at sample_rate_hz.
+inline std::vector<std::variant<EndpointData, TrajectoryData>> AccelCampaign(std::uint64_t seed, double kappa,
+                                                                            int sample_rate_hz) {
+  std::mt19937_64 g(seed);
+  TrajectoryData squares, fwd_back;
+  for (int r = 0; r < 12; ++r) {
+    const bool cw = r % 2 == 0;
+    AccelRobot robot(g, std::to_string(r + 1), cw ? "cw" : "ccw", kappa, sample_rate_hz);
+    robot.Pause(1.0);
+    for (int leg = 0; leg < 4; ++leg) {
+      robot.Leg(2.0);
+      robot.Pause(1.0);
+      robot.Turn(cw ? -0.5 * kAccelPi : 0.5 * kAccelPi);
+      robot.Pause(1.0);
+    }
+    squares.runs.push_back(robot.Finish());
+  }
+  for (int r = 0; r < 12; ++r) {
+    AccelRobot robot(g, std::to_string(r + 1), "fwd_back", kappa, sample_rate_hz);
+    robot.Pause(1.0);
+    robot.Leg(2.0);
+    robot.Pause(1.0);
+    robot.Leg(-2.0);
+    robot.Pause(1.0);
+    fwd_back.runs.push_back(robot.Finish());
+  }
+  return {squares, fwd_back};
+}
+
+/// The manifest of AccelCampaign: the robot's nominal geometry, ground-truth
+/// noise as stated.
+inline Manifest AccelManifest() {
+  RobotParams r;
+  r.wheelbase_m = kAccelWheelbase;
+  r.wheel_diameter_left_m = r.wheel_diameter_right_m = kAccelDiameter;
+  r.ticks_per_rev = kAccelTicks;
+  return sim::StandardCampaignManifest(r, 2.0, 2.0, GroundTruthNoise{3e-4, 1.5e-3});
+}
 
 }  // namespace umbmark::testing
