@@ -30,10 +30,24 @@
 //   [--side M] [--distance M] [--speed V] [--turn-rate W] [--kl K] [--kr K]
 //   [--E-d X] [--E-b X] [--gt-sigma-xy M] [--gt-sigma-theta R]
 //   [--wheelbase M] [--diameter M]
-// Effects (contract names, same parameters): scale_error:s,
-// direction_asymmetry:a, castor_kick:kappa, gt_offset:dx,dy,
-// time_offset:tau, and outside the contract gt_yaw_misalignment:delta,
-// floor_slope:g,dir.
+// Effects (contract names, same parameters; --effect may be repeated to
+// combine them): scale_error:s, direction_asymmetry:a, castor_kick:kappa,
+// gt_offset:dx,dy, time_offset:tau, bump_outliers:rate,sigma,
+// standstill_motion:sigma_xy,sigma_theta, run_time_offset:tau_sd, and
+// outside the contract gt_yaw_misalignment:delta, floor_slope:g,dir.
+// The last three contract effects draw from a second random stream (seed
+// S xor a constant), so that adding them leaves every other draw, and a
+// campaign without them, exactly as before.
+//   bump_outliers: per wheel the travel to the next bump is exponential with
+//     mean 1/rate metres of |true travel|; a bump adds N(0, sigma^2) m to
+//     that wheel's true travel in that 1 ms step.
+//   standstill_motion: at every standstill that follows a motion (a pause
+//     of at least one physics step), the robot settles: the true pose moves
+//     by N(0, sigma_xy^2) along each robot axis and N(0, sigma_theta^2) in
+//     heading, spread evenly over the first 100 ms of the standstill (or
+//     all of it when shorter) while the wheels, and so the encoders, stand.
+//   run_time_offset: per run tau_i ~ N(0, tau_sd^2), ground truth stamped t
+//     shows the true pose at t - tau - tau_i.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -80,7 +94,7 @@ struct Sample {
 /// geometry) and a 1 kHz clock.
 class Robot {
  public:
-  Robot(const Options& o, std::mt19937_64& g) : o_(o), g_(g) {
+  Robot(const Options& o, std::mt19937_64& g, std::mt19937_64& gx) : o_(o), g_(g), gx_(gx) {
     // Contract (formats.md): D_R / D_L = E_d, D_L + D_R = 2 D (eqs. 4.31-4.32).
     const double s = 1.0 + Effect(o, "scale_error", "s");
     dl_true_ = 2.0 / (o.E_d + 1.0) * o.diameter * s;
@@ -89,6 +103,14 @@ class Robot {
     std::uniform_real_distribution<double> u(0.0, 1.0);
     phase_L_ = u(g);
     phase_R_ = u(g);
+    // Second stream: only the effects that came after the first nine draw
+    // from it, and only when present.
+    if (const double sd = Effect(o, "run_time_offset", "tau_sd"); sd > 0.0)
+      tau_run_ = std::normal_distribution<double>(0.0, sd)(gx_);
+    if (const double rate = Effect(o, "bump_outliers", "rate"); rate > 0.0) {
+      std::exponential_distribution<double> gap(rate);
+      next_bump_ = {gap(gx_), gap(gx_)};
+    }
   }
 
   /// Drives one primitive: a leg of `distance` (signed) or a spot turn of
@@ -143,7 +165,27 @@ class Robot {
     }
   }
   void Pause(double seconds) {
-    for (int i = 0; i < static_cast<int>(std::lround(seconds / kDt)); ++i) Step(0.0, 0.0);
+    const int steps = static_cast<int>(std::lround(seconds / kDt));
+    // standstill_motion: a standstill after a motion; the settling is spread
+    // over its first 100 ms (robot frame at the stop: x along, y left).
+    std::array<double, 3> settle{0.0, 0.0, 0.0};
+    const double sxy = Effect(o_, "standstill_motion", "sigma_xy"), sth = Effect(o_, "standstill_motion", "sigma_theta");
+    const int settle_steps = std::min(steps, 100);
+    if (moved_ && steps > 0 && (sxy > 0.0 || sth > 0.0)) {
+      std::normal_distribution<double> n01(0.0, 1.0);
+      const double along = sxy * n01(gx_), across = sxy * n01(gx_), turn = sth * n01(gx_);
+      settle = {(along * std::cos(th_) - across * std::sin(th_)) / settle_steps,
+                (along * std::sin(th_) + across * std::cos(th_)) / settle_steps, turn / settle_steps};
+    }
+    if (steps > 0) moved_ = false;
+    for (int i = 0; i < steps; ++i) {
+      if (i < settle_steps) {
+        x_ += settle[0];
+        y_ += settle[1];
+        th_ += settle[2];
+      }
+      Step(0.0, 0.0);
+    }
   }
 
   /// The run's samples with their ground truth (after the run, so that a
@@ -180,6 +222,9 @@ class Robot {
     std::normal_distribution<double> n01(0.0, 1.0);
     sL += o_.k_L * std::sqrt(std::abs(sL)) * n01(g_);
     sR += o_.k_R * std::sqrt(std::abs(sR)) * n01(g_);
+    Bump(0, sL);
+    Bump(1, sR);
+    if (v != 0.0 || w != 0.0) moved_ = true;
     const double ds = 0.5 * (sL + sR), dth = (sR - sL) / b_true_;
     x_ += ds * std::cos(th_ + 0.5 * dth);
     y_ += ds * std::sin(th_ + 0.5 * dth);
@@ -207,12 +252,25 @@ class Robot {
     }
   }
 
+  /// bump_outliers on wheel `i` (0 left, 1 right) with true travel `s` in
+  /// this step: a bump when the wheel's |travel| passes the next bump's
+  /// distance (a Poisson process in travel, `rate` per metre).
+  void Bump(int i, double& s) {
+    const double rate = Effect(o_, "bump_outliers", "rate"), sigma = Effect(o_, "bump_outliers", "sigma");
+    if (!(rate > 0.0 && sigma > 0.0)) return;
+    next_bump_[i] -= std::abs(s);
+    std::exponential_distribution<double> gap(rate);
+    std::normal_distribution<double> bump(0.0, sigma);
+    for (; next_bump_[i] <= 0.0; next_bump_[i] += gap(gx_)) s += bump(gx_);
+  }
+
   /// The ground truth of the sample stamped s.t as the effects report it,
   /// plus the motion capture's noise.
   void GroundTruth(Sample& out) {
     // time_offset: the true pose at t - tau (the start pose before the run,
     // the end pose after it), to the 1 ms physics step.
-    const double tq = out.t - Effect(o_, "time_offset", "tau");
+    // run_time_offset adds this run's tau_i.
+    const double tq = out.t - Effect(o_, "time_offset", "tau") - tau_run_;
     std::size_t i = 0;
     if (tq > history_.front()[0])
       i = std::min(static_cast<std::size_t>(std::lround((tq - history_.front()[0]) / kDt)), history_.size() - 1);
@@ -227,6 +285,10 @@ class Robot {
 
   const Options& o_;
   std::mt19937_64& g_;
+  std::mt19937_64& gx_;  ///< second stream: bump_outliers, standstill_motion, run_time_offset
+  bool moved_ = false;   ///< a motion since the last standstill (standstill_motion)
+  double tau_run_ = 0.0;
+  std::array<double, 2> next_bump_{0.0, 0.0};
   double dl_true_, dr_true_, b_true_, phase_L_ = 0.0, phase_R_ = 0.0;
   double x_ = 0.0, y_ = 0.0, th_ = 0.0, phi_L_ = 0.0, phi_R_ = 0.0;
   double ox_ = 0.0, oy_ = 0.0, oth_ = 0.0, ticks_L_ = 0.0, ticks_R_ = 0.0;
@@ -295,13 +357,14 @@ void WriteRuns(const std::string& path, const std::vector<std::pair<std::string,
 int main(int argc, char** argv) {
   const Options o = Parse(argc, argv);
   std::mt19937_64 g(o.seed);
+  std::mt19937_64 gx(o.seed ^ 0x9E3779B97F4A7C15ULL);
   std::filesystem::create_directories(o.out);
   // Squares: 10 cw + 10 ccw alternating; each: pause, 4 x (leg, pause, turn, pause).
   std::vector<std::pair<std::string, std::vector<Sample>>> squares, fwd_back;
   const double inner_pause = o.pause_s, end_pause = std::max(o.pause_s, 1.0);
   for (int r = 0; r < 20; ++r) {
     const bool cw = r % 2 == 0;
-    Robot robot(o, g);
+    Robot robot(o, g, gx);
     robot.Pause(end_pause);
     for (int leg = 0; leg < 4; ++leg) {
       robot.Leg(o.side_m, leg == 0 || inner_pause > 0.0);
@@ -313,7 +376,7 @@ int main(int argc, char** argv) {
   }
   // Back and forth: pause, forward, pause, back, pause.
   for (int r = 0; r < 20; ++r) {
-    Robot robot(o, g);
+    Robot robot(o, g, gx);
     robot.Pause(end_pause);
     robot.Leg(o.distance_m, true);
     robot.Pause(inner_pause);
@@ -327,7 +390,7 @@ int main(int argc, char** argv) {
   const double stop_pause = std::max(o.pause_s, 0.5);
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   for (int r = 0; r < static_cast<int>(o.free_runs); ++r) {
-    Robot robot(o, g);
+    Robot robot(o, g, gx);
     robot.Pause(end_pause);
     for (int s = 0; s < 3; ++s) {
       std::vector<std::array<double, 2>> arcs(u01(g) < 0.5 ? 2 : 3);

@@ -26,10 +26,25 @@
 #            gt_offset: |d| = f sigma_xy; time_offset: tau = f sqrt(2)
 #            sigma_xy / v; direction_asymmetry: a = f sd_along(D) / D);
 #            outside effects (gt_yaw_misalignment 5-20 mrad, floor_slope
-#            0.2-1 %; target `unexplained`).
+#            0.2-1 %; target `unexplained`);
+#            pairs a real robot shows together, each effect at its own
+#            f = 3-5 (f for the first, f2 for the second; target: both in
+#            verdict.effects): pair_castor_bumps (castor_kick as above,
+#            bump_outliers rate 0.2-1 /m, sigma = f2 k sqrt(side), the wheel
+#            noise of one leg), pair_time_gt (time_offset and gt_offset as
+#            above), pair_scale_castor (scale_error, castor_kick with f2),
+#            pair_settle_clock (standstill_motion sigma_xy = f sqrt(2)
+#            sigma_xy_gt, sigma_theta = f sqrt(2) sigma_theta_gt, the ground
+#            truth's noise across a standstill; run_time_offset tau_sd =
+#            f2 sqrt(2) sigma_xy_gt / v). The pair classes are drawn after
+#            all others, so the other classes keep their campaigns.
 #
 # Usage: bench/independent_validation.sh [BUILD_DIR] [N] [SEED] [PROFILE]
-#   N campaigns per single/outside class, 2N clean and 2N negligible.
+#   N campaigns per single/outside/pair class, 2N clean and 2N negligible.
+#   With CASES_ONLY=1 in the environment the script only writes the case
+#   list (one generator command line per campaign) and prints its path;
+#   with ONLY=REGEX it runs only the classes matching REGEX (e.g. ONLY=pair_),
+#   on the same campaigns as a full run.
 #   PROFILE `castor_free`: N castor-kick campaigns only, all with free paths,
 #   acceleration limits, 10 or 20 Hz and 500 ticks/rev (the issue's case).
 #   With BEFORE=/path/to/umbmark in the environment every campaign is also
@@ -56,9 +71,9 @@ function S() { return rand() < 0.5 ? -1 : 1 }
 function LU(a, b) { return exp(U(log(a), log(b))) }
 BEGIN {
   srand(seed); pi = 3.141592653589793
-  split("none negligible scale_error castor_kick gt_offset time_offset direction_asymmetry gt_yaw_misalignment floor_slope", cls, " ")
+  nc = split("none negligible scale_error castor_kick gt_offset time_offset direction_asymmetry gt_yaw_misalignment floor_slope pair_castor_bumps pair_time_gt pair_scale_castor pair_settle_clock", cls, " ")
   id = 0
-  for (c = 1; c <= 9; ++c) {
+  for (c = 1; c <= nc; ++c) {
     count = (cls[c] == "none" || cls[c] == "negligible") ? 2 * n : n
     if (profile == "castor_free" && cls[c] != "castor_kick") count = 0
     for (i = 0; i < count; ++i) {
@@ -93,6 +108,21 @@ BEGIN {
       if (cls[c] == "direction_asymmetry") eff = sprintf("direction_asymmetry:a=%.6g", S() * f * sqrt(k2 * dist / 2) / dist)
       if (cls[c] == "gt_yaw_misalignment") eff = sprintf("gt_yaw_misalignment:delta=%.6g", S() * U(0.005, 0.02))
       if (cls[c] == "floor_slope") eff = sprintf("floor_slope:g=%.6g,dir=%.6g", U(0.002, 0.01), U(0, 2 * pi))
+      # Pairs: two --effect options, the second sized by its own f2.
+      if (cls[c] ~ /^pair_/) f2 = U(3, 5)
+      if (cls[c] == "pair_castor_bumps")
+        eff = sprintf("castor_kick:kappa=%.6g --effect bump_outliers:rate=%.6g,sigma=%.6g", \
+                      S() * f * sqrt(2 * k2 * (side < 1 ? side : 1)) / b, U(0.2, 1.0), f2 * sqrt(k2 * side))
+      if (cls[c] == "pair_time_gt") {
+        a = U(0, 2 * pi)
+        eff = sprintf("time_offset:tau=%.6g --effect gt_offset:dx=%.6g,dy=%.6g", S() * f * sqrt(2) * gxy / v, f2 * gxy * cos(a), f2 * gxy * sin(a))
+      }
+      if (cls[c] == "pair_scale_castor")
+        eff = sprintf("scale_error:s=%.6g --effect castor_kick:kappa=%.6g", S() * f * sqrt(k2 * side / 2) / side, \
+                      S() * f2 * sqrt(2 * k2 * (side < 1 ? side : 1)) / b)
+      if (cls[c] == "pair_settle_clock")
+        eff = sprintf("standstill_motion:sigma_xy=%.6g,sigma_theta=%.6g --effect run_time_offset:tau_sd=%.6g", \
+                      f * sqrt(2) * gxy, f * sqrt(2) * gth, f2 * sqrt(2) * gxy / v)
       design = sprintf("%dHz/%dticks/%s/%s/%s/%s", rate, ticks, pause ? "pauses" : "no-pauses", accel > 0 ? "accel" : "no-accel", hold > 0 ? "hold" : "no-hold", free ? "free" : "no-free")
       printf "%03d %s %s --seed %d --wheelbase %.6g --diameter %.6g --kl %.6g --kr %.6g --gt-sigma-xy %.6g --gt-sigma-theta %.6g --side %.6g --distance %.6g --speed %.6g --turn-rate %.6g --rate %d --ticks %d --pause %d --accel %.6g --heading-hold %.6g --free %d --E-d %.8g --E-b %.8g%s\n", \
         id, cls[c], design, seed * 1000 + id, b, d, kl, kr, gxy, gth, side, dist, v, w, rate, ticks, pause, accel, hold, free, ed, eb, eff == "" ? "" : " --effect " eff
@@ -100,8 +130,37 @@ BEGIN {
     }
   }
 }' > "$OUT/cases.txt"
+if [[ -n "${CASES_ONLY:-}" ]]; then echo "$OUT/cases.txt"; exit 0; fi
+if [[ -n "${ONLY:-}" ]]; then
+  awk -v only="$ONLY" '$2 ~ only' "$OUT/cases.txt" > "$OUT/cases_only.txt"
+  mv "$OUT/cases_only.txt" "$OUT/cases.txt"
+fi
 
 verdict_of() { tr -d '\n ' < "$1" | sed -n 's/.*"verdict":{"effect":"\([a-z_]*\)".*/\1/p'; }
+# verdict.effects as words (JSON keys are sorted: effects follows effect).
+named_of() {
+  tr -d '\n ' < "$1" | sed -n 's/.*"verdict":{"effect":"[a-z_]*","effects":\[\([^]]*\)\].*/\1/p' | tr -d '"' | tr ',' ' '
+}
+# The two contract effects a pair class must name (exact names: a fixed
+# time_offset is not run_time_offset and the other way round).
+pair_effects() {
+  case $1 in
+    pair_castor_bumps) echo castor_kick bump_outliers ;;
+    pair_time_gt) echo time_offset gt_offset ;;
+    pair_scale_castor) echo scale_error castor_kick ;;
+    pair_settle_clock) echo standstill_motion run_time_offset ;;
+  esac
+}
+# 1 when the diagnosis JSON $1 names both effects of pair class $2.
+pair_named() {
+  local named w
+  named=$(named_of "$1")
+  for w in $(pair_effects "$2"); do [[ " $named " == *" $w "* ]] || { echo 0; return; }; done
+  echo 1
+}
+# Both named (right), both named with a named verdict (not `unexplained`),
+# and a third effect named beside them, per pair class.
+declare -A pclean pextra
 declare -A total right dtotal dright bright bdright
 start=$(date +%s.%N)
 while read -r id cls design args; do
@@ -114,18 +173,27 @@ while read -r id cls design args; do
   [[ $cls == negligible ]] && expected=none
   [[ $cls == gt_yaw_misalignment || $cls == floor_slope ]] && expected=unexplained
   ok=0; [[ "$verdict" == "$expected" ]] && ok=1
+  named=""
+  if [[ $cls == pair_* ]]; then
+    named=$(named_of "$dir/diagnosis.json")
+    ok=$(pair_named "$dir/diagnosis.json" "$cls")
+    [[ $ok == 1 && $verdict != unexplained ]] && pclean[$cls]=$(( ${pclean[$cls]:-0} + 1 ))
+    (( $(wc -w <<< "$named") > 2 )) && pextra[$cls]=$(( ${pextra[$cls]:-0} + 1 ))
+    expected="both of: $(pair_effects "$cls")"
+  fi
   bok=0; bverdict=""
   if [[ -n "$BEFORE" ]]; then
     "$BEFORE" diagnose "$dir/campaign/campaign.toml" --json "$dir/diagnosis_before.json" > "$dir/report_before.txt"
     bverdict=$(verdict_of "$dir/diagnosis_before.json")
     [[ "$bverdict" == "$expected" ]] && bok=1
+    [[ $cls == pair_* ]] && bok=$(pair_named "$dir/diagnosis_before.json" "$cls")
   fi
   total[$cls]=$(( ${total[$cls]:-0} + 1 )); right[$cls]=$(( ${right[$cls]:-0} + ok )); bright[$cls]=$(( ${bright[$cls]:-0} + bok ))
   for part in ${design//\// }; do
     dtotal[$part]=$(( ${dtotal[$part]:-0} + 1 )); dright[$part]=$(( ${dright[$part]:-0} + ok )); bdright[$part]=$(( ${bdright[$part]:-0} + bok ))
   done
-  printf '%s %-20s %-48s -> %-20s %s%s\n' "$id" "$cls" "$design" "$verdict" "$([[ $ok == 1 ]] && echo ok || echo WRONG)" \
-    "${BEFORE:+ (before: $bverdict)}"
+  printf '%s %-20s %-48s -> %-20s %s%s%s\n' "$id" "$cls" "$design" "$verdict" "$([[ $ok == 1 ]] && echo ok || echo WRONG)" \
+    "${named:+ (named: $named)}" "${BEFORE:+ (before: $bverdict)}"
 done < "$OUT/cases.txt"
 end=$(date +%s.%N)
 
@@ -134,6 +202,15 @@ echo "per class (right = verdict none / the effect / unexplained for outside eff
 for c in none negligible scale_error castor_kick gt_offset time_offset direction_asymmetry gt_yaw_misalignment floor_slope; do
   [[ -n "${total[$c]:-}" ]] && printf '  %-20s %d/%d%s\n' "$c" "${right[$c]}" "${total[$c]}" "${BEFORE:+   before ${bright[$c]}/${total[$c]}}"
 done
+pairs=0; pairs_right=0
+for c in pair_castor_bumps pair_time_gt pair_scale_castor pair_settle_clock; do
+  [[ -n "${total[$c]:-}" ]] || continue
+  [[ $pairs == 0 ]] && echo "pairs (right = both effects in verdict.effects; of these with a named verdict, not unexplained; campaigns naming a third effect):"
+  printf '  %-20s %-36s %d/%d   named verdict %d   third effect %d%s\n' "$c" "$(pair_effects "$c")" "${right[$c]}" "${total[$c]}" \
+    "${pclean[$c]:-0}" "${pextra[$c]:-0}" "${BEFORE:+   before ${bright[$c]}/${total[$c]}}"
+  pairs=$((pairs + total[$c])); pairs_right=$((pairs_right + right[$c]))
+done
+(( pairs > 0 )) && echo "  all pairs            $pairs_right/$pairs (target 85 %)"
 echo "per design factor (all classes):"
 for p in $(printf '%s\n' "${!dtotal[@]}" | sort); do
   printf '  %-12s %d/%d%s\n' "$p" "${dright[$p]}" "${dtotal[$p]}" "${BEFORE:+   before ${bdright[$p]}/${dtotal[$p]}}"
