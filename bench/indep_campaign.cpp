@@ -29,7 +29,7 @@
 //   [--rate HZ] [--ticks N] [--pause S] [--accel A] [--heading-hold K] [--free N]
 //   [--side M] [--distance M] [--speed V] [--turn-rate W] [--kl K] [--kr K]
 //   [--E-d X] [--E-b X] [--gt-sigma-xy M] [--gt-sigma-theta R]
-//   [--wheelbase M] [--diameter M]
+//   [--wheelbase M] [--diameter M] [--settle S]
 // Effects (contract names, same parameters; --effect may be repeated to
 // combine them): scale_error:s, direction_asymmetry:a, castor_kick:kappa,
 // gt_offset:dx,dy, time_offset:tau, bump_outliers:rate,sigma,
@@ -44,8 +44,9 @@
 //   standstill_motion: at every standstill that follows a motion (a pause
 //     of at least one physics step), the robot settles: the true pose moves
 //     by N(0, sigma_xy^2) along each robot axis and N(0, sigma_theta^2) in
-//     heading, spread evenly over the first 100 ms of the standstill (or
-//     all of it when shorter) while the wheels, and so the encoders, stand.
+//     heading, spread evenly over the first `--settle` seconds of the
+//     standstill (default 0.1 s; all of it when shorter; 0.001 = one
+//     physics step, at once as the robot stops) while the wheels, and so the encoders, stand.
 //   run_time_offset: per run tau_i ~ N(0, tau_sd^2), ground truth stamped t
 //     shows the true pose at t - tau - tau_i.
 #include <algorithm>
@@ -73,6 +74,7 @@ struct Options {
   std::uint64_t seed = 1;
   std::map<std::string, std::map<std::string, double>> effects;
   double rate_hz = 20.0, ticks = 4096.0, pause_s = 1.0, accel = 0.0, heading_hold = 0.0, free_runs = 0.0;
+  double settle_s = 0.1;  ///< standstill_motion: how long the robot settles [s]
   double side_m = 3.0, distance_m = 3.0, speed = 0.3, turn_rate = 1.0;
   double k_L = 1e-3, k_R = 1e-3, E_d = 1.0, E_b = 1.0, gt_xy = 3e-4, gt_th = 1e-3;
   double wheelbase = 0.4, diameter = 0.1;
@@ -167,10 +169,10 @@ class Robot {
   void Pause(double seconds) {
     const int steps = static_cast<int>(std::lround(seconds / kDt));
     // standstill_motion: a standstill after a motion; the settling is spread
-    // over its first 100 ms (robot frame at the stop: x along, y left).
+    // over its first o_.settle_s (robot frame at the stop: x along, y left).
     std::array<double, 3> settle{0.0, 0.0, 0.0};
     const double sxy = Effect(o_, "standstill_motion", "sigma_xy"), sth = Effect(o_, "standstill_motion", "sigma_theta");
-    const int settle_steps = std::min(steps, 100);
+    const int settle_steps = std::clamp(static_cast<int>(std::lround(o_.settle_s / kDt)), 1, std::max(steps, 1));
     if (moved_ && steps > 0 && (sxy > 0.0 || sth > 0.0)) {
       std::normal_distribution<double> n01(0.0, 1.0);
       const double along = sxy * n01(gx_), across = sxy * n01(gx_), turn = sth * n01(gx_);
@@ -305,7 +307,8 @@ Options Parse(int argc, char** argv) {
       {"--distance", &o.distance_m}, {"--speed", &o.speed},    {"--turn-rate", &o.turn_rate},
       {"--kl", &o.k_L},           {"--kr", &o.k_R},            {"--E-d", &o.E_d},
       {"--E-b", &o.E_b},          {"--gt-sigma-xy", &o.gt_xy}, {"--gt-sigma-theta", &o.gt_th},
-      {"--wheelbase", &o.wheelbase}, {"--diameter", &o.diameter}, {"--free", &o.free_runs}};
+      {"--wheelbase", &o.wheelbase}, {"--diameter", &o.diameter}, {"--free", &o.free_runs},
+      {"--settle", &o.settle_s}};
   for (int i = 1; i < argc; ++i) {
     const std::string k = argv[i];
     if (i + 1 >= argc) {

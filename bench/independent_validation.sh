@@ -44,7 +44,9 @@
 #   With CASES_ONLY=1 in the environment the script only writes the case
 #   list (one generator command line per campaign) and prints its path;
 #   with ONLY=REGEX it runs only the classes matching REGEX (e.g. ONLY=pair_),
-#   on the same campaigns as a full run.
+#   on the same campaigns as a full run; SETTLE=S passes --settle S to the
+#   generator (how long standstill_motion's settling lasts, default 0.1 s;
+#   0.001 = at once as the robot stops, as `umbmark simulate` reads it).
 #   PROFILE `castor_free`: N castor-kick campaigns only, all with free paths,
 #   acceleration limits, 10 or 20 Hz and 500 ticks/rev (the issue's case).
 #   With BEFORE=/path/to/umbmark in the environment every campaign is also
@@ -62,7 +64,7 @@ for exe in "$UMBMARK" "$GEN" ${BEFORE:+"$BEFORE"}; do
   [[ -x "$exe" ]] || { echo "missing $exe (build the umbmark and indep_campaign targets)" >&2; exit 2; }
 done
 OUT=$(mktemp -d "${TMPDIR:-/tmp}/umbmark-indep.XXXXXX")
-echo "seed $SEED, $N per class, profile $PROFILE; campaigns in $OUT"
+echo "seed $SEED, $N per class, profile $PROFILE${SETTLE:+, settle $SETTLE s}; campaigns in $OUT"
 
 # One line per campaign: case class design generator-arguments.
 awk -v n="$N" -v seed="$SEED" -v profile="$PROFILE" '
@@ -166,7 +168,7 @@ start=$(date +%s.%N)
 while read -r id cls design args; do
   dir="$OUT/${id}_$cls"
   # shellcheck disable=SC2086
-  "$GEN" --out "$dir/campaign" $args
+  "$GEN" --out "$dir/campaign" $args ${SETTLE:+--settle "$SETTLE"}
   "$UMBMARK" diagnose "$dir/campaign/campaign.toml" --json "$dir/diagnosis.json" > "$dir/report.txt"
   verdict=$(verdict_of "$dir/diagnosis.json")
   expected=$cls
