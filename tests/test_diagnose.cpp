@@ -529,6 +529,36 @@ TEST_CASE("diagnose: standstill_motion is found, sigmas recovered", "[diagnose][
   CHECK_THAT(c->params.at("sigma_theta"), WithinRel(0.004, 0.25));
 }
 
+TEST_CASE("diagnose: standstill_motion is sized on the pieces it acts on (not every piece of their type)",
+          "[diagnose][negligible][new-effects]") {
+  // Figure-eights only: each circle is one motion from standstill to
+  // standstill, cut into several arc pieces of which only the last ends at
+  // the standstill. The effect widens that piece's position and heading sd
+  // by sqrt(2) sigma_xy and sigma_theta exactly (S_xy = diag(1, 1, 0),
+  // S_theta = e3 e3^T), so that is its size; the median over every arc
+  // piece would be 0 (pieces it does not act on once counted through a
+  // rounding residue of 1e-22 m^2, and the effect came out negligible).
+  Small s = MakeSmall(75);
+  s.manifest.experiments.clear();
+  testing::AddFreeExperiment(s.manifest, "free.csv");
+  s.sim.free_runs = 20;
+  s.sim.effects.stand_sigma_xy = 0.004;
+  s.sim.effects.stand_sigma_theta = 0.006;
+  const DiagnoseSummary d = Diagnose(Build(s), Fast());
+  INFO(d.verdict_reason);
+  const auto step = std::find_if(d.explanation.begin(), d.explanation.end(),
+                                 [](const ExplanationStep& e) { return e.effect == sim::EffectKind::kStandstillMotion; });
+  REQUIRE(step != d.explanation.end());
+  CHECK_FALSE(step->negligible);
+  CHECK(step->size_pieces == "arc");
+  CHECK(step->relative_size > 0.25);
+  CHECK_THAT(step->size_mm, WithinRel(1e3 * std::sqrt(2.0) * step->params.at("sigma_xy"), 1e-6));
+  CHECK_THAT(step->size_mrad, WithinRel(1e3 * step->params.at("sigma_theta"), 1e-6));
+  // 40 standstills: sigma_theta within 35 % (3 sigma of the sd of 40 draws).
+  CHECK_THAT(step->params.at("sigma_theta"), WithinRel(0.006, 0.35));
+  CHECK(std::find(d.verdict_effects.begin(), d.verdict_effects.end(), "standstill_motion") != d.verdict_effects.end());
+}
+
 TEST_CASE("diagnose: motion_noise_floor is found, sigma recovered", "[diagnose][new-effects]") {
   Small s = MakeSmall(72);
   s.sim.effects.floor_sigma = 0.006;

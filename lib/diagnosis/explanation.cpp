@@ -231,7 +231,12 @@ void Size(const CampaignData& c, const MeanModel& model, const BaselineFit& base
     std::map<PieceType, Spread> by_type;
     for (std::size_t j = 0; j < bases.size(); ++j) {
       const Eigen::Matrix3d A = PieceCovariance(bases[j], f.noise), B0 = PieceCovariance(bases[j], without);
-      const double dp = A(0, 0) + A(1, 1) - B0(0, 0) - B0(1, 1), dh = A(2, 2) - B0(2, 2);
+      // Sums first: A == B0 on a piece the effect does not act on must give
+      // exactly 0 (A00 + A11 - B00 - B11 leaves a rounding residue of
+      // ~1e-22 m^2, which counted every such piece as acted on, with a
+      // growth of 0, and made a standstill_motion acting on the last piece
+      // of each run only "negligible").
+      const double dp = (A(0, 0) + A(1, 1)) - (B0(0, 0) + B0(1, 1)), dh = A(2, 2) - B0(2, 2);
       if (!(dp > 0.0 || dh > 0.0)) continue;
       const double rp = std::sqrt((A(0, 0) + A(1, 1)) / std::max(B0(0, 0) + B0(1, 1), 1e-300)) - 1.0;
       const double rh = std::sqrt(A(2, 2) / std::max(B0(2, 2), 1e-300)) - 1.0;
