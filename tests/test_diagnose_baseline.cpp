@@ -192,7 +192,7 @@ TEST_CASE("diagnose --baseline: wheel noise given x2 and x0.5 is named, the rati
     CHECK(d.corrections[1].parameter == "k_R");
     CHECK_THAT(d.corrections[0].corrected, WithinRel(kTrueKL, 0.25));
     CHECK_THAT(d.corrections[1].corrected, WithinRel(kTrueKR, 0.25));
-    CHECK(d.corrections[0].text.find("(left) and x") != std::string::npos);
+    CHECK(d.corrections[0].text.find("(left) and off by x") != std::string::npos);
     // The evidence is the likelihood, not the mean gap it does not change.
     const std::string text = DiagnoseReport(d);
     CHECK(text.find("evidence for wheel_noise_error: very strong evidence: runs not used to fit it are") !=
@@ -318,4 +318,20 @@ TEST_CASE("umbmark diagnose --baseline: JSON keys, corrections, bad input", "[di
   sim::Effects effects;
   CHECK_THROWS_WITH(sim::ParseEffectSpec("wheelbase_error:s=0.01", effects),
                     Catch::Contains("parameter error"));
+}
+
+TEST_CASE("diagnose --baseline: a wheel simulated without noise gets a correction without a ratio", "[diagnose][baseline]") {
+  // k_L = 0 in the simulation: no ratio k_fit / k_given exists, so the text
+  // says the simulation has none while the runs show some.
+  const sim::SimulatedCampaign sc = Simulate(305);
+  const CampaignData c = BuildCampaign(sc.manifest, sc.data);
+  const DiagnoseSummary d = Diagnose(c, Fast(Given(TrueCal(), 0.0, kTrueKR)));
+  INFO(Describe(d));
+  CHECK(d.verdict == "wheel_noise_error");
+  REQUIRE(d.corrections.size() == 1);
+  CHECK(d.corrections[0].parameter == "k_L");
+  CHECK(d.corrections[0].given == 0.0);
+  CHECK_THAT(d.corrections[0].corrected, WithinRel(kTrueKL, 0.25));
+  CHECK(d.corrections[0].text.find("left wheel noise is 0, but the runs show noise") != std::string::npos);
+  CHECK(d.corrections[0].text.find("x0.00") == std::string::npos);
 }

@@ -187,20 +187,25 @@ std::vector<ParameterCorrection> Corrections(sim::EffectKind kind, const std::ma
     };
     const Wheel wheels[2] = {{"left", "k_L", given.k_L, Get(d, "k_L", 0.0), Get(d, "ratio_L", 0.0)},
                              {"right", "k_R", given.k_R, Get(d, "k_R", 0.0), Get(d, "ratio_R", 0.0)}};
-    auto off = [&](const Wheel& w) { return !(std::abs(w.ratio - 1.0) < negligible); };
+    // A given k of 0 has no ratio (DescribeGivenParams gives 0): any fitted
+    // noise is off.
+    auto off = [&](const Wheel& w) { return w.given <= 0.0 || !(std::abs(w.ratio - 1.0) < negligible); };
+    auto factor = [](const Wheel& w) {
+      return w.given > 0.0 ? fmt::format("off by x{:.2f}", w.ratio) : std::string("0, but the runs show noise");
+    };
     std::string text;
     if (off(wheels[0]) && off(wheels[1])) {
       text = fmt::format(
-          "the simulation's wheel noise is off by x{:.2f} (left) and x{:.2f} (right): set k_L = {:.3g}, k_R = {:.3g} "
-          "m^1/2 (were {:.3g}, {:.3g})",
-          wheels[0].ratio, wheels[1].ratio, wheels[0].fit, wheels[1].fit, given.k_L, given.k_R);
+          "the simulation's wheel noise is {} (left) and {} (right): set k_L = {:.3g}, k_R = {:.3g} m^1/2 (were "
+          "{:.3g}, {:.3g})",
+          factor(wheels[0]), factor(wheels[1]), wheels[0].fit, wheels[1].fit, given.k_L, given.k_R);
     } else {
       const Wheel& w = off(wheels[0]) ? wheels[0] : wheels[1];
       const Wheel& ok = off(wheels[0]) ? wheels[1] : wheels[0];
       text = fmt::format(
-          "the simulation's {} wheel noise is off by x{:.2f}: set {} = {:.3g} m^1/2 (was {:.3g}); {} = {:.3g} m^1/2 is "
+          "the simulation's {} wheel noise is {}: set {} = {:.3g} m^1/2 (was {:.3g}); {} = {:.3g} m^1/2 is "
           "consistent with the runs (fitted x{:.2f}, within the negligible {:.0f} %): keep it",
-          w.side, w.ratio, w.key, w.fit, w.given, ok.key, ok.given, ok.ratio, 100.0 * negligible);
+          w.side, factor(w), w.key, w.fit, w.given, ok.key, ok.given, ok.ratio, 100.0 * negligible);
     }
     for (const Wheel& w : wheels)
       if (off(w)) out.push_back({name, w.key, w.given, w.fit, "m^1/2", text});
