@@ -307,7 +307,7 @@ std::string DetermineKExperiment(const FitResult& f, const std::string& name) {
 /// the profile likelihood never falls far enough (the reference noise
 /// swamps the wheel noise).
 std::string KBound(const std::string& name, double upper) {
-  return std::isfinite(upper) ? fmt::format("only bounded: {} < {:.3g} m^1/2 (95 %)", name, upper)
+  return std::isfinite(upper) ? fmt::format("only bounded: {} < {:.3g} m^1/2 at 95 %", name, upper)
                               : std::string("not even bounded from above: the likelihood stays flat");
 }
 

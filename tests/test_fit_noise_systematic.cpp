@@ -235,7 +235,7 @@ TEST_CASE("fit-noise CLI: k at the boundary is 'not determined'; --params and --
     // Back-and-forth runs move both wheels alike: the warning names the bound
     // and the runs that would separate k_L from k_R.
     const double upper = j["k_L_upper95"].get<double>();
-    const std::string bound = fmt::format("only bounded: k_L < {:.3g} m^1/2 (95 %)", upper);
+    const std::string bound = fmt::format("only bounded: k_L < {:.3g} m^1/2 at 95 %", upper);
     REQUIRE(j["warnings"].size() == 1);
     const std::string warning = j["warnings"][0].get<std::string>();
     CHECK(warning.find("k_L is not determined by these runs") != std::string::npos);
@@ -251,7 +251,7 @@ TEST_CASE("fit-noise CLI: k at the boundary is 'not determined'; --params and --
     std::ifstream in(html);
     const std::string page((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     // The headline gives k_R's interval and, for k_L, the bound only (never "0 to ...").
-    CHECK(page.find(fmt::format("k_L not determined (only bounded: k_L &lt; {:.3g} m^1/2 (95 %))", upper)) != std::string::npos);
+    CHECK(page.find(fmt::format("k_L not determined (only bounded: k_L &lt; {:.3g} m^1/2 at 95 %)", upper)) != std::string::npos);
     CHECK(page.find(fmt::format("k_R = {:.3g} m^1/2 (95%: {:.3g} to {:.3g})", j["k_R"].get<double>(),
                                 j["k_R_ci95"][0].get<double>(), j["k_R_ci95"][1].get<double>())) != std::string::npos);
     const auto head = page.find("<section class=\"headline");
