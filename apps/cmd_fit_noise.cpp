@@ -303,7 +303,7 @@ std::string DetermineKExperiment(const FitResult& f, const std::string& name) {
                  "grows with distance, the reference noise does not) or a more precise reference would determine it";
 }
 
-/// What bounds an undetermined k: "k_L < x m^1/2 (95 %)", or nothing when
+/// What bounds an undetermined k: "k_L < x m^1/2 at 95 %", or nothing when
 /// the profile likelihood never falls far enough (the reference noise
 /// swamps the wheel noise).
 std::string KBound(const std::string& name, double upper) {
