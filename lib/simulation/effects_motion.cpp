@@ -76,8 +76,9 @@ std::size_t TickSpacing(const std::vector<double>& cum_left, const std::vector<d
 /// apart, and reading those gaps as standstills put turning into the
 /// standstills. The time of one tick there is read from the counts next to
 /// the gap: the spacing (in sample intervals) of a wheel's last two counts
-/// before it in the motion, or its first two after it, the longer of the
-/// two, since a motion slows into a gap or speeds up out of it. The motion
+/// before it in the motion, or its first two after it (with no longer still
+/// stretch between them), the longer of the two, since a motion slows into
+/// a gap or speeds up out of it. The motion
 /// moves through when no wheel reverses at the gap's end and the gap lasts
 /// no more intervals than that spacing. A pause as a campaign commands it
 /// (a second, or half of one) lasts many ticks' time even at creep speed:
@@ -91,8 +92,16 @@ bool MovesThroughGap(const std::vector<double>& cum_left, const std::vector<doub
   const std::size_t gap = k - (last + 1);
   const double eps = options.stand_eps_m;
   const std::size_t before = TickSpacing(cum_left, cum_right, eps, last, first, [](std::size_t) { return false; });
-  // After the gap up to a reversal (the start of another motion).
-  const std::size_t after = TickSpacing(cum_left, cum_right, eps, k, intervals - 1, reverses);
+  // After the gap up to a reversal (the start of another motion) or a still
+  // stretch longer than the gap (a lone count between two pauses, e.g. a
+  // wheel settling by a tick, tells no speed).
+  std::size_t still = 0;
+  const std::size_t after = TickSpacing(cum_left, cum_right, eps, k, intervals - 1, [&](std::size_t i) {
+    if (reverses(i)) return true;
+    const bool moves = TravelSign(cum_left, i, eps) != 0 || TravelSign(cum_right, i, eps) != 0;
+    still = moves ? 0 : still + 1;
+    return still > gap;
+  });
   return gap <= std::max(before, after);
 }
 
