@@ -46,7 +46,8 @@
 //     by N(0, sigma_xy^2) along each robot axis and N(0, sigma_theta^2) in
 //     heading, spread evenly over the first `--settle` seconds of the
 //     standstill (default 0.1 s; all of it when shorter; 0.001 = one
-//     physics step, at once as the robot stops) while the wheels, and so the encoders, stand.
+//     physics step, at once as the robot stops) while the wheels, and so
+//     the encoders, stand.
 //   run_time_offset: per run tau_i ~ N(0, tau_sd^2), ground truth stamped t
 //     shows the true pose at t - tau - tau_i.
 #include <algorithm>
