@@ -13,11 +13,11 @@
 // still stretches shorter than that inside it belong to it (a slow wheel
 // may skip an encoder tick). A longer still stretch ends the motion unless
 // the wheels move on through it: no wheel reverses after it and it lasts no
-// more intervals than one tick takes at the motion's speed there (the
-// faster wheel's count spacing next to the gap; coarse encoders at high
-// sample rates count a slow start or stop in bursts). So a leg followed by a spot turn without
-// a pause, or a reversal, are two motions "back to back" (the next starts at
-// the interval after the previous one's last). A motion is
+// more intervals than one tick takes at the motion's speed there (a
+// wheel's count spacing next to the gap; coarse encoders at high sample
+// rates count a slow start or stop in bursts). So a leg followed by a spot
+// turn without a pause, or a reversal, are two motions "back to back" (the
+// next starts at the interval after the previous one's last). A motion is
 //   straight  when its nominal heading change |R - L| / b <= straight_max_rad,
 //   turn      when |L + R| / 2 <= turn_max_ratio * |R - L| / 2 (the axle centre
 //             barely moves compared with the wheels),
