@@ -7,6 +7,7 @@
 // contract's JSON.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -362,6 +363,39 @@ TEST_CASE("diagnose: turn_scrub needs arcs: found with figure-eights", "[diagnos
   CHECK_THAT(c->params.at("k"), WithinAbs(0.05, 5.0 * c->param_se.at("k")));
   // With scrub in the model, E_b returns to the true wheelbase error.
   CHECK_THAT(c->E_b, WithinAbs(1.012, 3e-3));
+}
+
+TEST_CASE("diagnose: a turn scrub fitted 2 SE below 0 is a symptom in the explanation too, never named",
+          "[diagnose]") {
+  // Scrubbing only loses rotation (k >= 0). A slightly negative k (here
+  // -0.006, above advice.hpp's fixed floor of -0.01) is flagged by its
+  // standard error; the explanation's joint fits take the single-effect
+  // fit's SE. Before that they had none, and the June campaign named such
+  // a scrub (k = -0.0062) while its candidate was flagged impossible.
+  Small s = MakeSmall(51, 5, 10, true);
+  s.manifest.ground_truth = GroundTruthNoise{1e-4, 5e-4};
+  s.sim.effects.scrub_k = -0.006;
+  const DiagnoseSummary d = Diagnose(Build(s), Fast());
+  const Candidate* c = Find(d, sim::EffectKind::kTurnScrub);
+  REQUIRE(c);
+  INFO(d.verdict_reason);
+  INFO("k = " << c->params.at("k") << " +- " << c->param_se.at("k"));
+  CHECK_THAT(c->params.at("k"), WithinAbs(-0.006, 4.0 * c->param_se.at("k")));
+  REQUIRE(c->params.at("k") + 2.0 * c->param_se.at("k") < 0.0);
+  REQUIRE(c->params.at("k") > -0.01);
+  bool stepped = false;
+  for (const ExplanationStep& st : d.explanation)
+    if (st.effect == sim::EffectKind::kTurnScrub) {
+      stepped = true;
+      CHECK(st.unphysical.find("negative turn scrub") != std::string::npos);
+    }
+  CHECK(stepped);
+  CHECK(std::find(d.verdict_effects.begin(), d.verdict_effects.end(), "turn_scrub") == d.verdict_effects.end());
+  CHECK(d.verdict != "turn_scrub");
+  const nlohmann::json j = DiagnoseToJson(d);
+  bool flagged = false;
+  for (const auto& st : j.at("explanation")) flagged = flagged || st.contains("unphysical");
+  CHECK(flagged);
 }
 
 TEST_CASE("diagnose: turn_scrub without arcs: told from E_b by the spot turns' forward motion", "[diagnose]") {

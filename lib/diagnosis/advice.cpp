@@ -165,8 +165,9 @@ std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSu
                                                                                      : s.verdict_effects, " and ")));
     std::vector<std::string> specs;
     for (const auto& step : s.explanation) {
-      // Parameter errors are not simulated effects: their fix is above.
-      if (step.negligible || sim::IsParameterError(step.effect)) continue;
+      // Parameter errors are not simulated effects (their fix is above);
+      // an impossible fit is a symptom, not something to simulate.
+      if (step.negligible || !step.unphysical.empty() || sim::IsParameterError(step.effect)) continue;
       std::vector<std::string> kv;
       for (const auto& [k, v] : step.params) kv.push_back(fmt::format("{}={:.4g}", k, v));
       specs.push_back(fmt::format("--effect {}:{}", sim::EffectToString(step.effect), fmt::join(kv, ",")));

@@ -162,11 +162,11 @@ StopChoice ChooseStopModel(const CampaignData& recorded, const BaselineStart& st
 /// A single-effect verdict whose effect is negligible becomes `none`; an
 /// `unexplained` gap that the explanation closes (no significant gap left,
 /// held-out shrink >= min_heldout_shrink) is named by its effects.
-void NameEffects(const Explanation& ex, const DiagnoseOptions& options, int runs, DiagnoseSummary& out) {
+void NameEffects(const Explanation& ex, const DiagnoseOptions& options, DiagnoseSummary& out) {
   std::vector<std::string> named, negligible, impossible;
   for (const ExplanationStep& s : ex.steps) {
     const std::string name = sim::EffectToString(s.effect);
-    if (!UnphysicalFit(name, s.params, runs, {}).empty())
+    if (!s.unphysical.empty())
       impossible.push_back(name);
     else
       (s.negligible ? negligible : named).push_back(name);
@@ -237,11 +237,22 @@ void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit
     eo.progress = StageProgress(options.progress, 700.0, 1000.0, 1000.0);
     std::vector<sim::EffectKind> first;
     if (const auto k = sim::EffectFromString(out.verdict)) first.push_back(*k);
-    const Explanation ex = Explain(c, model, base, folds, out.candidates, fits.mean_fits, first, out.gap_score,
-                                   out.null_median, out.null_quantile_alpha, eo);
+    Explanation ex = Explain(c, model, base, folds, out.candidates, fits.mean_fits, first, out.gap_score,
+                             out.null_median, out.null_quantile_alpha, eo);
+    // A step's joint fit has no standard errors of its own; the effect's
+    // single-effect fit on the same runs gives them (a joint fit's are no
+    // smaller). Without them a turn scrub of k = -0.006 that its single fit
+    // puts 2 SE below 0 was named on the June campaign while the same
+    // effect was flagged impossible among the candidates.
+    for (ExplanationStep& st : ex.steps) {
+      std::map<std::string, double> se;
+      for (const Candidate& cd : out.candidates)
+        if (cd.effect == st.effect) se = cd.param_se;
+      st.unphysical = UnphysicalFit(sim::EffectToString(st.effect), st.params, static_cast<int>(c.runs.size()), se);
+    }
     out.explanation = ex.steps;
     out.explanation_stop = ex.stop_reason;
-    NameEffects(ex, options, static_cast<int>(c.runs.size()), out);
+    NameEffects(ex, options, out);
     timer.Lap("stepwise explanation");
   }
   const bool scrub_named = std::find(out.verdict_effects.begin(), out.verdict_effects.end(), "turn_scrub") !=

@@ -71,6 +71,10 @@ struct ExplanationStep {
   /// relative_size are measured; empty for the others.
   std::string size_pieces;
   bool negligible = false;
+  /// Why this fit is physically impossible (advice.hpp UnphysicalFit, with
+  /// the single-effect candidate's standard errors), empty when it is not;
+  /// filled by Diagnose. Such a step is a symptom and never named.
+  std::string unphysical;
 };
 
 struct Explanation {

@@ -61,8 +61,7 @@ nlohmann::json ExplanationJson(const DiagnoseSummary& s) {
                      {"negligible", e.negligible}});
     if (!e.size_pieces.empty()) steps.back()["size_pieces"] = e.size_pieces;
     // An impossible fit is a symptom, never named (diagnose.cpp NameEffects).
-    if (auto why = UnphysicalFit(sim::EffectToString(e.effect), e.params, s.baseline.runs, {}); !why.empty())
-      steps.back()["unphysical"] = std::move(why);
+    if (!e.unphysical.empty()) steps.back()["unphysical"] = e.unphysical;
   }
   return steps;
 }
@@ -251,8 +250,7 @@ void ExplanationSection(TextReport& o, const DiagnoseSummary& s) {
       o.line(fmt::format("    {:>4} {:<22} {:>17.0f}% {:>8.0f}%   {:>7.2f} / {:>6.2f}, {}{}  {}", ++k,
                          sim::EffectToString(e.effect), 100.0 * e.cumulative_shrink, 100.0 * e.cumulative_heldout_shrink,
                          e.size_mm, e.size_mrad, rel,
-                         !UnphysicalFit(sim::EffectToString(e.effect), e.params, s.baseline.runs, {}).empty()
-                             ? " (impossible value: a symptom)"
+                         !e.unphysical.empty() ? " (impossible value: a symptom)"
                          : e.negligible ? " (negligible)"
                                         : "",
                          params));
