@@ -11,6 +11,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "diagnosis/diagnose.hpp"
@@ -94,6 +95,22 @@ TEST_CASE("diagnose pairs: castor kick + bumps, both named and recovered", "[dia
   // About 0.63 x 2 wheels x 600 m = 750 bumps: rate within 30 %, sigma within 25 %.
   CHECK_THAT(bumps->params.at("rate"), WithinRel(0.63, 0.30));
   CHECK_THAT(bumps->params.at("sigma"), WithinRel(0.0063, 0.25));
+  // Its size beside the relative growth of the wheel noise: how much it
+  // widens one piece's scatter (printed as 0.00 / 0.00 before). Bumps add
+  // beta = rate sigma^2 per metre of each wheel's travel, as k^2 does
+  // (eq. 4), so on a straight piece of length L (the longest: 1 m) they
+  // alone give heading variance 2 beta L / b^2 and position variance
+  // beta L / 2 along plus 2 beta L^3 / (3 b^2) across. A piece's sd grows by
+  // at most that (sqrt(a + c) - sqrt(a) <= sqrt(c)); on shorter pieces and
+  // spot turns by less, but by more than a fifth of it on the median piece.
+  const double beta = bumps->params.at("rate") * std::pow(bumps->params.at("sigma"), 2), b = 0.3016 * 0.97093;
+  const double head_max = std::sqrt(2.0 * beta / (b * b)), pos_max = std::sqrt(beta / 2.0 + 2.0 * beta / (3.0 * b * b));
+  INFO("bumps: " << bumps->size_mm << " mm (bound " << 1e3 * pos_max << "), " << bumps->size_mrad << " mrad (bound "
+                 << 1e3 * head_max << ")");
+  CHECK(bumps->size_mm <= 1e3 * pos_max);
+  CHECK(bumps->size_mm > 0.2e3 * pos_max);
+  CHECK(bumps->size_mrad <= 1e3 * head_max);
+  CHECK(bumps->size_mrad > 0.2e3 * head_max);
 }
 
 TEST_CASE("diagnose pairs: time offset + 4 cm marker offset are not negligible", "[diagnose][pairs]") {

@@ -180,18 +180,47 @@ PieceScatter Scatter(const CampaignData& c, const std::vector<PieceBases>& bases
   return {std::sqrt(sp / n), std::sqrt(sh / n)};
 }
 
+/// The median over the pieces of how much an effect changes a piece's
+/// position and heading sd, into s.size_mm and s.size_mrad; with(j) and
+/// without(j) give piece j's covariance with and without it.
+template <class With, class Without>
+void MedianSdChange(std::size_t pieces, const With& with, const Without& without, ExplanationStep& s) {
+  std::vector<double> pos, head;
+  for (std::size_t j = 0; j < pieces; ++j) {
+    const Eigen::Matrix3d A = with(j), G = without(j);
+    pos.push_back(std::abs(std::sqrt(A(0, 0) + A(1, 1)) - std::sqrt(G(0, 0) + G(1, 1))));
+    head.push_back(std::abs(std::sqrt(A(2, 2)) - std::sqrt(G(2, 2))));
+  }
+  s.size_mm = 1e3 * Median(pos);
+  s.size_mrad = 1e3 * Median(head);
+}
+
 /// Practical size of effect e within the joint fit f (see explanation.hpp).
 void Size(const CampaignData& c, const MeanModel& model, const BaselineFit& base,
           const std::vector<PieceBases>& bases, const PieceScatter& noise, const SetFit& f, sim::EffectKind e,
           ExplanationStep& s) {
   const double kL2 = f.noise.kL2, kR2 = f.noise.kR2, kbar2 = 0.5 * (kL2 + kR2);
+  // correlated_noise and bump_outliers act like wheel noise: sized by the
+  // relative change of its sd, with the change of one piece's scatter in
+  // mm / mrad beside it. A bump process of rate r and variance s_b^2 adds
+  // r s_b^2 per metre of a wheel's travel, as k^2 does (eq. 4).
   if (e == sim::EffectKind::kCorrelatedNoise) {
     const double ratio = kbar2 > 0.0 ? f.noise.c_LR / kbar2 : 0.0;
     s.relative_size = std::abs(std::sqrt(std::max(0.0, 1.0 + ratio)) - 1.0);
+    NoiseParams without = f.noise;
+    without.c_LR = 0.0;
+    MedianSdChange(
+        bases.size(), [&](std::size_t j) -> Eigen::Matrix3d { return PieceCovariance(bases[j], f.noise); },
+        [&](std::size_t j) -> Eigen::Matrix3d { return PieceCovariance(bases[j], without); }, s);
     return;
   }
   if (e == sim::EffectKind::kBumpOutliers) {
-    s.relative_size = kbar2 > 0.0 ? std::sqrt(1.0 + f.noise.bump_rate * f.noise.bump_s2 / kbar2) - 1.0 : 1.0;
+    const double b2 = f.noise.bump_rate * f.noise.bump_s2;
+    s.relative_size = kbar2 > 0.0 ? std::sqrt(1.0 + b2 / kbar2) - 1.0 : 1.0;
+    MedianSdChange(
+        bases.size(),
+        [&](std::size_t j) -> Eigen::Matrix3d { return PieceCovariance(bases[j], f.noise) + b2 * (bases[j].A_L + bases[j].A_R); },
+        [&](std::size_t j) -> Eigen::Matrix3d { return PieceCovariance(bases[j], f.noise); }, s);
     return;
   }
   if (e == sim::EffectKind::kWheelNoiseError) {
@@ -203,14 +232,10 @@ void Size(const CampaignData& c, const MeanModel& model, const BaselineFit& base
     // scatter [mm, mrad].
     auto rel = [](double fit2, double given2) { return given2 > 0.0 ? std::abs(std::sqrt(fit2 / given2) - 1.0) : 1.0; };
     s.relative_size = std::max(rel(kL2, base.noise.kL2), rel(kR2, base.noise.kR2));
-    std::vector<double> pos, head;
-    for (const PieceBases& B : bases) {
-      const Eigen::Matrix3d A = kL2 * B.A_L + kR2 * B.A_R, G = base.noise.kL2 * B.A_L + base.noise.kR2 * B.A_R;
-      pos.push_back(std::abs(std::sqrt(A(0, 0) + A(1, 1)) - std::sqrt(G(0, 0) + G(1, 1))));
-      head.push_back(std::abs(std::sqrt(A(2, 2)) - std::sqrt(G(2, 2))));
-    }
-    s.size_mm = 1e3 * Median(pos);
-    s.size_mrad = 1e3 * Median(head);
+    MedianSdChange(
+        bases.size(), [&](std::size_t j) -> Eigen::Matrix3d { return kL2 * bases[j].A_L + kR2 * bases[j].A_R; },
+        [&](std::size_t j) -> Eigen::Matrix3d { return base.noise.kL2 * bases[j].A_L + base.noise.kR2 * bases[j].A_R; },
+        s);
     return;
   }
   if (IsNoiseEffect(e) && e != sim::EffectKind::kRunTimeOffset) {
