@@ -21,6 +21,7 @@
 #include "io/robot_toml.hpp"
 #include "io/rosbag2/bag.hpp"
 #include "io/rosbag2/cdr.hpp"
+#include "io/rosbag2/mcap_reader.hpp"
 #include "io/rosbag2/messages.hpp"
 #include "io/rosbag2/rosbag2_import.hpp"
 #include "support/run_cli.hpp"
@@ -357,6 +358,16 @@ TEST_CASE("Bad recordings: exit 1 naming the file and the byte offset or topic",
   const fs::path magic_bad = dir / "magic.mcap";
   Write(magic_bad, magic);
   expect(import(magic_bad), magic_bad, "not an MCAP file");
+  // A rejected file is closed: 300 rejections leave the process's open
+  // descriptors as they were (the constructor used to leak its FILE).
+  auto open_fds = [] {
+    std::size_t n = 0;
+    for ([[maybe_unused]] const auto& e : fs::directory_iterator("/proc/self/fd")) ++n;
+    return n;
+  };
+  const std::size_t fds_before = open_fds();
+  for (int i = 0; i < 300; ++i) CHECK_THROWS_AS(McapReader(magic_bad.string()), InputError);
+  CHECK(open_fds() == fds_before);
 
   // SQLite3: a database that is not a rosbag2, and a locked one.
   const fs::path other = dir / "other.db3";
