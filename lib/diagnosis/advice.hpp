@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "diagnosis/pieces.hpp"
+#include "diagnosis/plausibility.hpp"
 
 namespace umbmark::diag {
 
@@ -39,18 +40,6 @@ std::string FormatPValue(double p);
 /// says the mean gap is not what such an effect changes.
 std::string EvidenceInWords(double heldout_gain_nats, double evidence_nats, double heldout_shrink,
                             bool noise_effect = false);
-
-/// Why a fitted effect is physically impossible or implausible (empty when
-/// it is not): a negative or >= 1 turn scrub, a correlation at +-1, a wheel
-/// diameter off by more than 10 %, a castor kick over 50 mrad (3 deg), a
-/// ground-truth marker more than 0.3 m off the axle, a right wheel
-/// drifting by more than 5 % over the campaign (`runs`), noise of more
-/// than 50 mm per event, run time offsets over 1 s. A turn scrub counts as
-/// negative below -0.01, or below 0 by more than 2 of its standard errors
-/// (`se`, when given). Such a fit is a symptom: the effect soaked up
-/// something else.
-std::string UnphysicalFit(const std::string& effect, const std::map<std::string, double>& params, int runs,
-                          const std::map<std::string, double>& se = {});
 
 /// What to do next, in order: for `none`, use the model; for a named
 /// verdict, model the effects; for `unexplained`, the largest discrepancy

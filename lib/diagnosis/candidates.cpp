@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "diagnosis/mean_fit.hpp"
+#include "diagnosis/plausibility.hpp"
 #include "diagnosis/run_block.hpp"
 #include "core/parallel_for.hpp"
 #include "stats/distributions.hpp"
@@ -323,6 +324,7 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
       cd.note = "not a contract effect; not fitted";
       return;
     }
+    cd.impossible = !UnphysicalFit(sim::EffectToString(kind), cd.params, static_cast<int>(c.runs.size())).empty();
     cd.shrink = Shrink(Gap(cd.gap_after, null_median), x.gap_before);
     cd.evidence = cd.heldout_loglik_gain - options.complexity_penalty_nats * cd.parameters;
   };

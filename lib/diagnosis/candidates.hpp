@@ -46,6 +46,13 @@ struct Candidate {
   bool tested = false;
   double loglik_gain = 0.0;
   double lr_p_value = 1.0;
+  /// Fitted beyond the fixed bounds of plausibility.hpp's UnphysicalFit
+  /// (e.g. a turn scrub below -0.01; without the standard-error rule, so
+  /// a scrub slightly but significantly below 0 does not count). Such a
+  /// fit is another likelihood mode, not an alternative near the baseline
+  /// where Wilks' chi^2 holds, so its likelihood-ratio test is no evidence
+  /// of a gap (verdict.cpp).
+  bool impossible = false;
   std::array<double, kNumStatKinds> gap_by_kind{};
   std::string note;
 };

@@ -15,7 +15,15 @@ namespace {
 /// double precision can vouch for.
 std::string P(double p) { return p < 1e-12 ? std::string("p < 1e-12") : fmt::format("p = {:.3g}", p); }
 
-/// Combined p-value of G and the likelihood-ratio tests.
+/// Combined p-value of G and the likelihood-ratio tests. A test whose fit
+/// lies far outside the physical range (Candidate::impossible) counts in
+/// the Bonferroni factor but not as evidence: Wilks' chi^2 holds for
+/// alternatives near the baseline, and such a fit is another likelihood
+/// mode. A clean campaign from an independent simulator (10 Hz, 500
+/// ticks/rev) was called `unexplained` on a turn scrub of k = -1.01 with
+/// E_b = 2.0 (LR p = 1.2e-6) while its gap score lay at its null (G =
+/// 2.7, p = 0.42). A scrub slightly below 0 still counts (it imitates a
+/// real gap; test_diagnose), and the gap score sees every gap.
 void Significance(const CandidateFits& fits, double score_p_value, const VerdictOptions& options, Verdict& out) {
   {
     double min_p = 1.0;
@@ -23,7 +31,7 @@ void Significance(const CandidateFits& fits, double score_p_value, const Verdict
     for (const Candidate& cd : fits.candidates)
       if (cd.tested) {
         ++out.tests;
-        min_p = std::min(min_p, cd.lr_p_value);
+        if (!cd.impossible) min_p = std::min(min_p, cd.lr_p_value);
       }
     out.tests_p_value = std::min(1.0, out.tests * min_p);
     out.p_value = options.likelihood_tests && out.tests > 0
@@ -53,7 +61,7 @@ void Decide(const CandidateFits& fits, double score_p_value, double null_quantil
   // see it): significant after Bonferroni, gains held out, and leaves no
   // significant G.
   auto found_alone = [&](const Candidate& cd) {
-    return found_by_tests && cd.identifiable && cd.tested && out.tests * cd.lr_p_value < route_alpha &&
+    return found_by_tests && cd.identifiable && cd.tested && !cd.impossible && out.tests * cd.lr_p_value < route_alpha &&
            cd.evidence > 0.0 && cd.gap_after <= null_quantile_alpha;
   };
   std::stable_sort(rank.begin(), rank.end(), [&](std::size_t a, std::size_t b) {

@@ -1,0 +1,73 @@
+// The verdict's significance rule (diagnosis/verdict.hpp) on hand-made
+// candidate tables: which likelihood-ratio tests count as evidence.
+#include <catch2/catch.hpp>
+
+#include "diagnosis/verdict.hpp"
+
+using namespace umbmark::diag;
+using Catch::Matchers::WithinRel;
+
+namespace {
+
+/// A tested candidate as FitCandidates leaves it, with the given LR p.
+Candidate Tested(umbmark::sim::EffectKind kind, double lr_p, bool impossible) {
+  Candidate c;
+  c.effect = kind;
+  c.tested = true;
+  c.parameters = 1;
+  c.lr_p_value = lr_p;
+  c.impossible = impossible;
+  c.heldout_loglik_gain = 11.0;
+  c.evidence = 9.0;
+  c.heldout_shrink = -1.0;  // fits better in likelihood, widens the gap score
+  c.gap_after = 5.0;
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("verdict: an impossible fit's likelihood-ratio test is no evidence of a gap", "[diagnose][verdict]") {
+  // The case from the independent generator's clean campaign 777/004 (10 Hz,
+  // 500 ticks/rev): G far below its null (p = 0.42), and a turn scrub that
+  // reached k = -1.01 with E_b = 2.0, LR p = 1.2e-6. Before the rule the
+  // combined p was 4.8e-6 and the diagnosis `unexplained`.
+  const double score_p = 0.42, null_q = 13.3;
+  CandidateFits fits;
+  fits.candidates.push_back(Tested(umbmark::sim::EffectKind::kTurnScrub, 1.2e-6, /*impossible=*/true));
+  fits.candidates.push_back(Tested(umbmark::sim::EffectKind::kScaleError, 0.3, false));
+  fits.projected.resize(2);
+  const Verdict v = DecideVerdict(fits, score_p, null_q, VerdictOptions{});
+  CHECK(v.tests == 2);  // still counted in the Bonferroni factor
+  CHECK_THAT(v.tests_p_value, WithinRel(2 * 0.3, 1e-12));
+  CHECK_FALSE(v.significant);
+  CHECK(v.verdict == "none");
+
+  // The same fit at a possible value is evidence: significant, and found
+  // by its own test (before the rule this stage named the scrub, and
+  // diagnose.cpp's NameEffects turned the impossible name into
+  // `unexplained`).
+  fits.candidates[0].impossible = false;
+  const Verdict w = DecideVerdict(fits, score_p, null_q, VerdictOptions{});
+  CHECK_THAT(w.tests_p_value, WithinRel(2 * 1.2e-6, 1e-12));
+  CHECK_THAT(w.p_value, WithinRel(2 * 2 * 1.2e-6, 1e-12));
+  CHECK(w.significant);
+  CHECK(w.verdict == "turn_scrub");
+}
+
+TEST_CASE("verdict: an impossible fit is never found by its own likelihood-ratio test", "[diagnose][verdict]") {
+  // A significant gap that no candidate closes (score p = 1e-4), and one
+  // candidate whose own LR test would name it alone (found_alone in
+  // verdict.cpp: significant, gains held out, leaves no significant G).
+  CandidateFits fits;
+  Candidate c = Tested(umbmark::sim::EffectKind::kTurnScrub, 1e-8, false);
+  c.heldout_shrink = 0.2;
+  c.gap_after = 3.0;
+  fits.candidates.push_back(c);
+  fits.projected.resize(1);
+  const Verdict found = DecideVerdict(fits, 1e-4, 13.3, VerdictOptions{});
+  CHECK(found.verdict == "turn_scrub");
+  fits.candidates[0].impossible = true;
+  const Verdict symptom = DecideVerdict(fits, 1e-4, 13.3, VerdictOptions{});
+  CHECK(symptom.significant);  // the gap score alone
+  CHECK(symptom.verdict == "unexplained");
+}
