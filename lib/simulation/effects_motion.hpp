@@ -15,7 +15,11 @@
 // the wheels move on through it: no wheel reverses after it and it lasts no
 // more intervals than one tick takes at the motion's speed there (a
 // wheel's count spacing next to the gap; coarse encoders at high sample
-// rates count a slow start or stop in bursts). So a leg followed by a spot
+// rates count a slow start or stop in bursts). A lone count next to the gap
+// (the last as the motion brakes to rest, or the first as it starts) has
+// no spacing of its own: it belongs to the motion when the gap is at most
+// 1 + sqrt(2) times the spacing on the other side, what constant
+// deceleration gives (in whole intervals, see effects_motion.cpp). So a leg followed by a spot
 // turn without a pause, or a reversal, are two motions "back to back" (the
 // next starts at the interval after the previous one's last). A motion is
 //   straight  when its nominal heading change |R - L| / b <= straight_max_rad,
