@@ -133,7 +133,8 @@ void AnnotateIntervals(DiagRun& r, int min_stand_intervals) {
     // turn's last count, then a leg's first count a sample later under
     // acceleration limits) is a junction: the robot did not pause there.
     const bool from_standstill =
-        k == 0 || m.first_interval - r.motions[k - 1].last_interval > static_cast<std::size_t>(min_stand_intervals);
+        k == 0 || (m.first_interval - r.motions[k - 1].last_interval > static_cast<std::size_t>(min_stand_intervals) &&
+                   !m.after_brief_stop);
     if (from_standstill && m.cls != sim::MotionClass::kTurn)
       r.kick[m.first_interval] = static_cast<signed char>(m.sign);
     if (m.last_interval > m.first_interval) {
@@ -277,7 +278,8 @@ bool StartAmbiguous(const DiagRun& r, std::size_t mi, double tick_left_m, double
   const std::size_t i = m.first_interval;
   // From standstill, as AnnotateIntervals reads it for the castor kick.
   const bool from_standstill =
-      mi == 0 || i - r.motions[mi - 1].last_interval > static_cast<std::size_t>(r.min_stand_intervals);
+      mi == 0 || (i - r.motions[mi - 1].last_interval > static_cast<std::size_t>(r.min_stand_intervals) &&
+                  !m.after_brief_stop);
   if (!from_standstill || i == 0 || !(tick_left_m > 0.0 && tick_right_m > 0.0)) return false;
   auto counts = [&](std::size_t k) {
     return std::abs(r.left[k + 1] - r.left[k]) / tick_left_m + std::abs(r.right[k + 1] - r.right[k]) / tick_right_m;
@@ -366,7 +368,14 @@ void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, co
     // (PieceOptions::start_before_first_count).
     const bool early = !joined_before && o.start_before_first_count &&
                        StartAmbiguous(r, mi, tick_left_m, tick_right_m, o.start_lead_fraction);
-    const std::size_t s0 = joined_before ? m.FirstSample() + 1 : early ? m.FirstSample() - 1 : m.FirstSample();
+    // After a brief stop (effects_motion.hpp) the motion's first piece
+    // starts where the one before ended: the still samples between hold
+    // the braking and the start, not a standstill.
+    const bool brief = m.after_brief_stop && mi > 0 && cur <= m.FirstSample();
+    const std::size_t s0 = joined_before ? m.FirstSample() + 1
+                           : brief       ? cur
+                           : early       ? m.FirstSample() - 1
+                                         : m.FirstSample();
     const bool late = !joined_after && o.start_before_first_count &&
                       StopAmbiguous(r, mi, tick_left_m, tick_right_m, o.start_lead_fraction);
     const std::size_t s1 = m.EndSample() - (joined_after ? 1 : 0) + (late ? 1 : 0);

@@ -120,12 +120,14 @@ RunPlan ReplayPlan(const TrajectoryRun& run, const RobotParams& robot) {
     // From standstill: the run's first motion, or one after a standstill
     // (min_stand_intervals still intervals or more, what separates motions;
     // a motion that follows another back to back, or after a shorter still
-    // stretch, does not start from standstill, whatever its class). The
+    // stretch or a brief stop, does not start from standstill, whatever its
+    // class). The
     // diagnosis reads it the same way (diagnosis/pieces.cpp).
     step.from_standstill =
         i == m.first_interval &&
-        (next_motion == 0 || m.first_interval - motions[next_motion - 1].last_interval >
-                                 static_cast<std::size_t>(mo.min_stand_intervals));
+        (next_motion == 0 || (m.first_interval - motions[next_motion - 1].last_interval >
+                                  static_cast<std::size_t>(mo.min_stand_intervals) &&
+                              !m.after_brief_stop));
     if (step.from_standstill && m.cls != MotionClass::kTurn) {
       // The kick's direction is the motion's, not this first step's.
       const double sgn = m.left_m + m.right_m >= 0.0 ? 1.0 : -1.0;

@@ -120,6 +120,30 @@ bool MovesThroughGap(const std::vector<double>& cum_left, const std::vector<doub
   return gap <= std::max(before, after);
 }
 
+/// Whether the still stretch [last + 1, k) that ended a motion (first..last)
+/// is a brief stop: the robot braked to rest and started the next motion
+/// at once, as between a leg and a spot turn without a pause. Braking lets
+/// a wheel run on after its last count for at most about one count
+/// spacing (at constant speed it stops on the count), and starting from
+/// rest takes about one spacing of the next motion to its first count; a
+/// stretch no longer than the two together is no commanded pause. Both
+/// spacings come from the counts next to the stretch (TickSpacing); a side
+/// with fewer than two counts gives no spacing and no brief stop.
+bool BriefStop(const std::vector<double>& cum_left, const std::vector<double>& cum_right, const MotionOptions& options,
+               std::size_t first, std::size_t last, std::size_t k) {
+  const std::size_t intervals = cum_left.size() - 1;
+  const std::size_t gap = k - (last + 1);
+  const double eps = options.stand_eps_m;
+  const std::size_t before = TickSpacing(cum_left, cum_right, eps, last, first, [](std::size_t) { return false; });
+  std::size_t still = 0;
+  const std::size_t after = TickSpacing(cum_left, cum_right, eps, k, intervals - 1, [&](std::size_t i) {
+    const bool moves = TravelSign(cum_left, i, eps) != 0 || TravelSign(cum_right, i, eps) != 0;
+    still = moves ? 0 : still + 1;
+    return still > gap;
+  });
+  return before > 0 && after > 0 && gap <= before + after;
+}
+
 }  // namespace
 
 std::vector<MotionSegment> SegmentMotions(const std::vector<double>& cum_left, const std::vector<double>& cum_right,
@@ -137,6 +161,7 @@ std::vector<MotionSegment> SegmentMotions(const std::vector<double>& cum_left, c
   };
   auto sign = [&](const std::vector<double>& cum, std::size_t i) { return TravelSign(cum, i, options.stand_eps_m); };
   std::size_t i = 0;
+  bool next_after_brief_stop = false;  // of the motion found next
   while (i < intervals) {
     if (!moving(i)) {
       ++i;
@@ -144,6 +169,8 @@ std::vector<MotionSegment> SegmentMotions(const std::vector<double>& cum_left, c
     }
     MotionSegment m;
     m.first_interval = i;
+    m.after_brief_stop = next_after_brief_stop;
+    next_after_brief_stop = false;
     std::size_t last = i;
     std::size_t j = i + 1;
     // Each wheel's direction so far (0 until it moves): a wheel that turns
@@ -177,8 +204,11 @@ std::vector<MotionSegment> SegmentMotions(const std::vector<double>& cum_left, c
       if (k == intervals) break;
       if (k - j >= static_cast<std::size_t>(options.min_stand_intervals) &&
           !(options.move_through_tick_gaps &&
-            MovesThroughGap(cum_left, cum_right, options, m.first_interval, last, k, reverses)))
+            MovesThroughGap(cum_left, cum_right, options, m.first_interval, last, k, reverses))) {
+        next_after_brief_stop =
+            options.move_through_tick_gaps && BriefStop(cum_left, cum_right, options, m.first_interval, last, k);
         break;
+      }
       j = k;  // the motion continues through the gap
     }
     m.last_interval = last;

@@ -45,6 +45,14 @@ struct MotionSegment {
   /// straight / arc: +1 forward, -1 backward (sign of L + R); turn: +1 ccw, -1 cw.
   int sign = 1;
   double left_m = 0.0, right_m = 0.0;  ///< total nominal travel
+  /// The still stretch before this motion (min_stand_intervals or more) is
+  /// a brief stop, no pause: it lasts no longer than the count spacing of
+  /// the motion before it plus that of this one (braking to rest, starting
+  /// again), as between a leg and a spot turn without a commanded pause at
+  /// coarse encoders. No start from standstill (castor_kick), and the
+  /// diagnosis lays no standstill piece there. Only with
+  /// move_through_tick_gaps.
+  bool after_brief_stop = false;
   /// First sample of the motion (= first_interval) and one past its end
   /// (= last_interval + 1), for convenience.
   std::size_t FirstSample() const { return first_interval; }
