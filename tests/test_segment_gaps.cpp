@@ -238,3 +238,48 @@ TEST_CASE("diagnose: clean campaigns with acceleration limits at 500 ticks/rev a
   INFO("mean G " << sum / 4 << " against " << sum_old / 4 << " under the reading before");
   CHECK(sum < sum_old);
 }
+
+TEST_CASE("segmentation: legs and spot turns without pauses meet at brief stops, never at standstills",
+          "[segment-gaps]") {
+  // The robot of accel_robot.hpp (acceleration limits, creeping into the
+  // target) drives squares at 50 Hz with no pause between leg and turn. It
+  // brakes to rest and starts the next motion at once, one wheel turning
+  // the other way: the encoders stand for a few samples between, which is
+  // no commanded pause. With 1 s pauses no stop is brief.
+  std::mt19937_64 g(4711);
+  int brief = 0, standstills = 0, junctions = 0, brief_with_pauses = 0;
+  for (int run = 0; run < 10; ++run) {
+    for (const bool pauses : {false, true}) {
+      AccelRobot robot(g, std::to_string(run + 1), "ccw", 0.0, kRate);
+      robot.Pause(1.0);
+      for (int leg = 0; leg < 4; ++leg) {
+        robot.Leg(1.0);
+        if (pauses) robot.Pause(1.0);
+        robot.Turn(kQuarter);
+        if (pauses || leg == 3) robot.Pause(1.0);
+      }
+      const TrajectoryRun r = robot.Finish();
+      sim::MotionOptions mo;
+      mo.stand_eps_m = 0.5 * PerCount();
+      const auto ms = sim::SegmentMotions(Travel(r.ticks_left), Travel(r.ticks_right), testing::kAccelWheelbase, mo);
+      for (std::size_t k = 1; k < ms.size(); ++k) {
+        const std::size_t still = ms[k].first_interval - ms[k - 1].last_interval - 1;
+        if (pauses) {
+          brief_with_pauses += ms[k].after_brief_stop ? 1 : 0;
+          continue;
+        }
+        ++junctions;
+        if (ms[k].after_brief_stop)
+          ++brief;
+        else if (still >= static_cast<std::size_t>(mo.min_stand_intervals))
+          ++standstills;
+      }
+      if (!pauses) CHECK(ms.size() == 8);  // 4 legs, 4 turns
+    }
+  }
+  INFO(brief << " brief stops, " << standstills << " standstills of " << junctions << " junctions");
+  CHECK(junctions == 70);
+  CHECK(standstills == 0);
+  CHECK(brief >= 20);  // 25; the others are back to back (a still stretch under 2 samples)
+  CHECK(brief_with_pauses == 0);
+}

@@ -126,7 +126,9 @@ bool MovesThroughGap(const std::vector<double>& cum_left, const std::vector<doub
 /// a wheel run on after its last count for at most about one count
 /// spacing (at constant speed it stops on the count), and starting from
 /// rest takes about one spacing of the next motion to its first count; a
-/// stretch no longer than the two together is no commanded pause. Both
+/// stretch no longer than the two together is no commanded pause (at 50 Hz
+/// and 500 ticks/rev: 3-4 still samples between spacings of 1-2, against
+/// 25-50 for a pause of 0.5-1 s). Both
 /// spacings come from the counts next to the stretch (TickSpacing); a side
 /// with fewer than two counts gives no spacing and no brief stop.
 bool BriefStop(const std::vector<double>& cum_left, const std::vector<double>& cum_right, const MotionOptions& options,
@@ -141,7 +143,9 @@ bool BriefStop(const std::vector<double>& cum_left, const std::vector<double>& c
     still = moves ? 0 : still + 1;
     return still > gap;
   });
-  return before > 0 && after > 0 && gap <= before + after;
+  // In whole intervals a spacing s stands for up to s + 1 intervals of
+  // time and the gap g for a spacing of g + 1 (as for a lone count).
+  return before > 0 && after > 0 && gap + 1 <= (before + 1) + (after + 1);
 }
 
 }  // namespace
@@ -219,6 +223,17 @@ std::vector<MotionSegment> SegmentMotions(const std::vector<double>& cum_left, c
       m.sign = m.right_m - m.left_m >= 0.0 ? 1 : -1;
     else
       m.sign = m.right_m + m.left_m >= 0.0 ? 1 : -1;
+    // A brief stop is one between motions in different directions (a leg
+    // and a spot turn, a reversal): a wheel that ran one way runs the other
+    // after it. A wheel pausing for a sample or two and going on the same
+    // way (stiction at a slow start) is no brief stop; that stretch stays a
+    // standstill.
+    if (m.after_brief_stop && !out.empty()) {
+      const MotionSegment& p = out.back();
+      const double eps = options.stand_eps_m;
+      auto opposite = [eps](double a, double b) { return (a > eps && b < -eps) || (a < -eps && b > eps); };
+      m.after_brief_stop = opposite(p.left_m, m.left_m) || opposite(p.right_m, m.right_m);
+    }
     out.push_back(m);
     i = last + 1;
   }

@@ -48,8 +48,8 @@ struct MotionSegment {
   /// The still stretch before this motion (min_stand_intervals or more) is
   /// a brief stop, no pause: it lasts no longer than the count spacing of
   /// the motion before it plus that of this one (braking to rest, starting
-  /// again), as between a leg and a spot turn without a commanded pause at
-  /// coarse encoders. No start from standstill (castor_kick), and the
+  /// again), and a wheel runs the other way than before it, as between a
+  /// leg and a spot turn without a commanded pause at coarse encoders. No start from standstill (castor_kick), and the
   /// diagnosis lays no standstill piece there. Only with
   /// move_through_tick_gaps.
   bool after_brief_stop = false;
