@@ -67,6 +67,30 @@ std::size_t TickSpacing(const std::vector<double>& cum_left, const std::vector<d
   return 0;
 }
 
+/// The still stretch [last + 1, k) after a motion's intervals first..last
+/// and the count spacings next to it (TickSpacing; 0: fewer than two
+/// counts on that side). After the stretch the walk ends where stop(i)
+/// says, or at a still stretch longer than this one (a lone count between
+/// two pauses, e.g. a wheel settling by a tick, tells no speed).
+struct GapSpacings {
+  std::size_t gap = 0, before = 0, after = 0;
+};
+template <class Stop>
+GapSpacings SpacingsAround(const std::vector<double>& cum_left, const std::vector<double>& cum_right, double eps,
+                           std::size_t first, std::size_t last, std::size_t k, const Stop& stop) {
+  GapSpacings out;
+  out.gap = k - (last + 1);
+  out.before = TickSpacing(cum_left, cum_right, eps, last, first, [](std::size_t) { return false; });
+  std::size_t still = 0;
+  out.after = TickSpacing(cum_left, cum_right, eps, k, cum_left.size() - 2, [&](std::size_t i) {
+    if (stop(i)) return true;
+    const bool moves = TravelSign(cum_left, i, eps) != 0 || TravelSign(cum_right, i, eps) != 0;
+    still = moves ? 0 : still + 1;
+    return still > out.gap;
+  });
+  return out;
+}
+
 /// Whether a motion (intervals first..last so far) moves on through the
 /// still stretch [last + 1, k) of at least min_stand_intervals that ends at
 /// moving interval k. A wheel moving at speed v counts a tick every
@@ -89,20 +113,8 @@ bool MovesThroughGap(const std::vector<double>& cum_left, const std::vector<doub
                      const MotionOptions& options, std::size_t first, std::size_t last, std::size_t k,
                      const Reverses& reverses) {
   if (reverses(k)) return false;
-  const std::size_t intervals = cum_left.size() - 1;
-  const std::size_t gap = k - (last + 1);
-  const double eps = options.stand_eps_m;
-  const std::size_t before = TickSpacing(cum_left, cum_right, eps, last, first, [](std::size_t) { return false; });
-  // After the gap up to a reversal (the start of another motion) or a still
-  // stretch longer than the gap (a lone count between two pauses, e.g. a
-  // wheel settling by a tick, tells no speed).
-  std::size_t still = 0;
-  const std::size_t after = TickSpacing(cum_left, cum_right, eps, k, intervals - 1, [&](std::size_t i) {
-    if (reverses(i)) return true;
-    const bool moves = TravelSign(cum_left, i, eps) != 0 || TravelSign(cum_right, i, eps) != 0;
-    still = moves ? 0 : still + 1;
-    return still > gap;
-  });
+  // After the gap only up to a reversal (the start of another motion).
+  const auto [gap, before, after] = SpacingsAround(cum_left, cum_right, options.stand_eps_m, first, last, k, reverses);
   // A lone count on one side of the gap (a motion's last count as it stops,
   // or its first as it starts) gives no spacing there. Under constant
   // deceleration to rest at a count the ticks before it come at times
@@ -133,16 +145,8 @@ bool MovesThroughGap(const std::vector<double>& cum_left, const std::vector<doub
 /// with fewer than two counts gives no spacing and no brief stop.
 bool BriefStop(const std::vector<double>& cum_left, const std::vector<double>& cum_right, const MotionOptions& options,
                std::size_t first, std::size_t last, std::size_t k) {
-  const std::size_t intervals = cum_left.size() - 1;
-  const std::size_t gap = k - (last + 1);
-  const double eps = options.stand_eps_m;
-  const std::size_t before = TickSpacing(cum_left, cum_right, eps, last, first, [](std::size_t) { return false; });
-  std::size_t still = 0;
-  const std::size_t after = TickSpacing(cum_left, cum_right, eps, k, intervals - 1, [&](std::size_t i) {
-    const bool moves = TravelSign(cum_left, i, eps) != 0 || TravelSign(cum_right, i, eps) != 0;
-    still = moves ? 0 : still + 1;
-    return still > gap;
-  });
+  const auto [gap, before, after] = SpacingsAround(cum_left, cum_right, options.stand_eps_m, first, last, k,
+                                                   [](std::size_t) { return false; });
   // In whole intervals a spacing s stands for up to s + 1 intervals of
   // time and the gap g for a spacing of g + 1 (as for a lone count).
   return before > 0 && after > 0 && gap + 1 <= (before + 1) + (after + 1);
