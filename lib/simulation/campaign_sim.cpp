@@ -121,8 +121,7 @@ RunPlan ReplayPlan(const TrajectoryRun& run, const RobotParams& robot) {
     // (min_stand_intervals still intervals or more, what separates motions;
     // a motion that follows another back to back, or after a shorter still
     // stretch or a brief stop, does not start from standstill, whatever its
-    // class). The
-    // diagnosis reads it the same way (diagnosis/pieces.cpp).
+    // class). The diagnosis reads it the same way (diagnosis/pieces.cpp).
     step.from_standstill =
         i == m.first_interval &&
         (next_motion == 0 || (m.first_interval - motions[next_motion - 1].last_interval >

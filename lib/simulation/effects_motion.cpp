@@ -140,9 +140,9 @@ bool MovesThroughGap(const std::vector<double>& cum_left, const std::vector<doub
 /// rest takes about one spacing of the next motion to its first count; a
 /// stretch no longer than the two together is no commanded pause (at 50 Hz
 /// and 500 ticks/rev: 3-4 still samples between spacings of 1-2, against
-/// 25-50 for a pause of 0.5-1 s). Both
-/// spacings come from the counts next to the stretch (TickSpacing); a side
-/// with fewer than two counts gives no spacing and no brief stop.
+/// 25-50 for a pause of 0.5-1 s). Both spacings come from the counts next
+/// to the stretch (SpacingsAround); a side with fewer than two counts gives
+/// no spacing and no brief stop.
 bool BriefStop(const std::vector<double>& cum_left, const std::vector<double>& cum_right, const MotionOptions& options,
                std::size_t first, std::size_t last, std::size_t k) {
   const auto [gap, before, after] = SpacingsAround(cum_left, cum_right, options.stand_eps_m, first, last, k,

@@ -19,9 +19,11 @@
 // (the last as the motion brakes to rest, or the first as it starts) has
 // no spacing of its own: it belongs to the motion when the gap is at most
 // 1 + sqrt(2) times the spacing on the other side, what constant
-// deceleration gives (in whole intervals, see effects_motion.cpp). So a leg followed by a spot
-// turn without a pause, or a reversal, are two motions "back to back" (the
-// next starts at the interval after the previous one's last). A motion is
+// deceleration gives (in whole intervals, see effects_motion.cpp). A leg
+// followed by a spot turn without a pause, or a reversal, are two motions:
+// "back to back" (the next starts at the interval after the previous one's
+// last), or after a brief stop (MotionSegment::after_brief_stop) when the
+// encoders stand for a few samples between. A motion is
 //   straight  when its nominal heading change |R - L| / b <= straight_max_rad,
 //   turn      when |L + R| / 2 <= turn_max_ratio * |R - L| / 2 (the axle centre
 //             barely moves compared with the wheels),
