@@ -118,32 +118,25 @@ class Fields {
 }  // namespace
 
 McapReader::McapReader(std::string path) : path_(std::move(path)) {
-  file_ = std::fopen(path_.c_str(), "rb");
+  // The file is owned by file_ as soon as it is open, so a constructor that
+  // throws below (a rejected file) still closes it: a throwing constructor
+  // runs no destructor, and the MCAP fuzzer ran out of descriptors after
+  // ~1e6 non-MCAP inputs when the file was closed only there.
+  file_.reset(std::fopen(path_.c_str(), "rb"));
   if (!file_) throw InputError(path_, fmt::format("cannot open: {}", std::strerror(errno)));
-  // A constructor that throws runs no destructor: close the file here, or
-  // every rejected file leaks its descriptor and 1 MB buffer (the MCAP
-  // fuzzer ran out of descriptors after ~1e6 non-MCAP inputs).
-  try {
-    std::setvbuf(file_, nullptr, _IOFBF, 1 << 20);
-    if (std::fseek(file_, 0, SEEK_END) != 0) Fail(0, "cannot seek (not a regular file?)");
-    const long end = std::ftell(file_);
-    if (end < 0) Fail(0, "cannot tell the file size");
-    size_ = static_cast<std::uint64_t>(end);
-    std::rewind(file_);
-    std::uint8_t magic[8] = {};
-    if (size_ < 8 || std::fread(magic, 1, 8, file_) != 8 || std::memcmp(magic, kMagic, 8) != 0)
-      Fail(0, "not an MCAP file (the magic bytes \\x89MCAP0\\r\\n are missing)");
-  } catch (...) {
-    std::fclose(file_);
-    file_ = nullptr;
-    throw;
-  }
+  std::setvbuf(file_.get(), nullptr, _IOFBF, 1 << 20);
+  if (std::fseek(file_.get(), 0, SEEK_END) != 0) Fail(0, "cannot seek (not a regular file?)");
+  const long end = std::ftell(file_.get());
+  if (end < 0) Fail(0, "cannot tell the file size");
+  size_ = static_cast<std::uint64_t>(end);
+  std::rewind(file_.get());
+  std::uint8_t magic[8] = {};
+  if (size_ < 8 || std::fread(magic, 1, 8, file_.get()) != 8 || std::memcmp(magic, kMagic, 8) != 0)
+    Fail(0, "not an MCAP file (the magic bytes \\x89MCAP0\\r\\n are missing)");
   pos_ = 8;
 }
 
-McapReader::~McapReader() {
-  if (file_) std::fclose(file_);
-}
+McapReader::~McapReader() = default;
 
 void McapReader::Fail(std::uint64_t offset, const std::string& what) const {
   throw InputError(path_, fmt::format("byte {}: {}", offset, what));
@@ -151,7 +144,7 @@ void McapReader::Fail(std::uint64_t offset, const std::string& what) const {
 
 void McapReader::ReadExact(void* dst, std::size_t n, std::uint64_t record_offset) {
   if (n == 0) return;
-  if (std::fread(dst, 1, n, file_) != n)
+  if (std::fread(dst, 1, n, file_.get()) != n)
     Fail(record_offset, fmt::format("read error or file truncated (file is {} bytes)", size_));
   pos_ += n;
 }
@@ -160,18 +153,18 @@ bool McapReader::ReadSummary(McapSummary& out) {
   if (size_ < 8 + kFooterRecord + 8) return false;
   std::uint8_t tail[kFooterRecord + 8];
   const std::uint64_t footer_at = size_ - sizeof(tail);
-  if (std::fseek(file_, static_cast<long>(footer_at), SEEK_SET) != 0 || std::fread(tail, 1, sizeof(tail), file_) != sizeof(tail))
+  if (std::fseek(file_.get(), static_cast<long>(footer_at), SEEK_SET) != 0 || std::fread(tail, 1, sizeof(tail), file_.get()) != sizeof(tail))
     Fail(footer_at, "cannot read the footer");
-  std::fseek(file_, static_cast<long>(pos_), SEEK_SET);
+  std::fseek(file_.get(), static_cast<long>(pos_), SEEK_SET);
   if (std::memcmp(tail + kFooterRecord, kMagic, 8) != 0 || tail[0] != kFooter || Le64(tail + 1) != 20) return false;
   const std::uint64_t summary_start = Le64(tail + kRecordHeader);
   const std::uint32_t summary_crc = static_cast<std::uint32_t>(Le64(tail + kRecordHeader + 16) & 0xffffffffu);
   if (summary_start == 0) return false;
   if (summary_start < 8 || summary_start > footer_at) Fail(footer_at, fmt::format("footer's summary start {} is outside the file", summary_start));
   std::vector<std::uint8_t> summary(static_cast<std::size_t>(footer_at - summary_start));
-  std::fseek(file_, static_cast<long>(summary_start), SEEK_SET);
-  if (std::fread(summary.data(), 1, summary.size(), file_) != summary.size()) Fail(summary_start, "cannot read the summary");
-  std::fseek(file_, static_cast<long>(pos_), SEEK_SET);
+  std::fseek(file_.get(), static_cast<long>(summary_start), SEEK_SET);
+  if (std::fread(summary.data(), 1, summary.size(), file_.get()) != summary.size()) Fail(summary_start, "cannot read the summary");
+  std::fseek(file_.get(), static_cast<long>(pos_), SEEK_SET);
   if (summary_crc != 0) {
     // CRC of the summary section and the footer's fields before the CRC.
     std::uint32_t crc = Crc32(0, summary.data(), summary.size());
@@ -336,7 +329,7 @@ void McapReader::HandleRecord(std::uint8_t op, const std::uint8_t* content, std:
 // is accumulated over every byte before DataEnd.
 void McapReader::Stream(const std::function<bool(const McapChannel&)>& on_channel,
                         const std::function<void(const McapMessage&)>& on_message) {
-  std::fseek(file_, 8, SEEK_SET);
+  std::fseek(file_.get(), 8, SEEK_SET);
   pos_ = 8;
   schemas_.clear();
   channel_state_.clear();
@@ -360,7 +353,7 @@ void McapReader::Stream(const std::function<bool(const McapChannel&)>& on_channe
     ReadExact(record_.data(), record_.size(), offset);
     if (op == kFooter) {
       std::uint8_t magic[8] = {};
-      if (size_ - pos_ != 8 || std::fread(magic, 1, 8, file_) != 8 || std::memcmp(magic, kMagic, 8) != 0)
+      if (size_ - pos_ != 8 || std::fread(magic, 1, 8, file_.get()) != 8 || std::memcmp(magic, kMagic, 8) != 0)
         Fail(pos_, "the Footer is not followed by the closing magic bytes at the end of the file");
       return;
     }

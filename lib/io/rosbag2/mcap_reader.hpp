@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -88,7 +89,10 @@ class McapReader {
   void DecompressChunk(const std::uint8_t* content, std::size_t size, std::uint64_t offset);
 
   std::string path_;
-  std::FILE* file_ = nullptr;
+  struct FileCloser {
+    void operator()(std::FILE* f) const { std::fclose(f); }
+  };
+  std::unique_ptr<std::FILE, FileCloser> file_;  ///< closed however the reader ends
   std::uint64_t size_ = 0;
   std::uint64_t pos_ = 0;
   std::vector<std::uint8_t> record_;  ///< current record's content
