@@ -8,6 +8,7 @@
 //  - a campaign manifest: every run with ground truth at start and end, with
 //    a systematic mean per experiment and direction.
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -120,17 +121,45 @@ NoiseFitInputOptions InputOptions(const FitNoiseOptions& o, const std::optional<
 /// Appends runs of the file that becomes the next entry of out.sources.
 void AppendRuns(std::vector<WheelNoiseFitRun> runs, Loaded& out) {
   const int source = static_cast<int>(out.sources.size());
-  for (WheelNoiseFitRun& r : runs) {
-    r.source = source;
-    out.runs.push_back(std::move(r));
+  for (WheelNoiseFitRun& r : runs) r.source = source;
+  if (out.runs.empty()) {
+    out.runs = std::move(runs);
+    return;
   }
+  out.runs.reserve(out.runs.size() + runs.size());
+  std::move(runs.begin(), runs.end(), std::back_inserter(out.runs));
 }
 
-void AppendTrajectoryRuns(const TrajectoryData& t, const RobotParams& robot, const std::string& prefix,
+/// Every run of a trajectory file with ground truth at its start and end,
+/// read run by run (memory: the fit runs, not the file's samples). The
+/// runs are gathered in blocks and moved into one vector of the final size
+/// (growing one vector would hold 1.5 times the runs while it reallocates).
+void AppendTrajectoryRuns(io::TrajectoryReader& reader, const RobotParams& robot, const std::string& prefix,
                           const NoiseFitInputOptions& in, Loaded& out) {
-  int skipped = 0;
-  AppendRuns(NoiseRunsFromTrajectories(t, robot, prefix, in, &skipped), out);
-  out.skipped += skipped;
+  constexpr std::size_t kBlock = 1 << 15;
+  std::vector<std::vector<WheelNoiseFitRun>> blocks;
+  std::size_t total = 0;
+  TrajectoryRun run;
+  while (reader.NextRun(run)) {
+    std::optional<WheelNoiseFitRun> f = NoiseRunFromTrajectory(run, reader.path(), robot, prefix, in);
+    if (!f) {
+      ++out.skipped;
+      continue;
+    }
+    if (blocks.empty() || blocks.back().size() == kBlock) {
+      blocks.emplace_back();
+      blocks.back().reserve(kBlock);
+    }
+    blocks.back().push_back(std::move(*f));
+    ++total;
+  }
+  std::vector<WheelNoiseFitRun> runs;
+  runs.reserve(total);
+  for (auto& b : blocks) {
+    std::move(b.begin(), b.end(), std::back_inserter(runs));
+    std::vector<WheelNoiseFitRun>().swap(b);
+  }
+  AppendRuns(std::move(runs), out);
 }
 
 void AppendManifest(const std::string& path, const FitNoiseOptions& o, const SystematicErrors& sys, Loaded& out) {
@@ -146,8 +175,8 @@ void AppendManifest(const std::string& path, const FitNoiseOptions& o, const Sys
   for (const Experiment& e : m.experiments) {
     ++index;
     const std::string prefix = fmt::format("exp{}:{}:", index, ExperimentKindToString(e.kind));
-    io::RunFile rf = io::ReadRunFile(e.resolved_file);
-    if (auto* t = std::get_if<TrajectoryData>(&rf)) {
+    io::OpenedRunFile rf = io::OpenRunFile(e.resolved_file);
+    if (auto* t = std::get_if<io::TrajectoryReader>(&rf)) {
       AppendTrajectoryRuns(*t, robot, prefix, in, out);
     } else {
       const auto& ep = std::get<EndpointData>(rf);
@@ -185,8 +214,8 @@ Loaded Load(const FitNoiseOptions& o, const SystematicErrors& sys = {}) {
     out.sigma_xy = in.sigma_xy_m;
     out.sigma_theta = in.sigma_theta_rad;
     const std::string prefix = o.inputs.size() > 1 ? path + ":" : "";
-    io::RunFile rf = io::ReadRunFile(path);
-    if (auto* t = std::get_if<TrajectoryData>(&rf)) {
+    io::OpenedRunFile rf = io::OpenRunFile(path);
+    if (auto* t = std::get_if<io::TrajectoryReader>(&rf)) {
       AppendTrajectoryRuns(*t, robot, prefix, in, out);
       out.ground_truth = true;
     } else {
@@ -198,6 +227,7 @@ Loaded Load(const FitNoiseOptions& o, const SystematicErrors& sys = {}) {
     }
     out.sources.push_back(path);
   }
+  MergeLoneTurnGroups(out.runs);
   return out;
 }
 
@@ -390,11 +420,9 @@ FitResult Fit(const FitNoiseOptions& o, Loaded& data) {
   Progress progress(fmt::format("fitting k_L, k_R to {} runs", data.runs.size()));
   fo.progress = progress.Callback();
   if (f.source == "estimated") {
-    // The joint fit builds the runs again at three values of E_d: the
-    // first build is not needed any more (memory with 10^6 runs).
-    std::vector<WheelNoiseFitRun>().swap(data.runs);
+    // The joint fit rebuilds the runs' bases in place (the data are read once).
     SystematicEstimate e;
-    f.s = FitWheelNoiseWithSystematics([&](const SystematicErrors& x) { return Load(o, x).runs; }, fo, &e);
+    f.s = FitWheelNoiseWithSystematics(data.runs, fo, &e);
     f.estimate = e;
     f.systematic = e.value;
   } else {
@@ -435,9 +463,16 @@ std::vector<std::string> Notes(const FitResult& f) {
     notes.push_back(fmt::format("the scatter of this design barely shows E_d (+- {:.4f}, near the prior's {}); the "
                                 "intervals include that uncertainty: give --params CAL.json for narrower ones",
                                 f.estimate->E_d_se, WheelNoiseFitOptions{}.E_d_prior_sigma));
-  if (!f.estimate->E_b_determined)
-    notes.push_back("this design (no turns) does not show E_b; k is relative to the recorded wheelbase (a wheelbase "
-                    "off by x % moves k by up to x %): give --params CAL.json from `umbmark calibrate`");
+  if (!f.estimate->E_b_determined) {
+    const std::string why =
+        f.estimate->turns
+            ? fmt::format("the runs' mean return errors determine E_b only to +- {:.3f} (the prior's 0.05: too few "
+                          "runs per direction, or too much scatter, for the turns to show it)",
+                          f.estimate->E_b_se)
+            : std::string("this design (no turns) does not show E_b");
+    notes.push_back(why + "; k is relative to the recorded wheelbase (a wheelbase off by x % moves k by up to x %): "
+                          "give --params CAL.json from `umbmark calibrate`");
+  }
   return notes;
 }
 
@@ -543,6 +578,65 @@ void PrintText(const FitNoiseOptions& o, const Loaded& data, const FitResult& f,
   for (const auto& w : j["warnings"]) fmt::print("  WARNING: {}\n", w.get<std::string>());
 }
 
+/// The k_L, k_R that --ros2 turns into a covariance. A k at its boundary 0
+/// (not determined) would give a covariance that trusts that wheel almost
+/// perfectly (4e-10 m^2 pose variance on the README's square campaign), so
+/// an undetermined k is replaced by its 95 % upper bound (a conservative
+/// covariance; said in the YAML comment and the warnings).
+struct Ros2Noise {
+  double k_L = 0.0, k_R = 0.0;
+  std::string kL_source = "estimate", kR_source = "estimate";  ///< "estimate" or "upper95"
+  std::vector<std::string> comments;                           ///< YAML comment lines
+};
+
+/// An upper bound above this [m^1/2] says nothing about a wheel: its travel
+/// error after 1 m would be 5 cm, 10 to 100 times the k of Chong & Kleeman's
+/// robot (4e-4 to 6e-4) and of the robots in data/ (up to 8e-3).
+constexpr double kMaxUsefulKBound = 0.05;
+
+/// Ros2Noise of a fit; throws QualityGateError (exit 3, before anything is
+/// written) when an undetermined k has no useful upper bound either.
+Ros2Noise Ros2NoiseOf(const FitNoiseOptions& o, const FitResult& f) {
+  Ros2Noise r{f.s.k_L, f.s.k_R, "estimate", "estimate", {}};
+  for (const auto& [name, determined, upper, k, source] :
+       {std::tuple{"k_L", f.kL_determined, f.s.k_L_ci[1], &r.k_L, &r.kL_source},
+        std::tuple{"k_R", f.kR_determined, f.s.k_R_ci[1], &r.k_R, &r.kR_source}}) {
+    if (determined) continue;
+    if (!(upper <= kMaxUsefulKBound))
+      throw QualityGateError(fmt::format(
+          "fit-noise --ros2 {}: {} is not determined by these {} runs ({}), so no covariance is written; drive more "
+          "runs (back-and-forth runs, 10 m forward and back, 20 or more, determine both k), give the reference's "
+          "noise with --meas-sigma SXY,STHETA (or the manifest's [ground_truth]){}",
+          o.ros2, name, f.s.runs,
+          std::isfinite(upper) ? fmt::format("its 95 % upper bound {:.3g} m^1/2 says nothing about a wheel", upper)
+                               : std::string("not even bounded from above"),
+          f.source == "estimated"
+              ? ", or give the calibration (--params CAL.json from `umbmark calibrate --json`) so that E_d is not "
+                "estimated from the same few runs"
+              : ""));
+    *k = upper;
+    *source = "upper95";
+    r.comments.push_back(fmt::format("{} is not determined by the runs (its estimate sits at 0): its 95 % upper bound "
+                                     "{:.4g} m^1/2 is used, so this covariance is conservative",
+                                     name, upper));
+  }
+  return r;
+}
+
+/// The warning --ros2 adds for each k it replaced by its upper bound.
+std::vector<std::string> Ros2Warnings(const FitNoiseOptions& o, const FitResult& f) {
+  std::vector<std::string> out;
+  if (o.ros2.empty()) return out;
+  const Ros2Noise k = Ros2NoiseOf(o, f);
+  for (const auto& [name, source, value] :
+       {std::tuple{"k_L", k.kL_source, k.k_L}, std::tuple{"k_R", k.kR_source, k.k_R}})
+    if (source == "upper95")
+      out.push_back(fmt::format("--ros2 {}: {} is not determined, so its 95 % upper bound {:.4g} m^1/2 is written "
+                                "(a conservative covariance; back-and-forth runs and --meas-sigma would determine it)",
+                                o.ros2, name, value));
+  return out;
+}
+
 /// --plot, --report, --ros2; returns what was written.
 std::vector<std::string> WriteOutputs(const FitNoiseOptions& o, const Loaded& data, const FitResult& f,
                                       nlohmann::json& j) {
@@ -559,22 +653,27 @@ std::vector<std::string> WriteOutputs(const FitNoiseOptions& o, const Loaded& da
     written.push_back(o.report + " (HTML report)");
   }
   if (o.ros2.empty()) return written;
-  // diff_drive_controller covariance diagonals from the fitted noise.
-  const OdometryCovariance cov = OdometryCovarianceFromWheelNoise(s.k_L, s.k_R, *data.wheelbase_m, o.covariance);
-  CommandOutputs().Write(
-      o.ros2,
-      io::FormatDiffDriveCovariance(
-          o.controller, cov.pose, cov.twist,
-          {fmt::format("ros2_control diff_drive_controller covariance from umbmark fit-noise: k_L = {:.4g}, k_R = {:.4g} "
-                       "m^1/2, wheelbase {} m", s.k_L, s.k_R, *data.wheelbase_m),
-           fmt::format("stated for {} m/s at {} Hz updates (variances scale with speed; derivation: docs/ros2.md)",
-                       o.covariance.speed_mps, o.covariance.rate_hz),
-           fmt::format("{} = not measured by planar odometry (z, roll, pitch and rates); {} = lateral velocity "
-                       "(non-holonomic constraint)", kUnmeasuredVariance, kConstraintVariance)}));
+  // diff_drive_controller covariance diagonals from the fitted noise (an
+  // undetermined k at its 95 % upper bound, Ros2Noise).
+  const Ros2Noise k = Ros2NoiseOf(o, f);
+  const OdometryCovariance cov = OdometryCovarianceFromWheelNoise(k.k_L, k.k_R, *data.wheelbase_m, o.covariance);
+  std::vector<std::string> comment{
+      fmt::format("ros2_control diff_drive_controller covariance from umbmark fit-noise: k_L = {:.4g}, k_R = {:.4g} "
+                  "m^1/2, wheelbase {} m", k.k_L, k.k_R, *data.wheelbase_m)};
+  comment.insert(comment.end(), k.comments.begin(), k.comments.end());
+  comment.push_back(fmt::format("stated for {} m/s at {} Hz updates (variances scale with speed; derivation: docs/ros2.md)",
+                                o.covariance.speed_mps, o.covariance.rate_hz));
+  comment.push_back(fmt::format("{} = not measured by planar odometry (z, roll, pitch and rates); {} = lateral velocity "
+                                "(non-holonomic constraint)", kUnmeasuredVariance, kConstraintVariance));
+  CommandOutputs().Write(o.ros2, io::FormatDiffDriveCovariance(o.controller, cov.pose, cov.twist, comment));
   j["ros2"] = {{"file", o.ros2},
                {"controller", o.controller},
                {"rate_hz", o.covariance.rate_hz},
                {"speed_mps", o.covariance.speed_mps},
+               {"k_L", k.k_L},
+               {"k_R", k.k_R},
+               {"k_L_source", k.kL_source},
+               {"k_R_source", k.kR_source},
                {"pose_covariance_diagonal", cov.pose},
                {"twist_covariance_diagonal", cov.twist}};
   if (o.json.PrintText())
@@ -602,6 +701,7 @@ int RunFitNoise(const FitNoiseOptions& o) {
     throw InvalidOptions("--ros2 needs the robot's wheelbase (--robot or --wheelbase)");
   const FitResult f = Fit(o, data);
   nlohmann::json j = ResultJson(o, data, f);
+  for (const std::string& w : Ros2Warnings(o, f)) j["warnings"].push_back(w);  // throws (exit 3) before any output
   if (o.json.PrintText()) {
     PrintText(o, data, f, j);
   } else {

@@ -265,9 +265,11 @@ TEST_CASE("fit-noise CLI: k at the boundary is 'not determined'; --params and --
 }
 
 TEST_CASE("fit-noise CLI: E_d is kept at the means' value, with a warning, when the scatter does not fit", "[fit_noise][cli]") {
-  // 3000 trajectory runs of 1 m straight whose lateral error is NOT the
-  // wheel-noise model's (y = theta / 2 plus independent 0.3 mm): the joint
-  // fit would pull E_d far from 1 to bend the model onto the misfit.
+  // 3000 trajectory runs of 1 m forward and back (a path that retraces
+  // itself: the means do not show E_d, so its prior stays weak) whose
+  // lateral error is NOT the wheel-noise model's (y = theta / 2 plus
+  // independent 0.3 mm): the joint fit would pull E_d far from 1 to bend the
+  // model onto the misfit. (On straight runs the means pin E_d.)
   namespace fs = std::filesystem;
   const fs::path dir = fs::temp_directory_path() / fmt::format("umbmark_fit_noise_ed_{}", ::getpid());
   fs::create_directories(dir);
@@ -280,9 +282,9 @@ TEST_CASE("fit-noise CLI: E_d is kept at the means' value, with a warning, when 
   std::string csv = "run,direction,t_s,dist_left_m,dist_right_m,x_gt_m,y_gt_m,theta_gt_rad\n";
   for (int i = 1; i <= 3000; ++i) {
     const char* d = i % 2 ? "cw" : "ccw";
-    const double L = 1.0 + 0.001 * N01(rng), R = 1.0 + 0.001 * N01(rng), th = (R - L) / kB;
-    csv += fmt::format("{},{},0,0,0,0,0,0\n{},{},1,1.0,1.0,{:.9f},{:.9f},{:.9f}\n", i, d, i, d, 0.5 * (L + R),
-                       0.5 * th + 0.0003 * N01(rng), th);
+    const double L = 0.0014 * N01(rng), R = 0.0014 * N01(rng), th = (R - L) / kB;
+    csv += fmt::format("{},{},0,0,0,0,0,0\n{},{},1,1.0,1.0,1,0,0\n{},{},2,0.0,0.0,{:.9f},{:.9f},{:.9f}\n", i, d, i, d,
+                       i, d, 0.5 * (L + R), 0.5 * th + 0.0003 * N01(rng), th);
   }
   {
     std::ofstream f(dir / "straight.csv");

@@ -128,11 +128,34 @@ TEST_CASE("Odometry covariance from wheel noise: closed form vs Monte Carlo", "[
 
 TEST_CASE("fit-noise --ros2: the covariance diagonals of the fitted k_L, k_R as ROS 2 floats", "[ros2][cli]") {
   const fs::path dir = TempDir("ros2-noise");
-  const auto r = RunCli("fit-noise " + Q(ImportedBags() / "campaign.toml") + " --json - --ros2 " + Q(dir / "cov.yaml") +
-                        " --rate 25 --speed 0.3");
+  // Six squares with E_d estimated from the same runs leave one degree of
+  // freedom: k's 95 % upper bound (0.29 m^1/2) says nothing, so no
+  // covariance is written (exit 3, the hint names what would determine k).
+  const auto refused = RunCli("fit-noise " + Q(ImportedBags() / "campaign.toml") + " --ros2 " + Q(dir / "cov.yaml"));
+  CHECK(refused.status == 3);
+  CHECK(refused.err.find("is not determined by these 6 runs") != std::string::npos);
+  CHECK(refused.err.find("--params CAL.json") != std::string::npos);
+  CHECK(refused.err.find("--meas-sigma") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "cov.yaml"));
+  // With the calibration the fit keeps two degrees of freedom: k_L sits at
+  // 0 with an upper bound of 1.5e-3, and the covariance uses that bound.
+  const auto cal = RunCli("calibrate " + Q(ImportedBags() / "campaign.toml") + " --json " + Q(dir / "cal.json"));
+  REQUIRE(cal.status == 0);
+  const auto r = RunCli("fit-noise " + Q(ImportedBags() / "campaign.toml") + " --params " + Q(dir / "cal.json") +
+                        " --json - --ros2 " + Q(dir / "cov.yaml") + " --rate 25 --speed 0.3");
   REQUIRE(r.status == 0);
   const auto j = nlohmann::json::parse(r.out);
-  const double kl = j["k_L"], kr = j["k_R"];
+  REQUIRE_FALSE(j["k_L_determined"].get<bool>());
+  CHECK(j["ros2"]["k_L_source"] == "upper95");
+  CHECK(j["ros2"]["k_L"].get<double>() == j["k_L_upper95"].get<double>());
+  CHECK(j["ros2"]["k_L"].get<double>() > 100 * j["k_L"].get<double>());
+  CHECK(j["ros2"]["k_R"].get<double>() == j["k_R"].get<double>());
+  bool warned = false;
+  for (const auto& w : j["warnings"]) warned |= w.get<std::string>().find("95 % upper bound") != std::string::npos;
+  CHECK(warned);
+  const std::string yaml = umbmark::testing::Slurp((dir / "cov.yaml").string());
+  CHECK(yaml.find("# k_L is not determined by the runs") != std::string::npos);
+  const double kl = j["ros2"]["k_L"], kr = j["ros2"]["k_R"];
   const YAML::Node p = YAML::LoadFile((dir / "cov.yaml").string())["diff_drive_controller"]["ros__parameters"];
   REQUIRE(p["pose_covariance_diagonal"].size() == 6);
   REQUIRE(p["twist_covariance_diagonal"].size() == 6);

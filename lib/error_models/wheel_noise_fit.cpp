@@ -68,7 +68,7 @@ void CheckIdentifiable(const std::vector<WheelNoiseFitRun>& runs, const Grouping
 Eigen::Vector2d StartingPoint(const std::vector<WheelNoiseFitRun>& runs, const Grouping& grp) {
   PoseCovariance So = PoseCovariance::Zero(), SL = So, SR = So, SM = So;
   for (std::size_t i = 0; i < runs.size(); ++i) {
-    Eigen::Vector3d r = runs[i].error - grp.centre[static_cast<std::size_t>(grp.of_run[i])];
+    Eigen::Vector3d r = runs[i].error - runs[i].systematic - grp.centre[static_cast<std::size_t>(grp.of_run[i])];
     if (!runs[i].has_theta) r(2) = 0.0;
     So += r * r.transpose();
     SL += runs[i].basis.A_L;
@@ -108,7 +108,7 @@ void GoodnessOfFit(const LikelihoodModel& model, const Eigen::Vector3d& theta, W
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const WheelNoiseFitRun& r = runs[i];
     const PoseCovariance S = noise_fit::RunCovariance(model, i, qL, qR, eps);
-    Eigen::Vector3d res = r.error - mu[static_cast<std::size_t>(grp.of_run[i])];
+    Eigen::Vector3d res = r.error - r.systematic - mu[static_cast<std::size_t>(grp.of_run[i])];
     if (!r.has_theta) res(2) = std::numeric_limits<double>::quiet_NaN();
     out.residuals.push_back(res);
     out.predicted_run_covariance.push_back(S);
@@ -209,6 +209,13 @@ WheelNoiseFitSummary FitWheelNoise(const std::vector<WheelNoiseFitRun>& runs, co
   // 4. Group means, residuals and goodness of fit at the optimum.
   noise_fit::Evaluate(model, best.theta, &out.group_means);
   GoodnessOfFit(model, best.theta, out);
+  // Report each group's mean return error: mu_g plus its runs' average
+  // predicted systematic error.
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const auto g = static_cast<std::size_t>(grp.of_run[i]);
+    out.group_means[g].head<2>() += runs[i].systematic.head<2>() / grp.count[g];
+    if (runs[i].has_theta) out.group_means[g](2) += runs[i].systematic(2) / grp.count_theta[g];
+  }
   out.likelihood_passes = model.passes;
   return out;
 }

@@ -49,6 +49,16 @@
 
 namespace umbmark {
 
+/// The k^4 terms of S_i that the fit uses: second_order.hpp's LL, LR, RR
+/// (the fit's runs start with no heading uncertainty, so the p0 terms are
+/// zero). A third of SecondOrderBasis' size: with 10^6 runs and their E_d
+/// sensitivities that is 0.9 GB less.
+struct SecondOrderTerms {
+  PoseCovariance LL = PoseCovariance::Zero(), LR = PoseCovariance::Zero(), RR = PoseCovariance::Zero();
+  SecondOrderTerms() = default;
+  SecondOrderTerms(const SecondOrderBasis& b) : LL(b.LL), LR(b.LR), RR(b.RR) {}  // NOLINT: implicit on purpose
+};
+
 /// One run's data for the fit.
 struct WheelNoiseFitRun {
   std::string group;  ///< systematic-mean group (e.g. "fwd_back" or "exp2:cw")
@@ -62,7 +72,7 @@ struct WheelNoiseFitRun {
   CovarianceBasis basis;                            ///< motion covariance per unit k^2
   /// Second-order (heading-squared) term, k^4 terms of S_i (second_order.hpp);
   /// zero to fit the pure first-order model.
-  SecondOrderBasis second_order;
+  SecondOrderTerms second_order;
   PoseCovariance measurement = PoseCovariance::Zero();  ///< reference error covariance M_i
   /// What the odometry measured, per constant-curvature piece (left, right
   /// wheel travel [m] under the recorded robot) and the recorded wheelbase:
@@ -70,6 +80,22 @@ struct WheelNoiseFitRun {
   /// error. Empty when unknown.
   std::vector<WheelSegment> odometry_travel;
   double recorded_wheelbase_m = 0.0;
+  /// How RebuildNoiseRun (wheel_noise_fit_data.hpp) builds the bases from
+  /// odometry_travel: Kelly's form along the samples (trajectory runs) or
+  /// the closed forms along the pieces (commanded paths); with or without
+  /// the second-order terms.
+  bool kelly_basis = false;
+  bool with_second_order = false;
+  /// The group is the experiment's split by turning direction (":cw" /
+  /// ":ccw" appended by NoiseRunFromTrajectory), undone by
+  /// MergeLoneTurnGroups when a direction has a single run.
+  bool turn_grouped = false;
+  /// Predicted systematic return error of this run (uncorrected E_b, E_d
+  /// and scale along its own odometry travel; RebuildNoiseRun): run i's
+  /// mean is mu_g + systematic_i. Runs of one group that drove different
+  /// paths (free paths) have different systematic errors; one mean per
+  /// group would read their spread as wheel noise.
+  Eigen::Vector3d systematic = Eigen::Vector3d::Zero();
 };
 
 /// Covariance of the reference's error in a return error whose true
@@ -79,13 +105,15 @@ struct WheelNoiseFitRun {
 ///   M = diag(2 s_xy^2, 2 s_xy^2, s_th^2) + s_th^2 u u^T,  u = [y, -x, -1].
 PoseCovariance MeasurementCovariance(double sigma_xy_m, double sigma_theta_rad, const Pose2& relative);
 
-/// How run i's bases move with the diameter ratio E_d about the value E_d0
-/// they were built at: basis(E_d0 + eps) = basis + eps d1 + eps^2 d2 (and
-/// the same for the second-order terms); central differences of three
-/// builds (FitWheelNoiseWithSystematics).
+/// How run i's first-order bases move with the diameter ratio E_d about the
+/// value E_d0 they were built at: basis(E_d0 + eps) = basis + eps d1 +
+/// eps^2 d2; central differences of three builds
+/// (FitWheelNoiseWithSystematics). The second-order terms stay at E_d0:
+/// they are a correction of a few % whose own change over the fit's eps
+/// (under 0.001 at the optimum) is far below the noise, and leaving out
+/// their sensitivities saves 430 bytes per run.
 struct WheelNoiseRunSensitivity {
   CovarianceBasis d1, d2;
-  SecondOrderBasis q1, q2;
 };
 
 struct WheelNoiseFitOptions {
@@ -142,8 +170,10 @@ struct WheelNoiseFitSummary {
   int runs = 0;
   std::vector<std::string> groups;                 ///< group names, first-seen order
   std::vector<int> group_of_run;                   ///< index into `groups` of each run
-  std::vector<Eigen::Vector3d> group_means;        ///< fitted systematic means
-  std::vector<Eigen::Vector3d> residuals;          ///< e_i - mu_g(i), per run
+  /// Fitted mean return error of each group (mu_g plus the group's average
+  /// WheelNoiseFitRun::systematic).
+  std::vector<Eigen::Vector3d> group_means;
+  std::vector<Eigen::Vector3d> residuals;          ///< e_i - systematic_i - mu_g(i), per run
   std::vector<PoseCovariance> predicted_run_covariance;  ///< S_i at the fit
   std::vector<CovarianceElementCheck> goodness_of_fit;   ///< six elements
   PoseCovariance observed_covariance = PoseCovariance::Zero();

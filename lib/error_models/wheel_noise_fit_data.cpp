@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "core/angles.hpp"
 #include "core/errors.hpp"
@@ -19,89 +20,6 @@
 #include <Eigen/LU>
 
 namespace umbmark {
-
-std::vector<WheelNoiseFitRun> NoiseRunsFromEndpoints(const EndpointData& data, const std::vector<PathSegment>& path,
-                                                double wheelbase_m, const std::string& group_prefix,
-                                                const NoiseFitInputOptions& options) {
-  const std::vector<WheelSegment> wheels = ToWheelSegments(path, wheelbase_m);
-  // The path the true robot drove (see NoiseFitInputOptions::systematic).
-  const SystematicErrors& e = options.systematic;
-  std::vector<WheelSegment> true_wheels = wheels;
-  for (auto& w : true_wheels) w = {e.c_L * w.left_m, e.c_R * w.right_m};
-  const double true_wheelbase = e.E_b * wheelbase_m;
-  const PathCovarianceSummary pc =
-      PredictPathCovariance(true_wheels, true_wheelbase, WheelNoise{}, PoseCovariance::Zero());
-  SecondOrderBasis q2;
-  if (options.second_order) q2 = SecondOrderHeadingBasis(true_wheels, true_wheelbase);
-  const PoseCovariance M = MeasurementCovariance(options.sigma_xy_m, options.sigma_theta_rad, pc.mean);
-  std::vector<WheelNoiseFitRun> out;
-  for (const ReturnError& r : data.runs) {
-    WheelNoiseFitRun f;
-    f.group = group_prefix + r.direction;
-    f.run = r.run;
-    f.line = r.line;
-    f.has_theta = r.etheta_rad.has_value();
-    f.error = Eigen::Vector3d(r.ex_m, r.ey_m, f.has_theta ? WrapAngle(*r.etheta_rad) : 0.0);
-    f.basis = pc.motion;
-    f.second_order = q2;
-    f.measurement = M;
-    f.odometry_travel = wheels;
-    f.recorded_wheelbase_m = wheelbase_m;
-    out.push_back(f);
-  }
-  return out;
-}
-
-std::vector<WheelNoiseFitRun> NoiseRunsFromTrajectories(const TrajectoryData& data, const RobotParams& robot,
-                                                   const std::string& group_prefix,
-                                                   const NoiseFitInputOptions& options, int* skipped) {
-  std::vector<WheelNoiseFitRun> out;
-  int skip = 0;
-  for (const TrajectoryRun& run : data.runs) {
-    const std::size_t n = run.size();
-    if (n < 2 || !run.HasGroundTruth(0) || !run.HasGroundTruth(n - 1)) {
-      ++skip;
-      continue;
-    }
-    WheelTravel travel;
-    try {
-      travel = ComputeWheelTravel(run, robot, robot);
-    } catch (const InputError& e) {
-      throw InputError(data.path, run.lines.empty() ? 0 : run.lines.front(), 0, e.message());
-    }
-    // The true robot's travel and wheelbase (NoiseFitInputOptions::systematic).
-    const SystematicErrors& sys = options.systematic;
-    WheelTravel true_travel = travel;
-    for (double& v : true_travel.left_m) v *= sys.c_L;
-    for (double& v : true_travel.right_m) v *= sys.c_R;
-    const double true_wheelbase = sys.E_b * robot.wheelbase_m;
-    const TrajectoryCovarianceSummary kelly = TrajectoryCovariance(true_travel, true_wheelbase);
-    const Pose2 odo = IntegrateOdometry(travel, robot.wheelbase_m, Pose2{}).back();
-    const Pose2 gt = RelativeTo(run.GroundTruth(0), run.GroundTruth(n - 1));  // contract: GT in its first frame
-    WheelNoiseFitRun f;
-    f.group = group_prefix + run.direction;
-    // Runs without a cw/ccw label (e.g. circles both ways imported as one
-    // `free` experiment) are grouped by the way they turn: opposite
-    // directions have opposite systematic means, pooling them around one
-    // mean would read the difference as noise.
-    if (run.direction != "cw" && run.direction != "ccw" && std::abs(odo.theta) > 1.0) {
-      f.group += odo.theta < 0.0 ? ":cw" : ":ccw";
-    }
-    f.run = run.run;
-    f.line = run.lines.empty() ? 0 : run.lines.front();
-    f.error = Eigen::Vector3d(gt.x - odo.x, gt.y - odo.y, WrapAngle(gt.theta - odo.theta));
-    f.basis = kelly.motion;
-    if (options.second_order) f.second_order = SecondOrderHeadingBasis(true_travel, true_wheelbase);
-    f.measurement = MeasurementCovariance(options.sigma_xy_m, options.sigma_theta_rad, odo);
-    for (std::size_t i = 1; i < travel.left_m.size(); ++i) {
-      f.odometry_travel.push_back({travel.left_m[i] - travel.left_m[i - 1], travel.right_m[i] - travel.right_m[i - 1]});
-    }
-    f.recorded_wheelbase_m = robot.wheelbase_m;
-    out.push_back(f);
-  }
-  if (skipped) *skipped = skip;
-  return out;
-}
 
 namespace {
 
@@ -119,24 +37,173 @@ Eigen::Vector3d SystematicReturnError(const std::vector<WheelSegment>& travel, d
 
 }  // namespace
 
+void RebuildNoiseRun(WheelNoiseFitRun& r, const SystematicErrors& x) {
+  if (r.odometry_travel.empty()) return;
+  r.systematic = SystematicReturnError(r.odometry_travel, r.recorded_wheelbase_m, Eigen::Vector3d(x.E_b, x.c_L, x.c_R));
+  const double b = x.E_b * r.recorded_wheelbase_m;
+  if (r.kelly_basis) {
+    // Cumulative true wheel travel at every sample.
+    WheelTravel t;
+    t.left_m.reserve(r.odometry_travel.size() + 1);
+    t.right_m.reserve(r.odometry_travel.size() + 1);
+    double L = 0.0, R = 0.0;
+    t.left_m.push_back(0.0);
+    t.right_m.push_back(0.0);
+    for (const WheelSegment& w : r.odometry_travel) {
+      L += x.c_L * w.left_m;
+      R += x.c_R * w.right_m;
+      t.left_m.push_back(L);
+      t.right_m.push_back(R);
+    }
+    r.basis = TrajectoryCovariance(t, b).motion;
+    r.second_order = r.with_second_order ? SecondOrderTerms(SecondOrderHeadingBasis(t, b)) : SecondOrderTerms{};
+    return;
+  }
+  std::vector<WheelSegment> wheels = r.odometry_travel;
+  for (WheelSegment& w : wheels) w = {x.c_L * w.left_m, x.c_R * w.right_m};
+  r.basis = PredictPathCovariance(wheels, b, WheelNoise{}, PoseCovariance::Zero()).motion;
+  r.second_order = r.with_second_order ? SecondOrderTerms(SecondOrderHeadingBasis(wheels, b)) : SecondOrderTerms{};
+}
+
+std::vector<WheelNoiseFitRun> NoiseRunsFromEndpoints(const EndpointData& data, const std::vector<PathSegment>& path,
+                                                double wheelbase_m, const std::string& group_prefix,
+                                                const NoiseFitInputOptions& options) {
+  // One run template: the odometry's path, the bases along the path the
+  // true robot drove (see NoiseFitInputOptions::systematic), the reference
+  // noise at the path's end.
+  WheelNoiseFitRun t;
+  t.odometry_travel = ToWheelSegments(path, wheelbase_m);
+  t.recorded_wheelbase_m = wheelbase_m;
+  t.with_second_order = options.second_order;
+  RebuildNoiseRun(t, options.systematic);
+  const Pose2 end = PredictPathCovariance(t.odometry_travel, wheelbase_m, WheelNoise{}, PoseCovariance::Zero()).mean;
+  t.measurement = MeasurementCovariance(options.sigma_xy_m, options.sigma_theta_rad, end);
+  std::vector<WheelNoiseFitRun> out;
+  out.reserve(data.runs.size());
+  for (const ReturnError& r : data.runs) {
+    WheelNoiseFitRun f = t;
+    f.group = group_prefix + r.direction;
+    f.run = r.run;
+    f.line = r.line;
+    f.has_theta = r.etheta_rad.has_value();
+    f.error = Eigen::Vector3d(r.ex_m, r.ey_m, f.has_theta ? WrapAngle(*r.etheta_rad) : 0.0);
+    out.push_back(std::move(f));
+  }
+  return out;
+}
+
+std::optional<WheelNoiseFitRun> NoiseRunFromTrajectory(const TrajectoryRun& run, const std::string& path,
+                                                       const RobotParams& robot, const std::string& group_prefix,
+                                                       const NoiseFitInputOptions& options) {
+  const std::size_t n = run.size();
+  if (n < 2 || !run.HasGroundTruth(0) || !run.HasGroundTruth(n - 1)) return std::nullopt;
+  WheelTravel travel;
+  try {
+    travel = ComputeWheelTravel(run, robot, robot);
+  } catch (const InputError& e) {
+    throw InputError(path, run.lines.empty() ? 0 : run.lines.front(), 0, e.message());
+  }
+  const Pose2 odo = IntegrateOdometry(travel, robot.wheelbase_m, Pose2{}).back();
+  const Pose2 gt = RelativeTo(run.GroundTruth(0), run.GroundTruth(n - 1));  // contract: GT in its first frame
+  WheelNoiseFitRun f;
+  f.group = group_prefix + run.direction;
+  // Runs without a cw/ccw label (e.g. circles both ways imported as one
+  // `free` experiment) are grouped by the way they turn: opposite
+  // directions have opposite systematic means, pooling them around one
+  // mean would read the difference as noise.
+  if (run.direction != "cw" && run.direction != "ccw" && std::abs(odo.theta) > 1.0) {
+    f.group += odo.theta < 0.0 ? ":cw" : ":ccw";
+    f.turn_grouped = true;
+  }
+  f.run = run.run;
+  f.line = run.lines.empty() ? 0 : run.lines.front();
+  f.error = Eigen::Vector3d(gt.x - odo.x, gt.y - odo.y, WrapAngle(gt.theta - odo.theta));
+  f.measurement = MeasurementCovariance(options.sigma_xy_m, options.sigma_theta_rad, odo);
+  f.odometry_travel.reserve(travel.left_m.size() - 1);
+  for (std::size_t i = 1; i < travel.left_m.size(); ++i) {
+    f.odometry_travel.push_back({travel.left_m[i] - travel.left_m[i - 1], travel.right_m[i] - travel.right_m[i - 1]});
+  }
+  f.recorded_wheelbase_m = robot.wheelbase_m;
+  f.kelly_basis = true;
+  f.with_second_order = options.second_order;
+  // The bases along the path the true robot drove (NoiseFitInputOptions::systematic).
+  RebuildNoiseRun(f, options.systematic);
+  return f;
+}
+
+std::vector<WheelNoiseFitRun> NoiseRunsFromTrajectories(const TrajectoryData& data, const RobotParams& robot,
+                                                   const std::string& group_prefix,
+                                                   const NoiseFitInputOptions& options, int* skipped) {
+  std::vector<WheelNoiseFitRun> out;
+  int skip = 0;
+  for (const TrajectoryRun& run : data.runs) {
+    if (auto f = NoiseRunFromTrajectory(run, data.path, robot, group_prefix, options)) {
+      out.push_back(std::move(*f));
+    } else {
+      ++skip;
+    }
+  }
+  if (skipped) *skipped = skip;
+  MergeLoneTurnGroups(out);
+  return out;
+}
+
+void MergeLoneTurnGroups(std::vector<WheelNoiseFitRun>& runs) {
+  // Per experiment group (the name before the split): the runs of each part
+  // (not turning, ":cw", ":ccw"); a part with one run undoes the split.
+  auto base = [](const WheelNoiseFitRun& r) { return r.turn_grouped ? r.group.substr(0, r.group.rfind(':')) : r.group; };
+  std::map<std::string, bool> split_anywhere;
+  for (const WheelNoiseFitRun& r : runs)
+    if (r.turn_grouped) split_anywhere[base(r)] = true;
+  if (split_anywhere.empty()) return;
+  std::map<std::string, int> count;
+  for (const WheelNoiseFitRun& r : runs)
+    if (split_anywhere.count(base(r))) ++count[r.group];
+  std::map<std::string, bool> undo;
+  for (const WheelNoiseFitRun& r : runs)
+    if (split_anywhere.count(base(r)) && count[r.group] < 2) undo[base(r)] = true;
+  for (WheelNoiseFitRun& r : runs) {
+    if (!r.turn_grouped || !undo.count(base(r))) continue;
+    r.group = base(r);
+    r.turn_grouped = false;
+  }
+}
+
+
 SystematicErrors EstimateSystematicErrors(const std::vector<WheelNoiseFitRun>& runs,
                                           const WheelNoiseFitSummary& fit) {
   return EstimateSystematicErrorsWithSe(runs, fit).value;
 }
 
+namespace {
+
+/// Range of the odometry's heading along a run's travel [rad].
+double HeadingSweep(const std::vector<WheelSegment>& travel, double b) {
+  double th = 0.0, lo = 0.0, hi = 0.0;
+  for (const WheelSegment& w : travel) {
+    th += (w.right_m - w.left_m) / b;
+    lo = std::min(lo, th);
+    hi = std::max(hi, th);
+  }
+  return hi - lo;
+}
+
+}  // namespace
+
+// Gauss-Newton on sum_i (e_i - s_i(x))^T S_i^-1 (e_i - s_i(x)) + |x - 1|^2 /
+// 0.05^2 over x = (E_b, c_L, c_R), s_i(x) run i's noise-free return error
+// along its own odometry travel (SystematicReturnError), S_i the run's
+// covariance at the fit. For the runs of a group that all drove one path
+// this is the fit of the group's mean; runs of different paths (free paths)
+// each count with their own prediction.
 SystematicEstimate EstimateSystematicErrorsWithSe(const std::vector<WheelNoiseFitRun>& runs,
                                                   const WheelNoiseFitSummary& fit) {
-  // Per group: its fitted mean, the information of that mean (sum of the
-  // runs' inverse covariances; heading dropped for runs without it) and the
-  // runs that can predict it.
-  const std::size_t G = fit.groups.size();
-  std::vector<Eigen::Matrix3d> info(G, Eigen::Matrix3d::Zero());
-  std::vector<std::vector<std::size_t>> members(G);
+  // The runs that can predict their error, with their weights (heading
+  // dropped for runs without it).
+  std::vector<std::size_t> members;
+  std::vector<Eigen::Matrix3d> weight;
   for (std::size_t i = 0; i < runs.size() && i < fit.predicted_run_covariance.size(); ++i) {
     if (runs[i].odometry_travel.empty()) continue;
-    const auto g = static_cast<std::size_t>(
-        std::find(fit.groups.begin(), fit.groups.end(), runs[i].group) - fit.groups.begin());
-    if (g >= G) continue;
     Eigen::Matrix3d W = Eigen::Matrix3d::Zero();
     const PoseCovariance& S = fit.predicted_run_covariance[i];
     if (runs[i].has_theta) {
@@ -144,43 +211,42 @@ SystematicEstimate EstimateSystematicErrorsWithSe(const std::vector<WheelNoiseFi
     } else {
       W.topLeftCorner<2, 2>() = S.topLeftCorner<2, 2>().inverse();
     }
-    info[g] += W;
-    members[g].push_back(i);
+    members.push_back(i);
+    weight.push_back(W);
   }
-  auto model = [&](std::size_t g, const Eigen::Vector3d& x) {
-    Eigen::Vector3d m = Eigen::Vector3d::Zero();
-    for (std::size_t i : members[g]) m += SystematicReturnError(runs[i].odometry_travel, runs[i].recorded_wheelbase_m, x);
-    return Eigen::Vector3d(m / static_cast<double>(members[g].size()));
-  };
-  // Gauss-Newton with a weak prior (sigma 0.05) towards 1, central
-  // differences for the 3 x 3 Jacobian of each group's mean.
   constexpr double kPriorSigma = 0.05;
-  Eigen::Vector3d x(1.0, 1.0, 1.0);
-  bool any = false;
-  for (std::size_t g = 0; g < G; ++g) any = any || !members[g].empty();
   SystematicEstimate out;
-  if (!any) {
+  for (const WheelNoiseFitRun& r : runs)
+    if (!out.turns && r.recorded_wheelbase_m > 0.0 && HeadingSweep(r.odometry_travel, r.recorded_wheelbase_m) > kTurnRad)
+      out.turns = true;
+  if (members.empty()) {
     out.E_b_se = kPriorSigma;
+    out.E_d_se_means = kPriorSigma;
     out.E_b_determined = false;
     return out;
   }
+  auto predict = [&](std::size_t i, const Eigen::Vector3d& x) {
+    return SystematicReturnError(runs[i].odometry_travel, runs[i].recorded_wheelbase_m, x);
+  };
+  Eigen::Vector3d x(1.0, 1.0, 1.0);
   Eigen::Matrix3d H_last = Eigen::Matrix3d::Identity() / (kPriorSigma * kPriorSigma);
   for (int it = 0; it < 20; ++it) {
     Eigen::Matrix3d H = Eigen::Matrix3d::Identity() / (kPriorSigma * kPriorSigma);
     Eigen::Vector3d grad = (x - Eigen::Vector3d::Ones()) / (kPriorSigma * kPriorSigma);
-    for (std::size_t g = 0; g < G; ++g) {
-      if (members[g].empty()) continue;
-      const Eigen::Vector3d r = model(g, x) - fit.group_means[g];
+    for (std::size_t m = 0; m < members.size(); ++m) {
+      const std::size_t i = members[m];
+      Eigen::Vector3d r = predict(i, x) - runs[i].error;
+      r(2) = WrapAngle(r(2));
       Eigen::Matrix3d J;
-      for (int k = 0; k < 3; ++k) {
+      for (int k = 0; k < 3; ++k) {  // central differences
         const double h = 1e-6;
         Eigen::Vector3d xp = x, xm = x;
         xp(k) += h;
         xm(k) -= h;
-        J.col(k) = (model(g, xp) - model(g, xm)) / (2.0 * h);
+        J.col(k) = (predict(i, xp) - predict(i, xm)) / (2.0 * h);
       }
-      H += J.transpose() * info[g] * J;
-      grad += J.transpose() * info[g] * r;
+      H += J.transpose() * weight[m] * J;
+      grad += J.transpose() * weight[m] * r;
     }
     const Eigen::Vector3d step = H.ldlt().solve(grad);
     x -= step;
@@ -189,39 +255,45 @@ SystematicEstimate EstimateSystematicErrorsWithSe(const std::vector<WheelNoiseFi
     if (step.norm() < 1e-10) break;
   }
   out.value = {x(0), x(1), x(2)};
-  // Posterior standard deviation of E_b: near the prior's, the means do not see it.
-  out.E_b_se = std::sqrt(std::max(H_last.inverse()(0, 0), 0.0));
+  // Posterior standard deviations: near the prior's, the runs do not show it.
+  const Eigen::Matrix3d C = H_last.inverse();
+  out.E_b_se = std::sqrt(std::max(C(0, 0), 0.0));
   out.E_b_determined = out.E_b_se < 0.5 * kPriorSigma;
+  const Eigen::Vector3d g(0.0, -x(2) / (x(1) * x(1)), 1.0 / x(1));  // d(c_R / c_L) / dx
+  out.E_d_se_means = std::sqrt(std::max(g.dot(C * g), 0.0));
   return out;
 }
 
 namespace {
 
-/// Per-run sensitivities of the bases to E_d (WheelNoiseRunSensitivity) by
-/// central differences of builds at E0 - h and E0 + h about `centre` (built
-/// at E0); one extra build is alive at a time.
+/// Per-run sensitivities of the first-order bases to E_d
+/// (WheelNoiseRunSensitivity) by central differences of rebuilds at
+/// `lo` and `hi` (E_d0 -+ h) of each run built at E_d0: one run's copy at a
+/// time, so memory stays at one set of runs.
 std::vector<WheelNoiseRunSensitivity> Sensitivities(const std::vector<WheelNoiseFitRun>& centre,
-                                                    const std::function<std::vector<WheelNoiseFitRun>(double)>& at,
-                                                    double E0, double h) {
+                                                    const SystematicErrors& lo, const SystematicErrors& hi, double h) {
   std::vector<WheelNoiseRunSensitivity> s(centre.size());
-  for (const double sign : {-1.0, 1.0}) {
-    const std::vector<WheelNoiseFitRun> side = at(E0 + sign * h);
-    if (side.size() != centre.size()) throw std::logic_error("fit-noise: builds differ in their runs");
-    for (std::size_t i = 0; i < side.size(); ++i) {
-      const WheelNoiseFitRun &c = centre[i], &r = side[i];
-      WheelNoiseRunSensitivity& d = s[i];
-      auto add = [&](PoseCovariance& d1, PoseCovariance& d2, const PoseCovariance& v, const PoseCovariance& v0) {
-        d1 += sign / (2.0 * h) * v;                        // (f+ - f-) / 2h
-        d2 += (v - v0) / (2.0 * h * h);                    // (f+ - 2 f0 + f-) / 2h^2
-      };
-      add(d.d1.A_L, d.d2.A_L, r.basis.A_L, c.basis.A_L);
-      add(d.d1.A_R, d.d2.A_R, r.basis.A_R, c.basis.A_R);
-      add(d.q1.LL, d.q2.LL, r.second_order.LL, c.second_order.LL);
-      add(d.q1.LR, d.q2.LR, r.second_order.LR, c.second_order.LR);
-      add(d.q1.RR, d.q2.RR, r.second_order.RR, c.second_order.RR);
+  WheelNoiseFitRun side;
+  for (std::size_t i = 0; i < centre.size(); ++i) {
+    const WheelNoiseFitRun& c = centre[i];
+    WheelNoiseRunSensitivity& d = s[i];
+    side.odometry_travel = c.odometry_travel;
+    side.recorded_wheelbase_m = c.recorded_wheelbase_m;
+    side.kelly_basis = c.kelly_basis;
+    side.with_second_order = false;  // only the first-order bases move (WheelNoiseRunSensitivity)
+    for (const double sign : {-1.0, 1.0}) {
+      RebuildNoiseRun(side, sign < 0.0 ? lo : hi);
+      d.d1.A_L += sign / (2.0 * h) * side.basis.A_L;  // (f+ - f-) / 2h
+      d.d1.A_R += sign / (2.0 * h) * side.basis.A_R;
+      d.d2.A_L += (side.basis.A_L - c.basis.A_L) / (2.0 * h * h);  // (f+ - 2 f0 + f-) / 2h^2
+      d.d2.A_R += (side.basis.A_R - c.basis.A_R) / (2.0 * h * h);
     }
   }
   return s;
+}
+
+void RebuildAll(std::vector<WheelNoiseFitRun>& runs, const SystematicErrors& x) {
+  for (WheelNoiseFitRun& r : runs) RebuildNoiseRun(r, x);
 }
 
 }  // namespace
@@ -231,32 +303,30 @@ std::vector<WheelNoiseRunSensitivity> Sensitivities(const std::vector<WheelNoise
 // by Fisher scoring; recentred at the fitted E_d until the offset is under a
 // quarter of the difference step (the quadratic expansion is then exact to
 // far below the noise); (3) the final fit with E_d profiled in the intervals.
-WheelNoiseFitSummary FitWheelNoiseWithSystematics(
-    const std::function<std::vector<WheelNoiseFitRun>(const SystematicErrors&)>& build,
-    const WheelNoiseFitOptions& options, SystematicEstimate* estimated) {
+WheelNoiseFitSummary FitWheelNoiseWithSystematics(std::vector<WheelNoiseFitRun>& runs,
+                                                  const WheelNoiseFitOptions& options, SystematicEstimate* estimated) {
   WheelNoiseFitOptions quick = options;
   quick.intervals = false;
   quick.progress = nullptr;  // only the final fit reports (its stages are the long part)
-  SystematicEstimate from_means;
-  {
-    const std::vector<WheelNoiseFitRun> runs0 = build(SystematicErrors{});
-    from_means = EstimateSystematicErrorsWithSe(runs0, FitWheelNoise(runs0, quick));
-  }
+  const SystematicEstimate from_means = EstimateSystematicErrorsWithSe(runs, FitWheelNoise(runs, quick));
   const SystematicErrors& m = from_means.value;
   const double scale = 0.5 * (m.c_L + m.c_R), E_means = m.c_R / m.c_L;
   auto with_ed = [&](double E_d) {
     return SystematicErrors{m.E_b, 2.0 * scale / (E_d + 1.0), 2.0 * scale * E_d / (E_d + 1.0)};
   };
-  auto at = [&](double E_d) { return build(with_ed(E_d)); };
   constexpr double kStep = 0.004;  // difference step in E_d
   double E0 = E_means;
   WheelNoiseFitSummary out;
   bool determined = true;
   for (int pass = 0;; ++pass) {
-    const std::vector<WheelNoiseFitRun> runs = at(E0);
-    const std::vector<WheelNoiseRunSensitivity> sens = Sensitivities(runs, at, E0, kStep);
+    RebuildAll(runs, with_ed(E0));
+    const std::vector<WheelNoiseRunSensitivity> sens = Sensitivities(runs, with_ed(E0 - kStep), with_ed(E0 + kStep), kStep);
     WheelNoiseFitOptions o = quick;
+    // The prior on E_d is what the runs' means say about it (its standard
+    // error, at most the weak default): the scatter refines E_d only where
+    // the means leave it open (a path that retraces itself).
     o.E_d_prior_centre = E_means - E0;
+    o.E_d_prior_sigma = std::min(options.E_d_prior_sigma, std::max(from_means.E_d_se_means, 1e-6));
     const WheelNoiseFitSummary f = FitWheelNoise(runs, o, &sens);
     if (std::abs(E0 + f.E_d_offset - E_means) > kMaxJointEdShift) {
       determined = false;  // keep the means' E_d (see SystematicEstimate::E_d_determined)
@@ -273,7 +343,10 @@ WheelNoiseFitSummary FitWheelNoiseWithSystematics(
     out.likelihood_passes += options.intervals ? f.likelihood_passes : 0;
     break;
   }
-  if (!determined) out = FitWheelNoise(at(E_means), options);
+  if (!determined) {
+    RebuildAll(runs, with_ed(E_means));
+    out = FitWheelNoise(runs, options);
+  }
   if (estimated) {
     *estimated = from_means;
     estimated->value = with_ed(E0 + out.E_d_offset);
@@ -281,6 +354,13 @@ WheelNoiseFitSummary FitWheelNoiseWithSystematics(
     estimated->E_d_determined = determined;
   }
   return out;
+}
+
+WheelNoiseFitSummary FitWheelNoiseWithSystematics(
+    const std::function<std::vector<WheelNoiseFitRun>(const SystematicErrors&)>& build,
+    const WheelNoiseFitOptions& options, SystematicEstimate* estimated) {
+  std::vector<WheelNoiseFitRun> runs = build(SystematicErrors{});
+  return FitWheelNoiseWithSystematics(runs, options, estimated);
 }
 
 }  // namespace umbmark

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -63,15 +64,26 @@ struct SystematicEstimate {
   /// Standard error of E_d (joint fit: the scatter's Fisher information,
   /// with the prior) and of E_b (from the group means and the prior).
   double E_d_se = 0.0, E_b_se = 0.0;
+  /// Standard error of E_d from the runs' mean return errors alone (with
+  /// the weak prior): what the joint fit's prior on E_d is.
+  double E_d_se_means = 0.0;
   /// false: the groups' means do not show E_b (no turn in the design, e.g.
   /// straight forward and back): E_b stays at the prior's 1 and k is
   /// relative to the recorded wheelbase (give the calibration to fix it).
   bool E_b_determined = true;
+  /// Some run's odometry heading sweeps more than kTurnRad (a turn): when
+  /// E_b is not determined although the design turns, the runs are too few
+  /// or too noisy for their means to show it (not a design without turns).
+  bool turns = false;
   /// false: the scatter pulled E_d further than kMaxJointEdShift from the
   /// means' value (the model does not fit the scatter, or the design says
   /// nothing about E_d); the fit then keeps the means' E_d.
   bool E_d_determined = true;
 };
+
+/// Heading sweep [rad] of a run's odometry that counts as a turn
+/// (SystematicEstimate::turns).
+inline constexpr double kTurnRad = 0.5;
 
 /// Largest shift of E_d the scatter may make from the value the group means
 /// give (an uncalibrated robot's E_d is within a few percent of 1).
@@ -96,11 +108,38 @@ WheelNoiseFitSummary FitWheelNoiseWithSystematics(
     const std::function<std::vector<WheelNoiseFitRun>(const SystematicErrors&)>& build,
     const WheelNoiseFitOptions& options, SystematicEstimate* estimated);
 
+/// The same joint fit on runs built without systematic errors (the
+/// default NoiseFitInputOptions::systematic), each rebuilt in place
+/// (RebuildNoiseRun) instead of building all runs again: memory for one set
+/// of runs and their E_d sensitivities, the data read once (10^6 runs).
+/// On return the runs' bases are those of the estimated errors.
+WheelNoiseFitSummary FitWheelNoiseWithSystematics(std::vector<WheelNoiseFitRun>& runs,
+                                                  const WheelNoiseFitOptions& options, SystematicEstimate* estimated);
+
+/// Rebuilds a run's bases (first- and second-order) for the true robot with
+/// systematic errors `x` (wheel travel c times odometry_travel, wheelbase
+/// E_b times recorded_wheelbase_m), the way the builders below made them
+/// (kelly_basis, with_second_order). The return error and the reference
+/// covariance stay. A run without odometry_travel is left unchanged.
+void RebuildNoiseRun(WheelNoiseFitRun& run, const SystematicErrors& x);
+
 /// One run per endpoint row; `path` is what every run drove (wheelbase_m
 /// resolves turn segments). Rows without etheta use the x-y block.
 std::vector<WheelNoiseFitRun> NoiseRunsFromEndpoints(const EndpointData& data, const std::vector<PathSegment>& path,
                                                 double wheelbase_m, const std::string& group_prefix,
                                                 const NoiseFitInputOptions& options);
+
+/// The fit run of one trajectory run (`path`, `robot` as below); nullopt
+/// when the run lacks ground truth at its first or last sample.
+std::optional<WheelNoiseFitRun> NoiseRunFromTrajectory(const TrajectoryRun& run, const std::string& path,
+                                                       const RobotParams& robot, const std::string& group_prefix,
+                                                       const NoiseFitInputOptions& options);
+
+/// Undoes the turning-direction split (WheelNoiseFitRun::turn_grouped) of
+/// a direction with a single run: its systematic mean would absorb that
+/// run. NoiseRunsFromTrajectories calls it; call it after gathering runs of
+/// NoiseRunFromTrajectory.
+void MergeLoneTurnGroups(std::vector<WheelNoiseFitRun>& runs);
 
 /// One run per trajectory run that has ground truth at its first and last
 /// sample (others are counted in *skipped). Throws InputError (data.path)

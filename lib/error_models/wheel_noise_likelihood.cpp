@@ -21,7 +21,7 @@ using Bases = std::array<const PoseCovariance*, 5>;
 
 /// The five matrices S_i is linear in, with coefficients
 /// (q_L, q_R, q_L^2, q_L q_R, q_R^2): first-order bases, second-order terms.
-Bases BasesOf(const CovarianceBasis& a, const SecondOrderBasis& q) { return {&a.A_L, &a.A_R, &q.LL, &q.LR, &q.RR}; }
+Bases BasesOf(const CovarianceBasis& a, const SecondOrderTerms& q) { return {&a.A_L, &a.A_R, &q.LL, &q.LR, &q.RR}; }
 
 /// The five matrices at eps, and their derivative in eps.
 void BasesAt(const LikelihoodModel& m, std::size_t i, double eps, std::array<PoseCovariance, 5>& B,
@@ -33,10 +33,15 @@ void BasesAt(const LikelihoodModel& m, std::size_t i, double eps, std::array<Pos
     return;
   }
   const WheelNoiseRunSensitivity& s = (*m.sensitivity)[i];
-  const Bases b1 = BasesOf(s.d1, s.q1), b2 = BasesOf(s.d2, s.q2);
+  const std::array<const PoseCovariance*, 2> b1{&s.d1.A_L, &s.d1.A_R}, b2{&s.d2.A_L, &s.d2.A_R};
   for (std::size_t k = 0; k < 5; ++k) {
-    B[k] = *b0[k] + eps * *b1[k] + (eps * eps) * *b2[k];
-    if (dB) (*dB)[k] = *b1[k] + (2.0 * eps) * *b2[k];
+    if (k < 2) {
+      B[k] = *b0[k] + eps * *b1[k] + (eps * eps) * *b2[k];
+      if (dB) (*dB)[k] = *b1[k] + (2.0 * eps) * *b2[k];
+    } else {  // second-order terms: fixed at E_d0 (WheelNoiseRunSensitivity)
+      B[k] = *b0[k];
+      if (dB) (*dB)[k].setZero();
+    }
   }
 }
 
@@ -85,8 +90,9 @@ Grouping MakeGroups(const std::vector<WheelNoiseFitRun>& runs) {
   g.centre.assign(g.names.size(), Eigen::Vector3d::Zero());
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const auto k = static_cast<std::size_t>(g.of_run[i]);
-    g.centre[k].head<2>() += runs[i].error.head<2>() / g.count[k];
-    if (runs[i].has_theta) g.centre[k](2) += runs[i].error(2) / g.count_theta[k];
+    const Eigen::Vector3d e = runs[i].error - runs[i].systematic;
+    g.centre[k].head<2>() += e.head<2>() / g.count[k];
+    if (runs[i].has_theta) g.centre[k](2) += e(2) / g.count_theta[k];
   }
   return g;
 }
@@ -136,7 +142,7 @@ Evaluation Evaluate(const LikelihoodModel& m, const Eigen::Vector3d& theta, std:
     double logdet = 0.0;
     if (!InverseAndLogDet(S, r.has_theta, Si, logdet)) return ev;
     const auto g = static_cast<std::size_t>(grp.of_run[i]);
-    const Eigen::Vector3d d = r.error - grp.centre[g];  // d(2) meets only zeros of Si without etheta
+    const Eigen::Vector3d d = r.error - r.systematic - grp.centre[g];  // d(2) meets only zeros of Si without etheta
     const Eigen::Vector3d Sd = Si * d;
     GroupSums& gs = sums[g];
     gs.W += Si;
