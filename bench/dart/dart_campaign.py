@@ -1,0 +1,677 @@
+#!/usr/bin/python3
+"""Physics-engine campaigns for validating `umbmark diagnose` (issue 21).
+
+A differential-drive robot simulated in DART 6.12 (Debian `python3-dartpy`;
+run with /usr/bin/python3): a chassis on a free joint, two driven spherical
+wheels on revolute joints with velocity actuators (real point contact with
+Coulomb friction against the floor), and a castor (a frictionless ball, or a
+swivel castor: a fork on a vertical revolute joint with bearing friction and
+a trailing castor wheel).  The controller drives each leg, spot turn and arc
+on its own odometry (encoder ticks of the TRUE wheel angles, NOMINAL wheel
+diameters and wheelbase) and stops it when the odometry says the target is
+reached.  Motion capture samples the engine's true pose of the axle midpoint
+(or of a marker), adds white noise, and may be late (clock offsets).
+
+One class per physical cause (see CLASSES).  Besides the campaign (manifest
+TOML + trajectory CSVs in the contract format) the generator writes
+`truth.csv` (one row per motion: the TRUE pose change against ideal rolling
+from the true wheel angles, split into start / steady / stop phases) and
+`truth.md` (its summary and the expected verdict), the measured evidence for
+the expected answer.
+
+Usage: dart_campaign.py CLASS SEED OUTDIR [--quick]
+"""
+import argparse
+import math
+import os
+import sys
+
+import numpy as np
+import dartpy as dart
+
+DT = 0.002           # engine step (s); contact is exact sphere-box (DART detector)
+RATE = 20.0          # encoder / motion-capture sample rate of squares and back-and-forth runs (Hz)
+FREE_RATE = 50.0     # ... of the free paths (figure eights)
+FREE_SPEED = 0.2     # m/s along the figure eights
+G = 9.81
+WHEEL_MU_SWIVEL = 0.275   # castor classes: drive-wheel grip just under the slip threshold
+
+# Expected verdict per class, decided from the physics (truth.md checks it).
+CLASSES = {
+    "clean": "none",
+    "stop_slide": "stop_slide",
+    "swivel_castor": "castor_swivel",
+    "offset_castor": "castor_kick",
+    "floor_strips": "bump_outliers",
+    "turn_scrub": "turn_scrub",
+    "marker_offset": "gt_offset",
+    "clock_fixed": "time_offset",
+    "clock_per_run": "run_time_offset",
+    "eccentric_hubs": "unexplained",
+}
+
+
+def iso(t=(0.0, 0.0, 0.0), yaw=None):
+    T = dart.math.Isometry3()
+    T.set_identity()
+    T.set_translation(np.array(t, float))
+    if yaw is not None:
+        c, s = math.cos(yaw), math.sin(yaw)
+        T.set_rotation(np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]))
+    return T
+
+
+def wrap(a):
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def box_inertia(m, x, y, z):
+    return np.diag([m * (y * y + z * z) / 12, m * (x * x + z * z) / 12, m * (x * x + y * y) / 12])
+
+
+class Config:
+    """Everything one campaign is made of, drawn from the class and the seed."""
+
+    def __init__(self, cls, seed, quick):
+        rng = np.random.default_rng(seed)
+        self.cls, self.seed = cls, seed
+        U = rng.uniform
+        # Nominal robot (what the odometry uses) -- a robot unlike the bundled one.
+        self.b_nom = round(U(0.26, 0.36), 3)
+        self.d_nom = round(U(0.09, 0.12), 4)
+        self.d_nom_drawn = self.d_nom
+        # Fine encoders: the runs of a campaign are identical noise-free copies,
+        # and at 2048 ticks/rev their quantisation phases lock in the figure
+        # eights (0.5 mm along track over 5 m, read by diagnose as a gap).
+        self.ticks = int(rng.choice([8192, 16384]))
+        # True robot: wrong diameter ratio and wheelbase in every class (E_d, E_b).
+        ed = 1.0 + rng.choice([-1, 1]) * U(0.002, 0.005)
+        self.eb = 1.0 + rng.choice([-1, 1]) * U(0.01, 0.03)
+        mean_d = self.d_nom             # no common diameter error: E_d and E_b only
+        # E_d = D_R / D_L (ratio of true diameters relative to the nominal ratio 1)
+        self.r_left = mean_d / 2.0 * 2.0 / (ed + 1.0)
+        self.r_right = mean_d / 2.0 * 2.0 / (1.0 / ed + 1.0)
+        self.b_true = self.b_nom * self.eb
+        self.mass = U(4.0, 7.0)
+        # Motion: speeds and accelerations well inside the floor's grip.
+        self.v = U(0.25, 0.35)
+        self.w = U(0.9, 1.3)
+        self.acc = 0.6
+        self.alpha = 2.0
+        self.hard_stop = False        # wheels stop at once (braked) instead of ramping down
+        self.abrupt_turn_start = False
+        self.mu = 0.9                 # floor
+        self.wheel_mu = 1.5           # wheel tyres (a contact takes the smaller of the two)
+        self.castor_mu = 1.5
+        self.castor_trail = 0.025
+        self.castor = "ball"
+        self.castor_y = 0.0
+        self.swivel_friction = 0.0
+        self.strips = False
+        self.ecc = 0.0
+        self.marker = (0.0, 0.0)
+        self.tau = 0.0
+        self.tau_sd = 0.0
+        # Motion capture noise (stated in the manifest).
+        self.sig_xy = 0.0002
+        self.sig_th = 0.0005
+        # Campaign size.
+        self.side = 1.0
+        self.n_square = 2 if quick else 4       # per direction
+        self.fb_dist = 1.2
+        self.n_fb = 2 if quick else 4
+        self.n_free = 2
+        self.pause = 0.6
+        self.settle = 1.0
+        self._apply_class(rng)
+
+    def _apply_class(self, rng):
+        U = rng.uniform
+        c = self.cls
+        if c == "stop_slide":
+            # Hard braking (wheels locked at once) on a low-friction floor; the
+            # chassis coasts ~ v^2 / (2 mu_eff g) after legs and turns on after turns.
+            self.mu = U(0.55, 0.70)
+            self.hard_stop = True
+            self.acc, self.alpha = 0.8, 2.0
+            self.v = U(0.28, 0.32)
+            self.w = U(0.85, 0.95)
+        elif c in ("swivel_castor", "offset_castor"):
+            # A rubber swivel castor (trail 3 cm, bearing friction) on hard, low-grip
+            # drive wheels: when the castor swings back at a start it pulls one
+            # wheel past its grip, a brief slip turns the robot.  Without slip
+            # (grippy wheels) an ideal castor moves nothing the odometry misses.
+            # The slip threshold is sharp (rigid Coulomb contact: below it nothing,
+            # 0.02 in grip lower kicks of 10+ mrad), so the robot is fixed and the
+            # grip sits just under its threshold (0.29 for this robot).
+            self.b_nom, self.d_nom, self.mass, self.ticks = 0.30, 0.10, 5.5, 8192
+            self.b_true = self.b_nom * self.eb
+            self.r_left, self.r_right = self.r_left / self.d_nom_drawn * 0.10, self.r_right / self.d_nom_drawn * 0.10
+            self.castor = "swivel"
+            self.mu, self.castor_mu, self.wheel_mu = 1.0, 1.0, WHEEL_MU_SWIVEL
+            self.swivel_friction = U(0.14, 0.16)
+            self.castor_trail = 0.03
+            self.acc = 1.0
+            if c == "offset_castor":
+                self.castor_y = U(0.025, 0.035) * rng.choice([-1, 1])
+        elif c == "floor_strips":
+            self.strips = True
+        elif c == "turn_scrub":
+            # Fast spot turns started at full rate on a slippery floor: the wheels
+            # spin up before the chassis follows.
+            self.mu = U(0.45, 0.55)
+            self.w = U(1.15, 1.3)
+            self.abrupt_turn_start = True
+            self.acc = 0.4
+        elif c == "marker_offset":
+            ang = U(0, 2 * math.pi)
+            rad = U(0.004, 0.008)
+            self.marker = (rad * math.cos(ang), rad * math.sin(ang))
+        elif c == "clock_fixed":
+            self.tau = U(0.02, 0.04) * rng.choice([-1, 1])
+        elif c == "clock_per_run":
+            self.tau_sd = U(0.03, 0.04)
+        elif c == "eccentric_hubs":
+            self.ecc = U(0.0008, 0.0012)
+        elif c != "clean":
+            raise SystemExit(f"unknown class {c}; one of {', '.join(CLASSES)}")
+
+
+class Robot:
+    """The DART world: floor, chassis, two driven wheels, castor."""
+
+    def __init__(self, cfg):
+        self.cfg = cfg
+        self.world = dart.simulation.World()
+        self.world.setTimeStep(DT)
+        self.world.setGravity([0.0, 0.0, -G])
+        floor = dart.dynamics.Skeleton("floor")
+        j, body = floor.createWeldJointAndBodyNodePair()
+        self._box(body, (40.0, 40.0, 0.1), (0.0, 0.0, -0.05), cfg.mu)
+        self.world.addSkeleton(floor)
+        self.r_mean = 0.5 * (cfg.r_left + cfg.r_right)
+        self.skel = dart.dynamics.Skeleton("robot")
+        fj, self.chassis = self.skel.createFreeJointAndBodyNodePair()
+        self.chassis.setInertia(dart.dynamics.Inertia(
+            cfg.mass, [-0.04, 0.0, 0.01], box_inertia(cfg.mass, 0.40, cfg.b_true, 0.12)))
+        self.wheels = []
+        phase = [0.0, 2.1]
+        for i, (r, y) in enumerate(((cfg.r_left, cfg.b_true / 2), (cfg.r_right, -cfg.b_true / 2))):
+            wj, wb = self.skel.createRevoluteJointAndBodyNodePair(self.chassis)
+            wj.setTransformFromParentBodyNode(iso((0.0, y, 0.0)))
+            wj.setAxis([0.0, 1.0, 0.0])
+            wb.setInertia(dart.dynamics.Inertia(0.4, [0.0, 0.0, 0.0], np.diag([8e-4, 1.5e-3, 8e-4])))
+            off = (cfg.ecc * math.cos(phase[i]), 0.0, cfg.ecc * math.sin(phase[i]))
+            self._sphere(wb, r, off, cfg.wheel_mu)
+            wj.setActuatorType(dart.dynamics.RevoluteJoint.ActuatorType.VELOCITY)
+            wj.setForceUpperLimit(0, 60.0)
+            wj.setForceLowerLimit(0, -60.0)
+            self.wheels.append(wj)
+        self._castor()
+        self.world.addSkeleton(self.skel)
+        self.world.getConstraintSolver().setCollisionDetector(dart.collision.DARTCollisionDetector())
+        q = self.skel.getPositions()
+        q[5] = self.r_mean + 0.0003
+        self.skel.setPositions(q)
+        self.strips = []
+
+    swivel = None
+
+    @staticmethod
+    def _box(body, size, pos, mu):
+        sn = body.createShapeNode(dart.dynamics.BoxShape(list(size)))
+        sn.setRelativeTransform(iso(pos))
+        sn.createCollisionAspect()
+        sn.createDynamicsAspect().setFrictionCoeff(mu)
+
+    @staticmethod
+    def _sphere(body, r, pos, mu):
+        sn = body.createShapeNode(dart.dynamics.SphereShape(r))
+        sn.setRelativeTransform(iso(pos))
+        sn.createCollisionAspect()
+        sn.createDynamicsAspect().setFrictionCoeff(mu)
+
+    def _castor(self):
+        cfg, rc, xc = self.cfg, 0.02, -0.22
+        if cfg.castor == "ball":
+            # frictionless ball castor: carries load, no force in the plane
+            self._sphere(self.chassis, rc, (xc, cfg.castor_y, -(self.r_mean - rc)), 0.0)
+            return
+        # swivel castor: vertical swivel axis, fork with trail, castor wheel on an axle
+        sj, fork = self.skel.createRevoluteJointAndBodyNodePair(self.chassis)
+        sj.setTransformFromParentBodyNode(iso((xc, cfg.castor_y, -self.r_mean + rc + 0.03)))
+        sj.setAxis([0.0, 0.0, 1.0])
+        sj.setCoulombFriction(0, cfg.swivel_friction)
+        sj.setDampingCoefficient(0, 0.002)
+        fork.setInertia(dart.dynamics.Inertia(0.08, [-0.01, 0.0, -0.015], np.diag([2e-5, 2e-5, 2e-5])))
+        cj, cw = self.skel.createRevoluteJointAndBodyNodePair(fork)
+        cj.setTransformFromParentBodyNode(iso((-cfg.castor_trail, 0.0, -0.03)))
+        cj.setAxis([0.0, 1.0, 0.0])
+        cw.setInertia(dart.dynamics.Inertia(0.05, [0.0, 0.0, 0.0], np.diag([1e-5, 1e-5, 1e-5])))
+        self._sphere(cw, rc, (0.0, 0.0, 0.0), cfg.castor_mu)
+        self.swivel = sj
+
+    def add_strip(self, x, y, yaw, rng):
+        """A floor strip (6-10 mm high, 2-4 cm long) across the left wheel's path."""
+        sk = dart.dynamics.Skeleton(f"strip{len(self.strips)}_{self.world.getTime():.3f}")
+        j, body = sk.createWeldJointAndBodyNodePair()
+        h = rng.uniform(0.006, 0.010)
+        self._box(body, (rng.uniform(0.02, 0.04), 0.08, h), (0.0, 0.0, h / 2), self.cfg.mu)
+        j.setTransformFromParentBodyNode(iso((x, y, 0.0), yaw))
+        self.world.addSkeleton(sk)
+        self.strips.append(sk)
+
+    def clear_strips(self):
+        for sk in self.strips:
+            self.world.removeSkeleton(sk)
+        self.strips = []
+
+    def pose(self):
+        T = self.chassis.getWorldTransform()
+        p = T.translation()
+        R = T.rotation()
+        return p[0], p[1], math.atan2(R[1, 0], R[0, 0])
+
+    def wheel_angles(self):
+        return self.wheels[0].getPosition(0), self.wheels[1].getPosition(0)
+
+
+class Driver:
+    """Runs the robot: controller on nominal odometry, history of the truth."""
+
+    def __init__(self, cfg, robot, rng):
+        self.cfg, self.robot, self.rng = cfg, robot, rng
+        self.hist_t, self.hist_pose, self.hist_wheel = [], [], []
+        self.motions = []
+        self.prev_turn = 0       # sign of the last spot turn since the last line (0: none)
+        self.prev_dir = 0        # drive direction of the last line/arc
+        self.unyaw = 0.0
+        self.last_yaw = None
+        self._record()
+
+    def ticks(self):
+        a = self.robot.wheel_angles()
+        n = self.cfg.ticks
+        return [math.floor(x / (2 * math.pi) * n) for x in a]
+
+    def odo_travel(self):
+        k = math.pi * self.cfg.d_nom / self.cfg.ticks
+        t = self.ticks()
+        return t[0] * k, t[1] * k
+
+    def _record(self):
+        x, y, th = self.robot.pose()
+        if self.last_yaw is not None:
+            self.unyaw += wrap(th - self.last_yaw)
+        else:
+            self.unyaw = th
+        self.last_yaw = th
+        self.hist_t.append(self.robot.world.getTime())
+        self.hist_pose.append((x, y, self.unyaw))
+        self.hist_wheel.append(self.robot.wheel_angles())
+
+    def step(self, cmd_l, cmd_r):
+        self.robot.wheels[0].setCommand(0, cmd_l)
+        self.robot.wheels[1].setCommand(0, cmd_r)
+        self.robot.world.step()
+        self._record()
+
+    def idle(self, seconds):
+        for _ in range(int(round(seconds / DT))):
+            self.step(0.0, 0.0)
+
+    def place_at_start(self):
+        """The operator puts the robot on the start mark (origin, heading 0 of
+        the lab) before every run.  Besides being what a UMBmark procedure does,
+        A swivel castor is straightened (trailing).  It also
+        keeps each run's motions at the same angles to DART's friction
+        pyramid (its box friction is not isotropic: up to sqrt(2) more grip
+        along the diagonals), so equal causes give equal effects."""
+        skel = self.robot.skel
+        q = skel.getPositions()
+        q[0:6] = [0.0, 0.0, 0.0, 0.0, 0.0, self.robot.r_mean + 0.0003]
+        skel.setPositions(q)
+        skel.setVelocities(np.zeros(skel.getNumDofs()))
+        if self.robot.swivel is not None:
+            self.robot.swivel.setPosition(0, 0.0)     # castor straightened, trailing
+        self.prev_turn, self.prev_dir = 0, 0
+        self.idle(0.3)      # settles; longer than any clock offset looks back
+
+    def step_index(self):
+        return len(self.hist_t) - 1
+
+    def motion(self, kind, d_left, d_right, peak, sign, then=None):
+        """Drive nominal wheel travels (d_left, d_right) on odometry -- and then,
+        without stopping, the travels `then` (same length; the wheel-speed
+        ratio blends over 0.1 m, a figure eight's change of curvature); peak is
+        the fastest wheel's top speed (m/s).  Profile: ramp up (unless abrupt),
+        ramp down to the target (unless hard stop: wheels braked at once)."""
+        cfg = self.cfg
+        S = math.hypot(d_left, d_right)
+        u1 = (d_left / S, d_right / S)
+        u2 = u1 if then is None else (then[0] / S, then[1] / S)
+        total = S if then is None else 2 * S
+        blend = 0.05 * math.sqrt(2.0)
+        scale = S / max(abs(d_left), abs(d_right))
+        vmax = peak * scale
+        if kind == "turn":
+            acc = cfg.alpha * cfg.b_nom / 2 * scale
+        else:
+            acc = cfg.acc * scale
+        abrupt = kind == "turn" and cfg.abrupt_turn_start
+        start = self.step_index()
+        lp, rp = self.odo_travel()
+        if kind == "line" and cfg.strips:
+            self._place_strips(d_left)
+        t, s = 0.0, 0.0
+        while True:
+            f = min(max((s - (S - blend)) / (2 * blend), 0.0), 1.0) if then is not None else 0.0
+            u = ((1 - f) * u1[0] + f * u2[0], (1 - f) * u1[1] + f * u2[1])
+            n = math.hypot(u[0], u[1])
+            u = (u[0] / n, u[1] / n)
+            l, r = self.odo_travel()
+            s += (l - lp) * u[0] + (r - rp) * u[1]
+            lp, rp = l, r
+            rem = total - s
+            if rem <= 0.0:
+                break
+            v = vmax if abrupt else min(vmax, acc * (t + DT))
+            if not cfg.hard_stop:
+                v = min(v, max(math.sqrt(2.0 * acc * rem), 0.03 * vmax))
+            rn = cfg.d_nom / 2
+            self.step(v * u[0] / rn, v * u[1] / rn)
+            t += DT
+            if t > 120.0:
+                raise RuntimeError("motion did not finish")
+        stop = self.step_index()
+        self.idle(cfg.pause)
+        self.robot.clear_strips()
+        direction = 1 if d_left + d_right >= 0 else -1
+        before = "none"
+        if kind != "turn":
+            if self.prev_turn != 0:
+                before = "ccw" if self.prev_turn > 0 else "cw"
+            elif self.prev_dir != 0 and self.prev_dir != direction:
+                before = "reversal"
+            self.prev_dir, self.prev_turn = direction, 0
+        else:
+            self.prev_turn = sign
+        self.motions.append(dict(kind=kind, start=start, stop=stop, end=self.step_index(),
+                                 sign=sign, direction=direction, before=before,
+                                 v=peak, target=(d_left, d_right)))
+
+    def _place_strips(self, dist):
+        x, y, th = self.robot.pose()
+        n = self.rng.poisson(0.6 * abs(dist))
+        sgn = 1.0 if dist >= 0 else -1.0
+        b2 = self.cfg.b_true / 2
+        for _ in range(n):
+            s = sgn * self.rng.uniform(0.15, abs(dist) - 0.1)
+            px = x + s * math.cos(th) - b2 * math.sin(th)
+            py = y + s * math.sin(th) + b2 * math.cos(th)
+            self.robot.add_strip(px, py, th, self.rng)
+
+    # the experiments -------------------------------------------------------
+    def line(self, dist):
+        self.motion("line", dist, dist, self.cfg.v, 0)
+
+    def turn(self, angle):
+        h = angle * self.cfg.b_nom / 2
+        self.motion("turn", -h, h, self.cfg.w * self.cfg.b_nom / 2, 1 if angle > 0 else -1)
+
+    def arc(self, radius, angle):
+        b2 = self.cfg.b_nom / 2
+        dl, dr = angle * (radius - b2), angle * (radius + b2)
+        peak = self.cfg.v * max(abs(radius - b2), abs(radius + b2)) / abs(radius)
+        self.motion("arc", dl, dr, peak, 0)
+
+    def square(self, ccw):
+        for _ in range(4):
+            self.line(self.cfg.side)
+            self.turn((1 if ccw else -1) * math.pi / 2)
+
+    def back_and_forth(self):
+        self.line(self.cfg.fb_dist)
+        self.line(-self.cfg.fb_dist)
+
+    def figure_eight(self):
+        """Two circles of radius 0.6 m, ccw then cw, without stopping between,
+        at 0.2 m/s: DART's contact gives a little under sideways load (0.3 mm
+        towards the outside at 0.23 m/s^2 in a 0.4 m circle at 0.3 m/s, gone
+        when the curve ends), which would otherwise show as a gap of its own."""
+        rad, b2 = 0.6, self.cfg.b_nom / 2
+        ang = 2 * math.pi
+        peak = FREE_SPEED * (rad + b2) / rad
+        self.motion("arc", ang * (rad - b2), ang * (rad + b2), peak, 0,
+                    then=(ang * (rad + b2), ang * (rad - b2)))
+
+
+def run_campaign(cfg):
+    """Drive every experiment; returns the driver (history) and the runs."""
+    rng = np.random.default_rng(cfg.seed + 7919)
+    robot = Robot(cfg)
+    drv = Driver(cfg, robot, rng)
+    drv.idle(1.0)                      # let the robot settle on the floor
+    runs = []                          # (experiment, direction, first step, last step)
+
+    def run(exp, direction, body):
+        drv.place_at_start()
+        first = drv.step_index()
+        drv.idle(cfg.settle)
+        body()
+        drv.idle(cfg.settle - cfg.pause)
+        runs.append((exp, direction, first, drv.step_index()))
+        drv.idle(0.1)       # still before the next placement (a clock offset looks ahead)
+
+    for i in range(cfg.n_square):
+        run("square", "cw", lambda: drv.square(False))
+        run("square", "ccw", lambda: drv.square(True))
+    for _ in range(cfg.n_fb):
+        run("back_and_forth", "fwd_back", drv.back_and_forth)
+    for _ in range(cfg.n_free):
+        run("free", "free", drv.figure_eight)
+    return drv, runs
+
+
+def write_campaign(cfg, drv, runs, out):
+    """Manifest + one trajectory CSV per experiment (contract format)."""
+    rng = np.random.default_rng(cfg.seed + 104729)
+    t = np.asarray(drv.hist_t)
+    pose = np.asarray(drv.hist_pose)
+    wheel = np.asarray(drv.hist_wheel)
+    # free paths (arcs) at 50 Hz (more samples where the path curves)
+    every_for = {"square": int(round(1.0 / (RATE * DT))), "back_and_forth": int(round(1.0 / (RATE * DT))),
+                 "free": int(round(1.0 / (FREE_RATE * DT)))}
+    files = {"square": "square.csv", "back_and_forth": "fwd_back.csv", "free": "free.csv"}
+    rows = {k: [] for k in files}
+    counts = {k: 0 for k in files}
+    mx, my = cfg.marker
+    for exp, direction, first, last in runs:
+        counts[exp] += 1
+        run_no = counts[exp]
+        idx = np.arange(first, last + 1, every_for[exp])
+        tau = cfg.tau + (rng.normal(0.0, cfg.tau_sd) if cfg.tau_sd > 0 else 0.0)
+        ts = t[idx] - tau              # the true time each ground-truth sample shows
+        px = np.interp(ts, t, pose[:, 0])
+        py = np.interp(ts, t, pose[:, 1])
+        pth = np.interp(ts, t, pose[:, 2])
+        gx = px + mx * np.cos(pth) - my * np.sin(pth) + rng.normal(0, cfg.sig_xy, len(idx))
+        gy = py + mx * np.sin(pth) + my * np.cos(pth) + rng.normal(0, cfg.sig_xy, len(idx))
+        gth = pth + rng.normal(0, cfg.sig_th, len(idx))
+        # the lab frame: the true pose of the axle midpoint at the run's first
+        # sample (the noisy first sample would turn the whole run by its noise)
+        x0, y0, th0 = pose[first]
+        c, s = math.cos(th0), math.sin(th0)
+        dx, dy = gx - x0, gy - y0
+        rx, ry, rth = c * dx + s * dy, -s * dx + c * dy, gth - th0
+        tk = np.floor(wheel[idx] / (2 * math.pi) * cfg.ticks).astype(np.int64)
+        tk -= tk[0]
+        for k in range(len(idx)):
+            # 0.1 mm / 0.1 mrad steps: rounding adds 0.03 rms to 0.2 mm / 0.5 mrad noise
+            rows[exp].append(f"{run_no},{direction},{t[idx[k]] - t[first]:.2f},{tk[k, 0]},{tk[k, 1]},"
+                             f"{rx[k]:.4f},{ry[k]:.4f},{rth[k]:.4f}")
+        if cfg.tau_sd > 0:
+            drv.run_taus = getattr(drv, "run_taus", []) + [tau]
+    os.makedirs(out, exist_ok=True)
+    for exp, name in files.items():
+        if not rows[exp]:
+            continue
+        with open(os.path.join(out, name), "w") as f:
+            f.write(f"# DART 6.12 physics campaign, class {cfg.cls}, seed {cfg.seed} "
+                    "(bench/dart/dart_campaign.py)\n")
+            f.write("run,direction,t_s,ticks_left,ticks_right,x_gt_m,y_gt_m,theta_gt_rad\n")
+            f.write("\n".join(rows[exp]) + "\n")
+    with open(os.path.join(out, "campaign.toml"), "w") as f:
+        f.write(f"# DART 6.12 physics campaign: class {cfg.cls}, seed {cfg.seed}; "
+                f"expected verdict {CLASSES[cfg.cls]} (see truth.md)\n")
+        f.write("[robot]\n")
+        f.write(f"wheelbase_m            = {cfg.b_nom}\n")
+        f.write(f"wheel_diameter_left_m  = {cfg.d_nom}\n")
+        f.write(f"wheel_diameter_right_m = {cfg.d_nom}\n")
+        f.write(f"ticks_per_rev          = {cfg.ticks}\n\n")
+        f.write("[ground_truth]\n")
+        f.write(f"sigma_xy_m      = {cfg.sig_xy}\n")
+        f.write(f"sigma_theta_rad = {cfg.sig_th}\n\n")
+        f.write(f'[[experiment]]\nkind   = "square"\nside_m = {cfg.side}\nfile   = "square.csv"\n\n')
+        f.write(f'[[experiment]]\nkind       = "back_and_forth"\ndistance_m = {cfg.fb_dist}\n'
+                'file       = "fwd_back.csv"\n\n')
+        f.write('[[experiment]]\nkind = "free"\nfile = "free.csv"\n')
+
+
+class Truth:
+    """The cause measured on the engine's true poses: per motion phase, the true
+    pose change against ideal rolling from the true wheel angles (true wheel
+    radii and wheelbase), both in the frame of the phase's start."""
+
+    START = 0.4    # s: the start phase of a motion (where a castor kicks)
+
+    def __init__(self, cfg, drv):
+        self.cfg = cfg
+        self.pose = np.asarray(drv.hist_pose)
+        w = np.asarray(drv.hist_wheel)
+        ds_l = np.diff(w[:, 0]) * cfg.r_left
+        ds_r = np.diff(w[:, 1]) * cfg.r_right
+        self.ds = 0.5 * (ds_l + ds_r)
+        self.dth = (ds_r - ds_l) / cfg.b_true
+
+    def residual(self, a, b):
+        if b <= a:
+            return 0.0, 0.0, 0.0
+        th0 = self.pose[a, 2]
+        th = th0 + np.concatenate(([0.0], np.cumsum(self.dth[a:b])))
+        mid = 0.5 * (th[:-1] + th[1:])
+        ix = np.sum(self.ds[a:b] * np.cos(mid - th0))
+        iy = np.sum(self.ds[a:b] * np.sin(mid - th0))
+        dx, dy = self.pose[b, 0] - self.pose[a, 0], self.pose[b, 1] - self.pose[a, 1]
+        c, s = math.cos(th0), math.sin(th0)
+        tx, ty = c * dx + s * dy, -s * dx + c * dy
+        return tx - ix, ty - iy, (self.pose[b, 2] - th0) - (th[-1] - th0)
+
+    def motions(self, motions):
+        rows = []
+        n_start = int(round(self.START / DT))
+        for m in motions:
+            a, b, e = m["start"], m["stop"], m["end"]
+            mid = min(a + n_start, b)
+            st = self.residual(a, mid)
+            sd = self.residual(mid, b)
+            sp = self.residual(b, e)
+            wh = self.residual(a, e)
+            ideal_turn = float(np.sum(self.dth[a:e]))
+            rows.append(dict(m, start_res=st, steady_res=sd, stop_res=sp, whole_res=wh,
+                             ideal_turn=ideal_turn, travel=float(np.sum(np.abs(self.ds[a:e])))))
+        return rows
+
+
+def fmt_ms(vals, unit_scale, unit, dec=2):
+    if len(vals) == 0:
+        return "-"
+    v = np.asarray(vals) * unit_scale
+    sd = v.std(ddof=1) if len(v) > 1 else 0.0
+    return f"{v.mean():+.{dec}f}{' ' + unit if unit else ''} (sd {sd:.{dec}f}, n {len(v)})"
+
+
+def write_truth(cfg, rows, out, drv):
+    with open(os.path.join(out, "truth.csv"), "w") as f:
+        f.write("# per motion: TRUE pose change minus ideal rolling from the true wheel angles "
+                "(frame of the phase start); mm and mrad\n")
+        f.write("motion,kind,direction,sign,before,start_along_mm,start_heading_mrad,"
+                "steady_along_mm,steady_heading_mrad,stop_along_mm,stop_lateral_mm,"
+                "stop_heading_mrad,whole_along_mm,whole_lateral_mm,whole_heading_mrad\n")
+        for i, r in enumerate(rows):
+            st, sd, sp, wh = r["start_res"], r["steady_res"], r["stop_res"], r["whole_res"]
+            f.write(f"{i + 1},{r['kind']},{r['direction']},{r['sign']},{r['before']},"
+                    f"{st[0] * 1e3:.3f},{st[2] * 1e3:.3f},{sd[0] * 1e3:.3f},{sd[2] * 1e3:.3f},"
+                    f"{sp[0] * 1e3:.3f},{sp[1] * 1e3:.3f},{sp[2] * 1e3:.3f},"
+                    f"{wh[0] * 1e3:.3f},{wh[1] * 1e3:.3f},{wh[2] * 1e3:.3f}\n")
+    lines = [r for r in rows if r["kind"] == "line"]
+    turns = [r for r in rows if r["kind"] == "turn"]
+    slide = [r["stop_res"][0] * r["direction"] for r in lines]
+    turn_on = [r["stop_res"][2] * r["sign"] for r in turns]
+    scrub = [-(r["whole_res"][2] * r["sign"]) / abs(r["ideal_turn"]) for r in turns]
+    per_m = [r["steady_res"][0] * r["direction"] / max(r["travel"], 1e-9) for r in lines]
+    L = []
+    L.append(f"# Measured cause: class `{cfg.cls}`, seed {cfg.seed}\n")
+    L.append(f"Expected verdict: **{CLASSES[cfg.cls]}**\n")
+    L.append("Robot (true vs nominal): wheelbase "
+             f"{cfg.b_true:.4f} m vs {cfg.b_nom} (E_b {cfg.eb:.4f}); wheel diameters "
+             f"{2 * cfg.r_left:.5f} / {2 * cfg.r_right:.5f} m vs {cfg.d_nom} "
+             f"(E_d {cfg.r_right / cfg.r_left:.5f}); {cfg.ticks} ticks/rev; floor mu {cfg.mu:.2f}; "
+             f"castor {cfg.castor}" + (f" at y {cfg.castor_y * 1e3:+.0f} mm, swivel friction "
+                                       f"{cfg.swivel_friction:.3f} N m" if cfg.castor != "ball" else "")
+             + f"; v {cfg.v:.3f} m/s, w {cfg.w:.2f} rad/s; hard stops {cfg.hard_stop}; "
+             f"abrupt turn starts {cfg.abrupt_turn_start}.\n")
+    L.append(f"Motion capture: white noise {cfg.sig_xy * 1e3:.2f} mm, {cfg.sig_th * 1e3:.2f} mrad; "
+             f"marker at ({cfg.marker[0] * 1e3:+.2f}, {cfg.marker[1] * 1e3:+.2f}) mm; clock offset "
+             f"{cfg.tau * 1e3:+.1f} ms (v tau = {cfg.v * cfg.tau * 1e3:+.2f} mm); per-run clock sd "
+             f"{cfg.tau_sd * 1e3:.1f} ms"
+             + (f" (drawn: {', '.join(f'{x * 1e3:+.1f}' for x in getattr(drv, 'run_taus', []))} ms)"
+                if cfg.tau_sd > 0 else "") + ".\n")
+    L.append("True pose change minus ideal rolling from the true wheel angles "
+             "(mean, sd, count):\n")
+    L.append(f"- slide after a leg (stop phase, along travel): {fmt_ms(slide, 1e3, 'mm')}")
+    L.append(f"- turn-on after a spot turn (stop phase, in its sense): {fmt_ms(turn_on, 1e3, 'mrad')}")
+    L.append(f"- spot-turn deficit k = 1 - true/ideal heading change: {fmt_ms(scrub, 1.0, '', 4)}")
+    L.append(f"- steady legs, along travel per metre: {fmt_ms(per_m, 1e3, 'mm/m')}")
+    for before in ("ccw", "cw", "reversal", "none"):
+        for d in (1, -1):
+            k = [r["start_res"][2] for r in lines + [x for x in rows if x["kind"] == "arc"]
+                 if r["before"] == before and r["direction"] == d]
+            if k:
+                L.append(f"- heading at the start of a {'forward' if d > 0 else 'backward'} "
+                         f"motion after {before}: {fmt_ms(k, 1e3, 'mrad')}")
+    wh_al = [r["whole_res"][0] for r in lines]
+    wh_th = [r["whole_res"][2] for r in rows]
+    L.append(f"- whole motion (start to next start), legs along: {fmt_ms(wh_al, 1e3, 'mm')}; "
+             f"all motions heading: {fmt_ms(wh_th, 1e3, 'mrad')}")
+    L.append("")
+    with open(os.path.join(out, "truth.md"), "w") as f:
+        f.write("\n".join(L))
+    return "\n".join(L)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("cls", choices=sorted(CLASSES))
+    ap.add_argument("seed", type=int)
+    ap.add_argument("out")
+    ap.add_argument("--quick", action="store_true", help="half-size campaign (for the committed tests)")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="override a Config attribute (exploring the physics)")
+    ap.add_argument("--rate", type=float, default=RATE, help="sample rate of the CSVs (Hz)")
+    a = ap.parse_args()
+    globals()["RATE"] = a.rate
+    cfg = Config(a.cls, a.seed, a.quick)
+    for kv in a.set:
+        k, v = kv.split("=", 1)
+        if not hasattr(cfg, k):
+            raise SystemExit(f"--set: no attribute {k}")
+        setattr(cfg, k, type(getattr(cfg, k))(float(v)) if not isinstance(getattr(cfg, k), str) else v)
+    drv, runs = run_campaign(cfg)
+    write_campaign(cfg, drv, runs, a.out)
+    rows = Truth(cfg, drv).motions(drv.motions)
+    print(write_truth(cfg, rows, a.out, drv))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,92 @@
+// `umbmark diagnose` on campaigns a physics engine generated (DART 6.12,
+// bench/dart/dart_campaign.py; committed under tests/data/dart/, so the test
+// needs no DART): a robot unlike the bundled one, driven by a controller that
+// stops on its own odometry, with one physical cause per campaign.  The
+// expected verdicts come from the physics, checked on the engine's true poses
+// (each campaign's truth.md: true pose change per motion against ideal
+// rolling from the true wheel angles); the sizes the diagnosis fits are
+// compared with the engine's (marker position, clock offset, turn deficit).
+#include <catch2/catch.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <regex>
+#include <string>
+
+#include "support/run_cli.hpp"
+
+using namespace umbmark::testing;
+using Catch::Matchers::WithinAbs;
+
+namespace {
+
+const std::filesystem::path kDart = std::filesystem::path(UMBMARK_SOURCE_DIR) / "tests" / "data" / "dart";
+
+/// `diagnose --json -` on the committed campaign of class `cls` (once per class).
+const nlohmann::json& Diagnose(const std::string& cls) {
+  static std::map<std::string, nlohmann::json> cache;
+  auto it = cache.find(cls);
+  if (it == cache.end()) {
+    const auto r = RunCli("diagnose " + Q(kDart / cls / "campaign.toml") + " --json -");
+    INFO(cls << ": " << r.err);
+    REQUIRE(r.status == 0);
+    it = cache.emplace(cls, nlohmann::json::parse(r.out)).first;
+  }
+  return it->second;
+}
+
+std::string Truth(const std::string& cls) { return Slurp((kDart / cls / "truth.md").string()); }
+
+/// The number after `label` in the campaign's truth.md (the engine's value).
+double TruthNumber(const std::string& cls, const std::string& pattern) {
+  std::smatch m;
+  const std::string text = Truth(cls);
+  INFO(cls << ": " << pattern);
+  REQUIRE(std::regex_search(text, m, std::regex(pattern)));
+  return std::stod(m[1].str());
+}
+
+std::string ExpectedVerdict(const std::string& cls) {
+  std::smatch m;
+  const std::string text = Truth(cls);
+  REQUIRE(std::regex_search(text, m, std::regex(R"(Expected verdict: \*\*([a-z_]+)\*\*)")));
+  return m[1].str();
+}
+
+const nlohmann::json* Candidate(const nlohmann::json& j, const std::string& effect) {
+  for (const auto& c : j["candidates"])
+    if (c["effect"] == effect) return &c;
+  return nullptr;
+}
+
+}  // namespace
+
+TEST_CASE("DART campaigns: the verdict is the physical cause", "[diagnose][dart]") {
+  for (const std::string cls : {"clean", "floor_strips", "marker_offset", "clock_fixed", "eccentric_hubs"}) {
+    const auto& j = Diagnose(cls);
+    INFO(cls << ": " << j["verdict"].dump());
+    CHECK(j["verdict"]["effect"] == ExpectedVerdict(cls));
+  }
+}
+
+TEST_CASE("DART campaigns: fitted sizes match the engine's", "[diagnose][dart]") {
+  SECTION("marker offset: gt_offset within 0.3 mm of the marker's true position") {
+    const auto& j = Diagnose("marker_offset");
+    const auto* c = Candidate(j, "gt_offset");
+    REQUIRE(c != nullptr);
+    const double dx = TruthNumber("marker_offset", R"(marker at \(([-+0-9.]+),)") * 1e-3;
+    const double dy = TruthNumber("marker_offset", R"(marker at \([-+0-9.]+, ([-+0-9.]+)\))") * 1e-3;
+    CHECK_THAT((*c)["params"]["dx"].get<double>(), WithinAbs(dx, 3e-4));
+    CHECK_THAT((*c)["params"]["dy"].get<double>(), WithinAbs(dy, 3e-4));
+  }
+  SECTION("fixed clock offset: time_offset within 3 ms of the engine's") {
+    const auto& j = Diagnose("clock_fixed");
+    const auto* c = Candidate(j, "time_offset");
+    REQUIRE(c != nullptr);
+    const double tau = TruthNumber("clock_fixed", R"(clock offset ([-+0-9.]+) ms)") * 1e-3;
+    CHECK_THAT((*c)["params"]["tau"].get<double>(), WithinAbs(tau, 3e-3));
+  }
+}
