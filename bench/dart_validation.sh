@@ -10,7 +10,8 @@
 #   CLASSES="clean stop_slide" restricts the classes; QUICK=1 generates the
 #   half-size campaigns committed under tests/data/dart/; KEEP=DIR writes the
 #   campaigns to DIR instead of a temporary directory; BEFORE=/path/umbmark
-#   also diagnoses every campaign with that executable (a baseline).
+#   also diagnoses every campaign with that executable (a baseline); NICE=N
+#   sets the generators' niceness (default 10).
 # Needs /usr/bin/python3 with dartpy and numpy (apt-get install python3-dartpy).
 set -euo pipefail
 
@@ -40,7 +41,7 @@ done
 generate() {  # CLASS SEED
   local dir="$OUT/$1-$2"
   [[ -f "$dir/truth.md" ]] && return 0
-  nice "$PY" "$GEN" "$1" "$2" "$dir" ${QUICK:+--quick} >"$dir.log" 2>&1 ||
+  nice -n "${NICE:-10}" "$PY" "$GEN" "$1" "$2" "$dir" ${QUICK:+--quick} >"$dir.log" 2>&1 ||
     { echo "generator failed: $1 $2 (see $dir.log)" >&2; return 1; }
 }
 failed=0
