@@ -41,7 +41,8 @@ CLASSES = {
     "clean": "none",
     "stop_slide": "stop_slide",
     "swivel_castor": "castor_swivel",
-    "offset_castor": "castor_kick",
+    "offset_castor": "castor_kick+castor_swivel",   # both named (measured: a kick of one sign
+                                                    # at every forward start plus one that follows the turn)
     "floor_strips": "bump_outliers",
     "turn_scrub": "turn_scrub",
     "marker_offset": "gt_offset",
