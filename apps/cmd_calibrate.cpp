@@ -52,15 +52,15 @@ struct CalibrateOptions {
   double loss_scale_m = 0.02;
   int samples_per_run = 100;
   std::string sampling = "per_run";
-  std::string start_pose = "fitted";
-  double heading_weight = 4.0;
+  std::string start_pose = "session_frame";
+  double heading_weight = 2.0;
   std::string use = "recommended";
   bool per_experiment = false;
   bool no_heldout = false;  // --no-heldout: skip the leave-one-run-out comparison
 };
 
 // The parameters --ros2 and --plot use: --use classic | refined |
-// recommended (the lowest leave-one-run-out error; classic when none).
+// recommended (the held-out comparison's recommendation; classic when skipped).
 struct Chosen {
   std::string method;  ///< umbmark_<estimator> | refined | plain_least_squares | recorded
   RobotParams parameters;
@@ -100,15 +100,15 @@ Chosen ChooseParameters(const CalibrateJobResult& r, const HeldoutComparison& h,
   };
   if (use == "classic") return classic("--use classic");
   if (use == "refined") return refined("--use refined");
-  const std::string why = "recommended: lowest leave-one-run-out prediction error";
+  if (h.scheme == kHeldoutSkipped)
+    return classic("the held-out comparison was skipped (--no-heldout): the classic result");
+  const std::string why = "recommended: " + h.why;
   if (h.recommended == classic_name) return classic(why);
-  if (h.recommended == "refined") return refined(why);
+  if (h.recommended == "refined" && r.refined) return refined(why);
   if (const MethodHeldout* m = h.recommended.empty() ? nullptr : h.Find(h.recommended)) {
     return WithRatios({m->method, m->parameters, why}, s.recorded);
   }
-  if (h.scheme == kHeldoutSkipped)
-    return classic("the held-out comparison was skipped (--no-heldout): the classic result");
-  return classic("no recommendation could be formed (too few runs): the classic result");
+  return classic("no method could be compared: the classic result");
 }
 
 // Turns one command-line input into calibration inputs. A manifest's square
@@ -127,15 +127,30 @@ std::vector<CalibrateInput> LoadInputs(const std::string& path, const CalibrateO
     const Manifest m = io::ReadManifest(path);
     const RobotParams robot = o.robot.Resolve(m.robot);
     std::vector<std::string> tags;
+    std::vector<TrajectoryData> unseen;  // other shapes: held out for the comparison of methods
     int index = 0;
     for (const auto& e : m.experiments) {
       ++index;
-      if (e.kind != ExperimentKind::kSquare) continue;
+      if (e.kind != ExperimentKind::kSquare) {
+        io::RunFile rf = io::ReadRunFile(e.resolved_file);
+        if (auto* t = std::get_if<TrajectoryData>(&rf)) {
+          // Only runs with ground truth at the start and later (a final error).
+          std::erase_if(t->runs, [](const TrajectoryRun& r) {
+            if (r.size() < 2 || !r.HasGroundTruth(0)) return true;
+            for (std::size_t i = 1; i < r.size(); ++i)
+              if (r.HasGroundTruth(i)) return false;
+            return true;
+          });
+          if (!t->runs.empty()) unseen.push_back(std::move(*t));
+        }
+        continue;
+      }
       const double side = o.side_m.value_or(e.side_m);
       out.push_back(from_file(e.resolved_file, robot, side, fmt::format("{}#{}", path, index)));
       tags.push_back(std::to_string(index));
     }
     if (out.empty()) throw InputError(path, "the manifest has no square experiment to calibrate from");
+    for (auto& in : out) in.unseen = unseen;
     if (!o.per_experiment && out.size() > 1) {
       return {PoolInputs(out, tags, fmt::format("{} (experiments {} pooled)", path, fmt::join(tags, ", ")))};
     }
@@ -230,6 +245,11 @@ nlohmann::json JsonResult(const CalibrateInput& in, const CalibrateJobResult& r,
   j["heldout"] = {{"scheme", h.scheme},
                   {"measure", h.measure},
                   {"left_out", h.left_out},
+                  {"sessions", h.sessions},
+                  {"baseline", h.baseline.empty() ? nlohmann::json(nullptr) : nlohmann::json(h.baseline)},
+                  {"why", h.why},
+                  {"expected_error_m", skipped ? nlohmann::json(nullptr) : JsonNumber(h.expected_error_m)},
+                  {"expected_error_sem_m", skipped ? nlohmann::json(nullptr) : JsonNumber(h.expected_error_sem_m)},
                   {"runner_up", h.runner_up.empty() ? nlohmann::json(nullptr) : nlohmann::json(h.runner_up)},
                   {"runner_up_difference_m", h.runner_up.empty() ? nlohmann::json(nullptr)
                                                                    : JsonNumber(h.runner_up_difference_m)},
@@ -268,17 +288,33 @@ void PrintEvaluation(const char* title, const EvaluationSummary& e) {
              Rad2Deg(e.max_max_heading_error_rad), Rad2Deg(e.max_final_heading_error_rad));
 }
 
+/// What the held-out scheme left out, for the table's title.
+std::string SchemeText(const HeldoutComparison& h) {
+  if (h.scheme == "unseen_paths") return "paths of other shapes, unseen by every calibration";
+  if (h.scheme == "leave_one_session_out") return fmt::format("leave-one-session-out over {} sessions", h.sessions);
+  if (h.scheme == "k_fold_over_runs") return "10-fold (over runs)";
+  return "leave-one-run-out";
+}
+
 /// The held-out table: each method's prediction error and the recommendation.
 void PrintHeldoutTable(const HeldoutComparison& h) {
-  fmt::print("Which calibration to trust: {} prediction error ({} folds, {})\n",
-             h.scheme == "leave_one_run_out" ? "leave-one-run-out" : "10-fold (over runs)",
-             h.methods.empty() ? 0 : h.methods.front().folds,
-             h.measure == "max_position_error_m" ? "largest position error along the left-out run"
-                                                   : "left-out return error vs the model's prediction");
+  const std::string measure = h.measure == "final_position_error_m" ? "final position error, odometry from the first "
+                                                                      "ground-truth pose"
+                              : h.measure == "max_position_error_m" ? "largest position error along the left-out run"
+                                                                    : "left-out return error vs the model's prediction";
+  fmt::print("Which calibration to trust: {} prediction error ({} folds, {})\n", SchemeText(h),
+             h.methods.empty() ? 0 : h.methods.front().folds, measure);
+  const MethodHeldout* lowest = nullptr;
   for (const auto& m : h.methods) {
+    if ((m.Recommendable() || m.method == "recorded") && m.folds > 0 && (!lowest || m.mean_m < lowest->mean_m))
+      lowest = &m;
+  }
+  for (const auto& m : h.methods) {
+    std::string mark;
+    if (&m == lowest) mark += "   lowest";
+    if (m.method == h.recommended) mark += "   <- recommended";
     fmt::print("  {:<20} {:7.2f} mm +- {:5.2f} (SE){}{}\n", m.method, m.mean_m * 1e3, m.sem_m * 1e3,
-               m.failed_folds ? fmt::format(", failed on {} folds", m.failed_folds) : "",
-               m.method == h.recommended ? "   <- lowest" : "");
+               m.failed_folds ? fmt::format(", failed on {} folds", m.failed_folds) : "", mark);
   }
   for (const auto& n : h.notes) fmt::print("  note: {}\n", n);
   if (!h.recommended.empty()) {
@@ -286,12 +322,15 @@ void PrintHeldoutTable(const HeldoutComparison& h) {
     fmt::print("  Put {} on the robot: wheelbase {:.6f} m, left diameter {:.6f} m, right diameter {:.6f} m\n",
                h.recommended, m->parameters.wheelbase_m, m->parameters.wheel_diameter_left_m,
                m->parameters.wheel_diameter_right_m);
+    fmt::print("  ({}; baseline {})\n", h.why, h.baseline);
+    fmt::print("  Expected error on paths it has not seen: {:.2f} mm +- {:.2f} (SE){}\n", h.expected_error_m * 1e3,
+               h.expected_error_sem_m * 1e3,
+               h.scheme == "unseen_paths" || h.scheme == "leave_one_session_out"
+                   ? ""
+                   : " (from left-out square runs of the same session: other shapes and days may differ)");
     if (!h.runner_up.empty()) {
-      fmt::print("  ({:.2f} mm +- {:.2f} better than the runner-up {}{})\n", h.runner_up_difference_m * 1e3,
-                 h.runner_up_difference_sem_m * 1e3, h.runner_up,
-                 h.runner_up_difference_m < 2.0 * h.runner_up_difference_sem_m
-                     ? "; the difference is within 2 SE, either is as good"
-                     : "");
+      fmt::print("  runner-up {}: {:+.2f} mm +- {:.2f} (SE) against it\n", h.runner_up, h.runner_up_difference_m * 1e3,
+                 h.runner_up_difference_sem_m * 1e3);
     }
   }
 }
@@ -480,7 +519,9 @@ CalibrateJobOptions JobOptions(const CalibrateOptions& o) {
   jo.umbmark.outlier_threshold = o.outlier_threshold;
   jo.integrator = *IntegratorFromString(o.integrator);
   jo.keep_classic_on_refine_failure = true;
-  if (o.refine) {
+  // The full-path fits' settings: used by --refine and, without it, by the
+  // held-out comparison on trajectory input (heldout.hpp).
+  {
     RefineOptions ro;
     auto has = [](const std::vector<std::string>& v, const char* name) {
       return std::find(v.begin(), v.end(), name) != v.end();
@@ -495,7 +536,8 @@ CalibrateJobOptions JobOptions(const CalibrateOptions& o) {
     ro.start_pose = *StartPoseFromString(o.start_pose);
     ro.heading_weight = o.heading_weight;
     if (auto err = ro.Check(); !err.empty()) throw InvalidOptions(err);
-    jo.refine = ro;
+    jo.compare_refine = ro;
+    if (o.refine) jo.refine = ro;
   }
   return jo;
 }
@@ -729,8 +771,8 @@ Command SetupCalibrate(CLI::App& parent) {
                 "JSON `recommended` and `heldout_error` say \"skipped\", and --use recommended takes the classic "
                 "result). Default: compare");
   app->add_option("--use", opts->use,
-                  "Calibration --ros2 and --plot use: the recommended one (lowest leave-one-run-out error), classic "
-                  "UMBmark, or refined (needs --refine)")
+                  "Calibration --ros2 and --plot use: the recommended one (held-out comparison: "
+                  "docs/calibration-comparison.md), classic UMBmark, or refined (needs --refine)")
       ->check(CLI::IsMember({"recommended", "classic", "refined"}))
       ->capture_default_str();
   app->add_option("--report", opts->report, "Write a self-contained HTML report (result, next steps, plots)");
@@ -757,8 +799,9 @@ Command SetupCalibrate(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--start-pose", opts->start_pose,
                   "With --refine on trajectories: each run's frame at its first ground-truth sample, the mean over "
-                  "its initial standstill, or fitted (profiled out; docs/calibration-comparison.md)")
-      ->check(CLI::IsMember({"first_sample", "standstill_mean", "fitted"}))
+                  "its initial standstill, fitted (profiled out per run), or session_frame (first sample, one "
+                  "ground-truth frame error per recording session fitted jointly; docs/calibration-comparison.md)")
+      ->check(CLI::IsMember({"first_sample", "standstill_mean", "fitted", "session_frame"}))
       ->capture_default_str();
   app->add_option("--heading-weight", opts->heading_weight,
                   "With --refine on trajectories: heading residual weight, in wheelbases per radian (0 = position only)")

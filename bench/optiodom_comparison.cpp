@@ -6,20 +6,28 @@
 // (`optiodom` rows of published-results.csv for the same square datasets)
 // are evaluated the same way beside them.
 //
-// Usage: optiodom_comparison [--choices] [DATA_DIR]   (default: data/optiodom-2020-06)
+// Usage: optiodom_comparison [--choices | --sessions] [DATA_DIR]   (default: data/optiodom-2020-06)
 // Prints a Markdown table: mean final / mean max / worst final position
 // error over the held-out runs, in mm.
 //
-// --choices: the refined fit's defaults chosen by held-out evidence across
-// recordings. Every cross-recording pair (one square recording's runs to
-// calibrate, one circular or ivanjko recording's runs to evaluate: 4 x 10
+// --sessions: the evidence behind the defaults: every recording session of
+// the folder calibrates in turn and every other session tests (see
+// Sessions below), including what `calibrate` writes for --ros2.
+//
+// --choices: one setting of the refined fit varied at a time around the
+// defaults, on squares -> 25 June pairs. Every cross-recording pair (one
+// square recording's runs to calibrate, one circular or ivanjko recording's runs to evaluate: 4 x 10
 // pairs) gives the mean final position error of that recording's runs; for
 // each choice (heading weight, robust loss scale, poses per run, start pose)
 // one table varies it around the defaults and compares every row with plain
 // least squares (position-only residual at every sample, no robust loss,
 // wheelbase and both diameters free) pair by pair.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <limits>
+#include <optional>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -30,6 +38,7 @@
 #include <fmt/format.h>
 
 #include "calibration/calibrate_job.hpp"
+#include "calibration/heldout.hpp"
 #include "calibration/refine.hpp"
 #include "evaluation/trajectory_eval.hpp"
 #include "io/optiodom.hpp"
@@ -181,7 +190,8 @@ int Choices(const HeldOut& held, const std::vector<fs::path>& squares) {
   }
   {
     std::vector<Candidate> c;
-    for (StartPose sp : {StartPose::kFirstSample, StartPose::kStandstillMean, StartPose::kFitted}) {
+    for (StartPose sp : {StartPose::kFirstSample, StartPose::kStandstillMean, StartPose::kFitted,
+                          StartPose::kSessionFrame}) {
       RefineOptions o = base;
       o.start_pose = sp;
       c.push_back({StartPoseToString(sp), o});
@@ -199,16 +209,168 @@ int Choices(const HeldOut& held, const std::vector<fs::path>& squares) {
   return 0;
 }
 
+/// One cross-session candidate: parameters from one recording set (nullopt
+/// when it cannot calibrate from it, e.g. UMBmark from circles).
+struct SessionCandidate {
+  std::string label;
+  std::function<std::optional<RobotParams>(const io::OptiOdomDataset&)> fit;
+};
+
+/// What `calibrate` writes for --ros2 (outputs_use) on one square set,
+/// with or without --refine: the held-out recommendation's parameters.
+RobotParams CalibrateWrites(const io::OptiOdomDataset& ds, bool refine, const std::vector<TrajectoryData>* unseen) {
+  CalibrateInput in = InputFromTrajectories(ds.runs, ds.robot, ds.experiment.side_m, Integrator::kArc, ds.id);
+  if (unseen) in.unseen = *unseen;
+  CalibrateJobOptions o;
+  if (refine) o.refine = RefineOptions{};
+  o.keep_classic_on_refine_failure = true;
+  const CalibrateJobResult r = RunCalibrateJob(in, o);
+  const HeldoutComparison h = CompareMethodsHeldout(in, o, r);
+  const MethodHeldout* m = h.Find(h.recommended);
+  fmt::print(stderr, "  {} {}: recommended {} ({}; scheme {})\n", ds.id, refine ? "--refine" : "defaults",
+             h.recommended, h.why, h.scheme);
+  return m ? m->parameters : r.umbmark.corrected;
+}
+
+/// --sessions: every recording set of the folder (4 square, 6 circular, 4
+/// ivanjko sessions) calibrates in turn; each calibration is tested on
+/// every OTHER set's runs (mean final position error, odometry from the
+/// first ground-truth pose: the OptiOdom protocol). Columns split the
+/// pairs by what calibrated and what was tested.
+int Sessions(const fs::path& root) {
+  std::vector<io::OptiOdomDataset> sets;
+  for (const char* cat : {"square", "circular", "ivanjko"}) {
+    std::vector<fs::path> dirs;
+    for (const auto& e : fs::directory_iterator(root / cat)) dirs.push_back(e.path());
+    std::sort(dirs.begin(), dirs.end());
+    for (const auto& d : dirs) sets.push_back(io::ImportOptiOdom(d.string()));
+  }
+  auto refined = [](RefineOptions o) {
+    return [o](const io::OptiOdomDataset& ds) -> std::optional<RobotParams> {
+      return RefineFromTrajectories({{ds.robot, &ds.runs}}, ds.robot, o).refined;
+    };
+  };
+  auto with = [](StartPose sp, double hw) {
+    RefineOptions o;
+    o.start_pose = sp;
+    o.heading_weight = hw;
+    return o;
+  };
+  std::vector<SessionCandidate> cands;
+  cands.push_back({"recorded (no calibration)", [](const io::OptiOdomDataset& ds) -> std::optional<RobotParams> {
+                     return ds.robot;
+                   }});
+  cands.push_back({"UMBmark (mean)", [](const io::OptiOdomDataset& ds) -> std::optional<RobotParams> {
+                     if (ds.category != "square") return std::nullopt;
+                     const auto in = InputFromTrajectories(ds.runs, ds.robot, ds.experiment.side_m, Integrator::kArc, ds.id);
+                     return RunCalibrateJob(in, CalibrateJobOptions{}).umbmark.corrected;
+                   }});
+  cands.push_back({"plain least squares", refined(PlainLeastSquaresOptions())});
+  for (double hw : {0.0, 1.0, 4.0}) {
+    cands.push_back({fmt::format("refined, first_sample, heading {}", hw), refined(with(StartPose::kFirstSample, hw))});
+  }
+  for (double hw : {1.0, 4.0}) {
+    cands.push_back({fmt::format("refined, fitted, heading {}", hw), refined(with(StartPose::kFitted, hw))});
+  }
+  for (double hw : {0.0, 0.5, 1.0, 2.0, 4.0}) {
+    cands.push_back({fmt::format("refined, session_frame, heading {}", hw), refined(with(StartPose::kSessionFrame, hw))});
+  }
+  const std::vector<TrajectoryData>* no_unseen = nullptr;
+  cands.push_back({"calibrate --ros2 (defaults)", [&](const io::OptiOdomDataset& ds) -> std::optional<RobotParams> {
+                     if (ds.category != "square") return std::nullopt;
+                     return CalibrateWrites(ds, false, no_unseen);
+                   }});
+  cands.push_back({"calibrate --ros2 --refine", [&](const io::OptiOdomDataset& ds) -> std::optional<RobotParams> {
+                     if (ds.category != "square") return std::nullopt;
+                     return CalibrateWrites(ds, true, no_unseen);
+                   }});
+  // err[candidate][source][target] (NaN: not computed).
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::vector<std::vector<double>>> err(cands.size());
+  for (std::size_t c = 0; c < cands.size(); ++c) {
+    err[c].assign(sets.size(), std::vector<double>(sets.size(), nan));
+    for (std::size_t s = 0; s < sets.size(); ++s) {
+      std::optional<RobotParams> p;
+      try {
+        p = cands[c].fit(sets[s]);
+      } catch (const std::exception& e) {
+        fmt::print(stderr, "{} on {}: {}\n", cands[c].label, sets[s].id, e.what());
+      }
+      if (!p) continue;
+      for (std::size_t t = 0; t < sets.size(); ++t) {
+        if (t == s) continue;
+        err[c][s][t] = Summarise(EvaluateRuns(sets[t].runs, sets[t].id, *p, sets[t].robot, Integrator::kArc))
+                           .mean_final_position_error_m;
+      }
+    }
+  }
+  const std::size_t plain = 2;
+  // Mean over the pairs (source category, target category) where plain
+  // least squares is defined (it cannot calibrate from the ivanjko sets:
+  // straight runs and spins do not determine the wheelbase from positions).
+  auto cell = [&](std::size_t c, const char* src, const char* dst, int* count = nullptr) {
+    double sum = 0.0;
+    int n = 0;
+    for (std::size_t s = 0; s < sets.size(); ++s) {
+      if (src && sets[s].category != src) continue;
+      for (std::size_t t = 0; t < sets.size(); ++t) {
+        if (t == s || (dst && sets[t].category != dst) || !std::isfinite(err[plain][s][t])) continue;
+        if (!std::isfinite(err[c][s][t])) return std::string("-");
+        sum += err[c][s][t];
+        ++n;
+      }
+    }
+    if (count) *count = n;
+    return n ? fmt::format("{:.2f}", 1e3 * sum / n) : std::string("-");
+  };
+  int n_sq = 0, n_circ = 0, n_all = 0;
+  cell(plain, "square", nullptr, &n_sq);
+  cell(plain, "circular", nullptr, &n_circ);
+  cell(plain, nullptr, nullptr, &n_all);
+  fmt::print("Cross-session evidence: {} recording sets (4 square sessions of 23 June, 6 circular and 4 ivanjko "
+             "sessions of 25 June); each calibrates in turn, every OTHER set tests: mean final position error of its "
+             "runs [mm], odometry from each run's first ground-truth pose. Pairs where plain least squares is "
+             "defined.\n\n",
+             sets.size());
+  fmt::print("| method | squares -> circles (24) | squares -> ivanjko (16) | squares -> other squares (12) | square "
+             "sources, all ({}) | circle sources -> other sets ({}) | all pairs ({}) | pairs <= plain LS | worst pair "
+             "vs plain LS [mm] |\n|---|---|---|---|---|---|---|---|---|\n",
+             n_sq, n_circ, n_all);
+  for (std::size_t c = 0; c < cands.size(); ++c) {
+    int better = 0, n = 0;
+    double worst = -1e9;
+    for (std::size_t s = 0; s < sets.size(); ++s) {
+      for (std::size_t t = 0; t < sets.size(); ++t) {
+        if (!std::isfinite(err[c][s][t]) || !std::isfinite(err[plain][s][t])) continue;
+        const double d = err[c][s][t] - err[plain][s][t];
+        better += d <= 1e-12 ? 1 : 0;
+        worst = std::max(worst, d);
+        ++n;
+      }
+    }
+    fmt::print("| {} | {} | {} | {} | {} | {} | {} | {}/{} | {:+.2f} |\n", cands[c].label,
+               cell(c, "square", "circular"), cell(c, "square", "ivanjko"), cell(c, "square", "square"),
+               cell(c, "square", nullptr), cell(c, "circular", nullptr), cell(c, nullptr, nullptr), better, n,
+               1e3 * worst);
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool choices = false;
+  bool choices = false, sessions = false;
   if (argc > 1 && std::string(argv[1]) == "--choices") {
     choices = true;
     --argc;
     ++argv;
+  } else if (argc > 1 && std::string(argv[1]) == "--sessions") {
+    sessions = true;
+    --argc;
+    ++argv;
   }
   const fs::path root = argc > 1 ? fs::path(argv[1]) : fs::path("data/optiodom-2020-06");
+  if (sessions) return Sessions(root);
   HeldOut held;
   std::size_t held_runs = 0;
   for (const char* cat : {"circular", "ivanjko"}) {

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -78,6 +79,7 @@ CalibrateInput PoolInputs(const std::vector<CalibrateInput>& parts, const std::v
     for (ReturnError e : p.errors) {
       e.run = tags[k] + ":" + e.run;
       pooled.errors.push_back(std::move(e));
+      pooled.sessions.push_back(static_cast<int>(k));
     }
     if (all_trajectories) {
       for (TrajectoryRun r : p.trajectories->runs) {
@@ -87,6 +89,7 @@ CalibrateInput PoolInputs(const std::vector<CalibrateInput>& parts, const std::v
     }
     pooled.files.insert(pooled.files.end(), p.files.begin(), p.files.end());
   }
+  pooled.unseen = parts.front().unseen;
   return pooled;
 }
 
@@ -108,11 +111,18 @@ RefineSummary RefineInput(const CalibrateInput& input, const std::vector<bool>& 
   // the first and last sample only (the contract's minimum) the return
   // errors are all the data say, so the commanded-square model fits them.
   if (input.trajectories && HasInteriorGroundTruth(*input.trajectories)) {
-    TrajectoryData kept;
-    kept.path = input.trajectories->path;
-    for (std::size_t i = 0; i < input.trajectories->runs.size(); ++i)
-      if (keep[i]) kept.runs.push_back(input.trajectories->runs[i]);
-    return RefineFromTrajectories({{input.recorded, &kept}}, input.recorded, ro);
+    // One set per recording session (each has its own ground-truth frame
+    // error with StartPose::kSessionFrame).
+    std::map<int, TrajectoryData> kept;
+    for (std::size_t i = 0; i < input.trajectories->runs.size(); ++i) {
+      if (!keep[i]) continue;
+      TrajectoryData& d = kept[input.sessions.empty() ? 0 : input.sessions[i]];
+      d.path = input.trajectories->path;
+      d.runs.push_back(input.trajectories->runs[i]);
+    }
+    std::vector<TrajectoryRunSet> sets;
+    for (const auto& [session, d] : kept) sets.push_back({input.recorded, &d});
+    return RefineFromTrajectories(sets, input.recorded, ro);
   }
   SquareRunSet set;
   set.side_m = input.side_m;

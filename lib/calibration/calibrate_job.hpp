@@ -25,6 +25,14 @@ struct CalibrateInput {
   std::vector<ReturnError> errors;           ///< from endpoints, or computed from trajectories
   std::optional<TrajectoryData> trajectories;  ///< trajectory input only
   std::vector<std::string> files;              ///< the data files behind it (several when pooled)
+  /// Recording session of each run (same order as errors): the part index
+  /// when PoolInputs pooled several square experiments (each experiment of
+  /// a manifest is one recording session). Empty: one session.
+  std::vector<int> sessions;
+  /// Paths of other shapes (a manifest's circles, free paths, back-and-forth
+  /// runs) with ground truth: never used to calibrate, only to compare the
+  /// methods on paths they did not see (heldout.hpp).
+  std::vector<TrajectoryData> unseen;
 };
 
 struct CalibrateJobOptions {
@@ -39,6 +47,12 @@ struct CalibrateJobOptions {
   /// A failed refined fit: false (default) throws RefineError; true keeps
   /// the classic result and records the failure in `refine_failure`.
   bool keep_classic_on_refine_failure = false;
+  /// Settings of the full-path fits (refined, with the trajectory settings
+  /// the user chose) that the held-out comparison computes on trajectory
+  /// input when `refine` is not set: every method the data allow is
+  /// compared, --refine only adds intervals and identifiability. Default
+  /// RefineOptions{}.
+  RefineOptions compare_refine;
   /// Progress of the held-out comparison (heldout.hpp), in folds
   /// (core/progress.hpp). Default: none.
   ProgressCallback progress;

@@ -1,4 +1,5 @@
-// Leave-one-run-out comparison of calibration methods (see heldout.hpp).
+// Held-out comparison of calibration methods and the recommendation (see
+// heldout.hpp).
 #include "calibration/heldout.hpp"
 
 #include <algorithm>
@@ -6,6 +7,8 @@
 #include <functional>
 #include <limits>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 
 #include <Eigen/Core>
 #include <Eigen/LU>
@@ -80,53 +83,316 @@ UmbmarkOptions FoldUmbmarkOptions(const CalibrateInput& in, const CalibrateJobOp
   return uo;
 }
 
-}  // namespace
+/// A method: its parameters from a set of runs (throws when it cannot fit).
+struct Method {
+  std::string name;
+  int simplicity = 0;
+  std::function<RobotParams(const CalibrateInput&)> fit;
+};
 
-HeldoutComparison CompareMethodsHeldout(const CalibrateInput& input, const CalibrateJobOptions& options,
-                                        const CalibrateJobResult& full) {
-  HeldoutComparison out;
-  out.measure = input.trajectories ? "max_position_error_m" : "return_error_prediction_m";
-  const bool final_turn = options.refine ? options.refine->final_turn : true;
-  std::vector<std::size_t> used;
-  for (std::size_t i = 0; i < full.umbmark.runs.size(); ++i) {
-    if (full.umbmark.runs[i].used()) used.push_back(i);
-  }
-  const bool with_trajectories = options.refine.has_value();  // only the refined fits read them
-  const CalibrateInput all_used = Subset(input, used, with_trajectories);
-  const std::vector<bool> keep_all(used.size(), true);
-
-  // A method: its parameters from a set of runs (throws when it cannot fit).
-  using Fit = std::function<RobotParams(const CalibrateInput&)>;
-  struct Method {
-    std::string name;
-    Fit fit;
-  };
+/// Step 1: every method the input allows, simplest first (heldout.hpp).
+std::vector<Method> MethodsFor(const CalibrateInput& input, const CalibrateJobOptions& options) {
   std::vector<Method> methods;
-  methods.push_back({"recorded", [](const CalibrateInput& in) { return in.recorded; }});
+  methods.push_back({"recorded", 0, [](const CalibrateInput& in) { return in.recorded; }});
   for (UmbmarkEstimator est : {UmbmarkEstimator::kX, UmbmarkEstimator::kY, UmbmarkEstimator::kMean}) {
-    methods.push_back({fmt::format("umbmark_{}", UmbmarkEstimatorToString(est)), [&, est](const CalibrateInput& in) {
+    methods.push_back({fmt::format("umbmark_{}", UmbmarkEstimatorToString(est)), 1, [&options, est](const CalibrateInput& in) {
                          return CalibrateUmbmark(in.errors, in.recorded, FoldUmbmarkOptions(in, options, est), in.path)
                              .corrected;
                        }});
   }
-  auto refine_with = [&](const RefineOptions& ro) {
-    return [&, ro](const CalibrateInput& in) {
+  auto refine_with = [&options](const RefineOptions& ro) {
+    return [&options, ro](const CalibrateInput& in) {
       const UmbmarkSummary classic =
           CalibrateUmbmark(in.errors, in.recorded, FoldUmbmarkOptions(in, options, options.umbmark.estimator), in.path);
       return RefineInput(in, std::vector<bool>(in.errors.size(), true), ro, classic.selected, options.integrator)
           .refined;
     };
   };
-  if (options.refine) {
-    methods.push_back({"refined", refine_with(*options.refine)});
-    if (input.trajectories) methods.push_back({"plain_least_squares", refine_with(PlainLeastSquaresOptions())});
+  // The full-path fits need ground truth along the path; there they are
+  // compared without --refine too.
+  const bool paths = input.trajectories && HasInteriorGroundTruth(*input.trajectories);
+  if (paths) methods.push_back({"plain_least_squares", 2, refine_with(PlainLeastSquaresOptions())});
+  if (options.refine || paths) methods.push_back({"refined", 3, refine_with(options.refine.value_or(options.compare_refine))});
+  return methods;
+}
+
+/// One training set and what it predicts: each entry of `tests` is one fold
+/// (its error the mean over its items).
+struct TestItem {
+  bool unseen = false;    ///< an unseen path (input.unseen) rather than a square run
+  std::size_t file = 0;   ///< unseen: which TrajectoryData
+  std::size_t index = 0;  ///< square: index into input.errors; unseen: run index
+};
+struct FoldGroup {
+  std::vector<std::size_t> train;  ///< indices into input.errors
+  std::vector<std::vector<TestItem>> tests;
+  std::vector<std::string> labels;  ///< one per test
+};
+
+/// Step 2: the folds (scheme in heldout.hpp); sets out->scheme, sessions,
+/// measure.
+std::vector<FoldGroup> MakeFolds(const CalibrateInput& input, const std::vector<std::size_t>& used,
+                                 HeldoutComparison* out) {
+  std::vector<FoldGroup> groups;
+  std::vector<int> session_ids;
+  for (std::size_t i : used) session_ids.push_back(input.sessions.empty() ? 0 : input.sessions[i]);
+  std::vector<int> distinct = session_ids;
+  std::sort(distinct.begin(), distinct.end());
+  distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+  out->sessions = static_cast<int>(distinct.size());
+  std::size_t unseen_runs = 0;
+  for (const auto& d : input.unseen) unseen_runs += d.runs.size();
+  if (unseen_runs > 0) {
+    out->scheme = "unseen_paths";
+    out->measure = "final_position_error_m";
+    FoldGroup g{used, {}, {}};
+    for (std::size_t f = 0; f < input.unseen.size(); ++f) {
+      for (std::size_t r = 0; r < input.unseen[f].runs.size(); ++r) {
+        g.tests.push_back({{true, f, r}});
+        g.labels.push_back(fmt::format("{}:{}", input.unseen[f].path, input.unseen[f].runs[r].run));
+      }
+    }
+    groups.push_back(std::move(g));
+    return groups;
   }
+  if (distinct.size() >= 2) {
+    out->scheme = "leave_one_session_out";
+    for (int s : distinct) {
+      FoldGroup g;
+      for (std::size_t k = 0; k < used.size(); ++k) {
+        if (session_ids[k] != s) {
+          g.train.push_back(used[k]);
+        } else {
+          g.tests.push_back({{false, 0, used[k]}});
+          g.labels.push_back(input.errors[used[k]].run);
+        }
+      }
+      groups.push_back(std::move(g));
+    }
+    return groups;
+  }
+  const bool loo = used.size() <= kMaxLeaveOneOutRuns;
+  if (!loo) {
+    out->scheme = "k_fold_over_runs";
+    out->notes.push_back(fmt::format("{} runs: {}-fold cross-validation over runs instead of leave-one-run-out",
+                                     used.size(), kFolds));
+  }
+  const std::size_t n_folds = loo ? used.size() : kFolds;
+  for (std::size_t f = 0; f < n_folds; ++f) {
+    FoldGroup g;
+    std::vector<TestItem> test;
+    for (std::size_t k = 0; k < used.size(); ++k) {
+      if (k % n_folds == f) {
+        test.push_back({false, 0, used[k]});
+      } else {
+        g.train.push_back(used[k]);
+      }
+    }
+    g.labels.push_back(test.size() == 1 ? input.errors[test.front().index].run
+                                        : fmt::format("fold {} of {} ({} runs)", f + 1, n_folds, test.size()));
+    g.tests.push_back(std::move(test));
+    groups.push_back(std::move(g));
+  }
+  return groups;
+}
+
+/// How well `p` predicts one test item (see heldout.hpp) [m].
+double ItemError(const CalibrateInput& in, const TestItem& t, const RobotParams& p, Integrator integrator,
+                 bool final_turn) {
+  if (t.unseen) {
+    const TrajectoryData& d = in.unseen[t.file];
+    return EvaluateRun(d.runs[t.index], d.path, in.label, p, in.recorded, integrator).final_position_error_m;
+  }
+  return PredictionError(in, t.index, p, integrator, final_turn);
+}
+
+/// Step 3: every method on every fold group; appends one error per test
+/// (NaN where the method failed) and returns per test whether every method
+/// predicted it. A group where even classic UMBmark cannot calibrate the
+/// training runs (e.g. the only run of a direction left out) is not formed.
+std::vector<bool> RunFolds(const CalibrateInput& input, const CalibrateJobOptions& options,
+                           const std::vector<Method>& methods, const std::vector<FoldGroup>& groups,
+                           bool with_trajectories, HeldoutComparison* out) {
+  const bool final_turn = options.refine ? options.refine->final_turn : true;
+  std::vector<bool> complete;
+  ProgressCounter progress(options.progress, static_cast<double>(groups.size()));
+  for (const FoldGroup& g : groups) {
+    const CalibrateInput train = Subset(input, g.train, with_trajectories);
+    std::vector<std::vector<double>> errs(methods.size());  // [method][test]
+    for (std::size_t m = 0; m < methods.size(); ++m) {
+      errs[m].assign(g.tests.size(), kNaN);
+      try {
+        const RobotParams p = methods[m].fit(train);
+        for (std::size_t t = 0; t < g.tests.size(); ++t) {
+          double sum = 0.0;
+          for (const TestItem& item : g.tests[t]) sum += ItemError(input, item, p, options.integrator, final_turn);
+          errs[m][t] = sum / static_cast<double>(g.tests[t].size());
+        }
+      } catch (const std::runtime_error& e) {  // InputError, QualityGateError
+        if (out->methods[m].failure.empty()) out->methods[m].failure = e.what();
+      }
+    }
+    const bool formed = std::isfinite(errs[1].empty() ? kNaN : errs[1].front());  // classic (umbmark_x)
+    for (std::size_t t = 0; t < g.tests.size(); ++t) {
+      if (!formed) {
+        out->notes.push_back(fmt::format("{} cannot be left out (the rest does not calibrate)", g.labels[t]));
+        continue;
+      }
+      bool all = true;
+      for (std::size_t m = 0; m < methods.size(); ++m) {
+        out->methods[m].fold_errors_m.push_back(errs[m][t]);
+        out->methods[m].failed_folds += std::isfinite(errs[m][t]) ? 0 : 1;
+        all = all && std::isfinite(errs[m][t]);
+      }
+      out->left_out.push_back(g.labels[t]);
+      complete.push_back(all);
+    }
+    progress.Add();
+  }
+  return complete;
+}
+
+/// Mean and standard error of `v` over the complete folds.
+std::pair<double, double> MeanAndSem(const std::vector<double>& v, const std::vector<bool>& complete) {
+  double sum = 0.0;
+  int n = 0;
+  for (std::size_t k = 0; k < complete.size(); ++k) {
+    if (!complete[k]) continue;
+    sum += v[k];
+    ++n;
+  }
+  if (n == 0) return {kNaN, kNaN};
+  const double mean = sum / n;
+  double ss = 0.0;
+  for (std::size_t k = 0; k < complete.size(); ++k) {
+    if (complete[k]) ss += (v[k] - mean) * (v[k] - mean);
+  }
+  return {mean, n > 1 ? std::sqrt(ss / (n - 1) / n) : kNaN};
+}
+
+/// Mean and standard error of b - a over the complete folds.
+std::pair<double, double> PairedDifference(const MethodHeldout& a, const MethodHeldout& b,
+                                           const std::vector<bool>& complete) {
+  std::vector<double> d(complete.size(), 0.0);
+  for (std::size_t k = 0; k < complete.size(); ++k) {
+    if (complete[k]) d[k] = b.fold_errors_m[k] - a.fold_errors_m[k];
+  }
+  return MeanAndSem(d, complete);
+}
+
+/// Step 4: each method's mean, SE and rms over the folds every method
+/// completed.
+void SummariseMethods(const std::vector<bool>& complete, HeldoutComparison* out) {
+  const int formed = static_cast<int>(complete.size());
+  for (auto& h : out->methods) {
+    std::tie(h.mean_m, h.sem_m) = MeanAndSem(h.fold_errors_m, complete);
+    double sq = 0.0;
+    int n = 0;
+    for (std::size_t k = 0; k < complete.size(); ++k) {
+      if (!complete[k]) continue;
+      sq += h.fold_errors_m[k] * h.fold_errors_m[k];
+      ++n;
+    }
+    h.folds = n;
+    h.rms_m = n > 0 ? std::sqrt(sq / n) : kNaN;
+    if (h.failed_folds > 0) {
+      out->notes.push_back(fmt::format("{} failed on {} of {} folds (first: {}); it is not recommended", h.method,
+                                       h.failed_folds, formed, h.failure));
+    } else if (!h.fitted_all) {
+      out->notes.push_back(fmt::format("{} failed on all runs ({}); it is not recommended", h.method, h.failure));
+    }
+  }
+}
+
+/// Step 5: the recommendation rule (heldout.hpp).
+void Recommend(const CalibrateJobOptions& options, const std::vector<bool>& complete, HeldoutComparison* out) {
+  const MethodHeldout* baseline = out->Find("plain_least_squares");
+  if (!baseline || !baseline->Recommendable()) {
+    baseline = out->Find(fmt::format("umbmark_{}", UmbmarkEstimatorToString(options.umbmark.estimator)));
+  }
+  if (baseline->method == "plain_least_squares") {
+    out->notes.push_back("the path determines wheelbase, both diameters and so the overall scale: the classic rows "
+                         "(scale held at the recorded value) are shown for reference, not recommended");
+  }
+  out->baseline = baseline->method;
+  const MethodHeldout* chosen = baseline;
+  const int folds = out->methods.front().folds;
+  if (folds < 3) {
+    out->notes.push_back(fmt::format("only {} folds: too few to compare the methods; the simplest well-determined "
+                                     "calibration ({}) is recommended",
+                                     folds, baseline->method));
+    out->why = "too few folds to compare: the simplest well-determined calibration";
+  } else {
+    // Where the path determines all three parameters (the baseline is
+    // plain least squares), the classic rows hold the overall scale at the
+    // recorded value the data contradict: shown, not recommended.
+    const int least = baseline->simplicity;
+    const MethodHeldout* best = nullptr;
+    for (const auto& h : out->methods) {
+      if (h.method != "recorded" && h.simplicity >= least && h.Recommendable() && (!best || h.mean_m < best->mean_m))
+        best = &h;
+    }
+    out->why = fmt::format("the simplest well-determined calibration ({})", baseline->method);
+    if (best && best != baseline) {
+      if (!baseline->Recommendable()) {
+        chosen = best;
+        out->why = "lowest held-out error (the simplest well-determined calibration failed)";
+      } else {
+        const auto [d, se] = PairedDifference(*best, *baseline, complete);
+        if (d > se) {
+          chosen = best;
+          out->why = fmt::format("lowest held-out error, {:.2f} mm +- {:.2f} (SE) below {}", d * 1e3, se * 1e3,
+                                 baseline->method);
+        } else {
+          out->why = fmt::format("the simplest well-determined calibration; {} is {:.2f} mm +- {:.2f} (SE) lower, "
+                                 "within its standard error",
+                                 best->method, d * 1e3, se * 1e3);
+        }
+      }
+    }
+    const MethodHeldout* rec = out->Find("recorded");
+    if (rec->folds > 0 && (!chosen->Recommendable() || rec->mean_m <= chosen->mean_m)) {
+      chosen = rec;
+      out->why = "the recorded parameters have the lowest held-out error: no calibration predicts unseen runs better";
+    }
+  }
+  out->recommended = chosen->method;
+  out->expected_error_m = chosen->mean_m;
+  out->expected_error_sem_m = chosen->sem_m;
+  // Runner-up: the lowest other method (recorded included) that could be recommended.
+  const MethodHeldout* second = nullptr;
+  for (const auto& h : out->methods) {
+    const bool eligible = h.method == "recorded" || (h.Recommendable() && h.simplicity >= baseline->simplicity);
+    if (&h != chosen && eligible && h.folds > 0 && (!second || h.mean_m < second->mean_m)) second = &h;
+  }
+  if (second && chosen->folds > 0) {
+    out->runner_up = second->method;
+    std::tie(out->runner_up_difference_m, out->runner_up_difference_sem_m) =
+        PairedDifference(*chosen, *second, complete);
+  }
+}
+
+}  // namespace
+
+// The named steps above: methods, folds, fits per fold, summary, rule.
+HeldoutComparison CompareMethodsHeldout(const CalibrateInput& input, const CalibrateJobOptions& options,
+                                        const CalibrateJobResult& full) {
+  HeldoutComparison out;
+  out.measure = input.trajectories ? "max_position_error_m" : "return_error_prediction_m";
+  std::vector<std::size_t> used;
+  for (std::size_t i = 0; i < full.umbmark.runs.size(); ++i) {
+    if (full.umbmark.runs[i].used()) used.push_back(i);
+  }
+  const std::vector<Method> methods = MethodsFor(input, options);
+  const bool with_trajectories = methods.back().simplicity >= 2;  // only the fits of the path read them
+  const CalibrateInput all_used = Subset(input, used, with_trajectories);
 
   // Parameters on all used runs.
   out.methods.resize(methods.size());
   for (std::size_t m = 0; m < methods.size(); ++m) {
     MethodHeldout& h = out.methods[m];
     h.method = methods[m].name;
+    h.simplicity = methods[m].simplicity;
     if (h.method == "refined" && full.refined) {
       h.parameters = full.refined->refined;
       continue;
@@ -136,121 +402,13 @@ HeldoutComparison CompareMethodsHeldout(const CalibrateInput& input, const Calib
     } catch (const std::runtime_error& e) {  // InputError, QualityGateError
       h.failure = e.what();
       h.parameters = input.recorded;
+      h.fitted_all = false;
     }
   }
-
-  // Folds: each run alone, or kFolds interleaved groups (both directions in
-  // each) for many runs; a fold's error is the mean over its runs.
-  std::vector<std::vector<std::size_t>> folds;
-  if (used.size() <= kMaxLeaveOneOutRuns) {
-    for (std::size_t k = 0; k < used.size(); ++k) folds.push_back({k});
-  } else {
-    out.scheme = "k_fold_over_runs";
-    folds.resize(kFolds);
-    for (std::size_t k = 0; k < used.size(); ++k) folds[k % kFolds].push_back(k);
-    out.notes.push_back(fmt::format("{} runs: {}-fold cross-validation over runs instead of leave-one-run-out",
-                                    used.size(), kFolds));
-  }
-  std::vector<bool> complete;  // every method predicted this fold
-  std::vector<bool> in_fold(used.size(), false);
-  ProgressCounter progress(options.progress, static_cast<double>(folds.size()));
-  for (std::size_t f = 0; f < folds.size(); ++f) {
-    for (std::size_t k : folds[f]) in_fold[k] = true;
-    std::vector<std::size_t> rest;
-    rest.reserve(used.size());
-    for (std::size_t j = 0; j < used.size(); ++j) {
-      if (!in_fold[j]) rest.push_back(used[j]);
-    }
-    for (std::size_t k : folds[f]) in_fold[k] = false;
-    const CalibrateInput train = Subset(input, rest, with_trajectories);
-    out.left_out.push_back(folds[f].size() == 1
-                               ? input.errors[used[folds[f].front()]].run
-                               : fmt::format("fold {} of {} ({} runs)", f + 1, folds.size(), folds[f].size()));
-    bool all = true;
-    for (std::size_t m = 0; m < methods.size(); ++m) {
-      double err = kNaN;
-      try {
-        const RobotParams p = methods[m].fit(train);
-        double sum = 0.0;
-        for (std::size_t k : folds[f]) sum += PredictionError(input, used[k], p, options.integrator, final_turn);
-        err = sum / static_cast<double>(folds[f].size());
-      } catch (const std::runtime_error& e) {  // InputError, QualityGateError
-        if (out.methods[m].failure.empty()) out.methods[m].failure = e.what();
-      }
-      out.methods[m].fold_errors_m.push_back(err);
-      all = all && std::isfinite(err);
-    }
-    complete.push_back(all);
-    progress.Add();
-  }
-  int formed = 0;
-  for (std::size_t k = 0; k < complete.size(); ++k) {
-    // A fold where even the classic methods fail could not be formed (e.g. the
-    // only run of a direction left out); it is not held against any method.
-    const bool classic_ok = std::isfinite(out.methods[1].fold_errors_m[k]);
-    if (!classic_ok) {
-      out.notes.push_back(fmt::format("run {} cannot be left out (the rest does not calibrate)", out.left_out[k]));
-      continue;
-    }
-    ++formed;
-    for (auto& h : out.methods) h.failed_folds += std::isfinite(h.fold_errors_m[k]) ? 0 : 1;
-  }
-  for (auto& h : out.methods) {
-    double sum = 0.0, sq = 0.0;
-    int n = 0;
-    for (std::size_t k = 0; k < complete.size(); ++k) {
-      if (!complete[k]) continue;
-      sum += h.fold_errors_m[k];
-      sq += h.fold_errors_m[k] * h.fold_errors_m[k];
-      ++n;
-    }
-    h.folds = n;
-    h.mean_m = n > 0 ? sum / n : kNaN;
-    h.rms_m = n > 0 ? std::sqrt(sq / n) : kNaN;
-    double ss = 0.0;
-    for (std::size_t k = 0; k < complete.size(); ++k) {
-      if (complete[k]) ss += std::pow(h.fold_errors_m[k] - h.mean_m, 2);
-    }
-    h.sem_m = n > 1 ? std::sqrt(ss / (n - 1) / n) : kNaN;
-    if (h.failed_folds > 0) {
-      out.notes.push_back(fmt::format("{} failed on {} of {} folds (first: {}); it is not recommended", h.method,
-                                      h.failed_folds, formed, h.failure));
-    }
-  }
-  if (formed < 3 || out.methods.front().folds < 3) {
-    out.notes.push_back(fmt::format("only {} leave-one-run-out folds: too few to recommend a method", formed));
-    return out;
-  }
-  // Lowest mean among calibration methods that completed every fold.
-  const MethodHeldout* best = nullptr;
-  const MethodHeldout* second = nullptr;
-  for (const auto& h : out.methods) {
-    if (h.method == "recorded" || h.failed_folds > 0 || !std::isfinite(h.mean_m)) continue;
-    if (!best || h.mean_m < best->mean_m) {
-      second = best;
-      best = &h;
-    } else if (!second || h.mean_m < second->mean_m) {
-      second = &h;
-    }
-  }
-  if (!best) return out;
-  out.recommended = best->method;
-  if (second) {
-    out.runner_up = second->method;
-    std::vector<double> d;
-    for (std::size_t k = 0; k < complete.size(); ++k) {
-      if (complete[k]) d.push_back(second->fold_errors_m[k] - best->fold_errors_m[k]);
-    }
-    double mean = 0.0;
-    for (double v : d) mean += v;
-    mean /= static_cast<double>(d.size());
-    double ss = 0.0;
-    for (double v : d) ss += (v - mean) * (v - mean);
-    out.runner_up_difference_m = mean;
-    out.runner_up_difference_sem_m = d.size() > 1 ? std::sqrt(ss / static_cast<double>(d.size() - 1) /
-                                                              static_cast<double>(d.size()))
-                                                  : kNaN;
-  }
+  const std::vector<FoldGroup> groups = MakeFolds(input, used, &out);
+  const std::vector<bool> complete = RunFolds(input, options, methods, groups, with_trajectories, &out);
+  SummariseMethods(complete, &out);
+  Recommend(options, complete, &out);
   return out;
 }
 
@@ -314,8 +472,11 @@ std::vector<std::string> TrustWarnings(const CalibrateJobResult& result, const H
         check.reduced_chi2, check.dof, check.p_value));
   }
   const MethodHeldout* rec = heldout.Find("recorded");
-  const MethodHeldout* best = heldout.recommended.empty() ? nullptr : heldout.Find(heldout.recommended);
-  if (rec && best && rec->mean_m < best->mean_m) {
+  const MethodHeldout* best = nullptr;  // the lowest calibration
+  for (const auto& h : heldout.methods) {
+    if (h.method != "recorded" && h.Recommendable() && (!best || h.mean_m < best->mean_m)) best = &h;
+  }
+  if (rec && best && rec->folds > 0 && rec->mean_m <= best->mean_m) {
     w.push_back(fmt::format(
         "no calibration predicts left-out runs better than the recorded parameters ({:.2f} mm vs {:.2f} mm for {}): "
         "the systematic error is within the scatter; keep the recorded parameters or record more runs",

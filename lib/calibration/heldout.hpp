@@ -1,28 +1,53 @@
-// Which calibration to put on the robot: leave-one-run-out prediction error
-// of every calibration method the data allow (calibrate's `recommended` and
-// per-method `heldout_error`).
+// Which calibration to put on the robot: the prediction error of every
+// calibration method the data allow on runs it did not see (calibrate's
+// `recommended` and per-method `heldout_error`).
 //
-// Each run the calibration used is left out in turn; every method calibrates
-// on the remaining runs and its parameters predict the left-out run:
-//  - trajectory input: the largest position error along the left-out run
-//    with those parameters (odometry from its encoder samples against its
-//    ground truth, as `evaluate` computes it). The whole path, not the final
-//    pose: a closed square's final pose hides errors that cancel (on the June
-//    OptiOdom squares the final pose favoured classic UMBmark where the
-//    whole path and other paths favour the refined fit);
-//  - return errors only (endpoint input): the distance between the measured
-//    return error (x, y) and the exact commanded-square return error of a
-//    robot with those parameters (model/commanded_square.hpp).
-// Above 200 used runs (where one calibration per run would cost time
-// quadratic in the runs) the folds are 10 interleaved groups of runs
-// instead (scheme "k_fold_over_runs"; a fold's error is its runs' mean).
-// Outlier rejection and --exclude-runs are decided once on all runs and kept
-// across folds. Methods: recorded (no calibration, the baseline),
-// umbmark_x, umbmark_y, umbmark_mean (classic estimators), refined and, for
-// trajectories, plain_least_squares (PlainLeastSquaresOptions) when the
-// refined fit is asked for.
+// What is held out, in order of preference (scheme):
+//  - "unseen_paths": the input carries paths of other shapes (a manifest's
+//    circles, free paths, back-and-forth runs: CalibrateInput::unseen).
+//    Every method calibrates on all used square runs and predicts each
+//    unseen run: its final position error, odometry from the run's first
+//    ground-truth pose (the OptiOdom protocol). One fold per unseen run.
+//  - "leave_one_session_out": square runs of two or more recording sessions
+//    (CalibrateInput::sessions). Every method calibrates on the other
+//    sessions and predicts each run of the left-out one; one fold per run.
+//  - "leave_one_run_out" (or "k_fold_over_runs" above 200 used runs: 10
+//    interleaved groups, a fold's error is its runs' mean): one session of
+//    squares. In-distribution: it does not see other shapes or days, which
+//    is why the recommendation below prefers the simpler method unless the
+//    difference is clear.
+// Measures: unseen paths, the final position error; square trajectories,
+// the largest position error along the left-out run (a closed square's
+// final pose hides errors that cancel); return errors only (endpoint
+// input), the distance between the measured return error (x, y) and the
+// exact commanded-square return error of a robot with those parameters.
+// Outlier rejection and --exclude-runs are decided once on all runs.
+//
+// Methods, simplest first: recorded (no calibration); umbmark_x, umbmark_y,
+// umbmark_mean (classic, the overall scale held); plain_least_squares
+// (PlainLeastSquaresOptions: wheelbase and both diameters, no modelling
+// choice) and refined, on trajectory input with ground truth along the path
+// (with or without --refine), refined also on return errors with --refine.
+//
+// Recommendation (never empty unless skipped):
+//  - the baseline is the simplest well-determined calibration:
+//    plain_least_squares where the path determines all three parameters,
+//    else the classic estimator asked for (umbmark_<estimator>); a method
+//    whose fit failed on some fold is not well determined and not
+//    recommendable;
+//  - another method, at least as complete as the baseline (with plain least
+//    squares as baseline the classic rows, which hold the overall scale the
+//    path determines, are shown but not recommended: on the OptiOdom
+//    sessions they lose up to 5.6 mm per pair, docs/calibration-comparison.md),
+//    is recommended only when it beats the baseline by more than the
+//    standard error of the paired difference; the lowest such;
+//  - `recorded` is recommended when its mean is the lowest;
+//  - with fewer than 3 folds the baseline (a note says why).
+// The recommended method's mean and SE are the expected error on unseen
+// paths (expected_error_m, expected_error_sem_m).
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -41,19 +66,35 @@ struct MethodHeldout {
   int folds = 0;         ///< folds in the mean
   int failed_folds = 0;  ///< folds where this method's fit failed (not recommendable)
   std::string failure;   ///< the first failure's message
+  /// 0 recorded, 1 classic UMBmark, 2 plain least squares, 3 refined.
+  int simplicity = 0;
+  bool fitted_all = true;  ///< its fit on all used runs succeeded
+  bool Recommendable() const { return fitted_all && failed_folds == 0 && folds > 0 && std::isfinite(mean_m); }
 };
 
 struct HeldoutComparison {
-  std::string scheme = "leave_one_run_out";  ///< or "k_fold_over_runs" (above 200 runs)
-  /// max_position_error_m (trajectories) | return_error_prediction_m (endpoints)
+  /// leave_one_run_out | k_fold_over_runs | leave_one_session_out | unseen_paths
+  std::string scheme = "leave_one_run_out";
+  /// final_position_error_m (unseen paths) | max_position_error_m (square
+  /// trajectories) | return_error_prediction_m (endpoints)
   std::string measure;
-  std::vector<std::string> left_out;  ///< run ids, fold order
+  std::vector<std::string> left_out;  ///< run ids (or fold names), fold order
+  int sessions = 1;                   ///< recording sessions of the square runs
   std::vector<MethodHeldout> methods;
-  /// Lowest mean among calibration methods without failed folds; empty when
-  /// fewer than 3 folds could be formed.
+  /// The simplest well-determined calibration (see above).
+  std::string baseline;
+  /// See above; empty only when no method could be fitted at all.
   std::string recommended;
-  /// Standard error of the paired difference between the recommended method
-  /// and the runner-up [m] (0 without a runner-up).
+  /// Why `recommended` (one sentence for the user).
+  std::string why;
+  /// Expected error on unseen paths of the recommended method: its mean
+  /// held-out error and that mean's standard error [m] (NaN without folds).
+  double expected_error_m = 0.0, expected_error_sem_m = 0.0;
+  /// The runner-up (the lowest other recommendable method, recorded
+  /// included) and its paired difference to the recommended method:
+  /// runner-up minus recommended [m] and that mean's standard error (0
+  /// without a runner-up). Negative when the recommended method was kept as
+  /// the simpler one although the runner-up's mean is lower.
   double runner_up_difference_m = 0.0, runner_up_difference_sem_m = 0.0;
   std::string runner_up;
   std::vector<std::string> notes;

@@ -79,6 +79,7 @@ const char* StartPoseToString(StartPose s) {
     case StartPose::kFirstSample: return "first_sample";
     case StartPose::kStandstillMean: return "standstill_mean";
     case StartPose::kFitted: return "fitted";
+    case StartPose::kSessionFrame: return "session_frame";
   }
   return "?";
 }
@@ -87,6 +88,7 @@ std::optional<StartPose> StartPoseFromString(std::string_view s) {
   if (s == "first_sample") return StartPose::kFirstSample;
   if (s == "standstill_mean") return StartPose::kStandstillMean;
   if (s == "fitted") return StartPose::kFitted;
+  if (s == "session_frame") return StartPose::kSessionFrame;
   return std::nullopt;
 }
 

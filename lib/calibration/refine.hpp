@@ -107,7 +107,14 @@ enum class StartPose {
   /// aligns the odometry positions with the ground truth (2-D Procrustes,
   /// closed form, differentiated through) is applied, i.e. the start pose
   /// is a nuisance profiled out of the objective.
-  kFitted
+  kFitted,
+  /// The run's first ground-truth sample, seen through one frame error per
+  /// recording session (TrajectoryRunSet): the motion-capture rigid body's
+  /// yaw and origin against the axle midpoint, [a, o_x, o_y], fitted
+  /// jointly with the parameters. Three unknowns per session instead of
+  /// three per run (kFitted), so what a session shares is modelled and
+  /// nothing else is absorbed (docs/calibration-comparison.md).
+  kSessionFrame
 };
 const char* StartPoseToString(StartPose s);
 std::optional<StartPose> StartPoseFromString(std::string_view s);
@@ -183,15 +190,17 @@ struct RefineOptions {
   int samples_per_run = 100;
   /// See PoseSampling. Default kPerRun.
   PoseSampling sampling = PoseSampling::kPerRun;
-  /// See StartPose. Default kFirstSample.
-  StartPose start_pose = StartPose::kFitted;
+  /// See StartPose. Default kSessionFrame (chosen across recording
+  /// sessions: docs/calibration-comparison.md).
+  StartPose start_pose = StartPose::kSessionFrame;
   /// Metres per radian for the heading residual; <= 0 means the reference
   /// wheelbase (a heading error of 1 rad counts like a position error of
   /// one wheelbase: the displacement of a wheel contact point). Default 0.
   double heading_length_m = 0.0;
   /// Multiplies the heading residual (h = heading_weight * heading length);
-  /// 0 = position-only residual. Default 1.
-  double heading_weight = 4.0;
+  /// 0 = position-only residual. Default 2 (chosen across recording
+  /// sessions: docs/calibration-comparison.md).
+  double heading_weight = 2.0;
   /// Robust loss per sampled pose and its scale [m]. Default Huber, 0.02 m:
   /// about twice the path residual of a calibrated small robot, so ordinary
   /// poses stay quadratic and a bump or a tracking glitch counts linearly.

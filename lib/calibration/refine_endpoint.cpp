@@ -128,17 +128,11 @@ Weighting WeightGroup(const Group& g, const std::map<std::pair<std::size_t, int>
   return w;
 }
 
-}  // namespace
-
-RefineSummary RefineFromReturnErrors(const std::vector<SquareRunSet>& sets, const RobotParams& reference,
-                                     const RefineOptions& options) {
-  using refine_detail::FitProblem;
-  if (auto e = options.Check(); !e.empty()) throw InvalidOptions(e);
-  if (auto e = reference.Check(); !e.empty()) throw InvalidOptions("reference robot: " + e);
-
-  // ---- step 1: validate and group the runs ----
+/// Step 1: validates the runs and groups them by (set, direction).
+std::map<std::pair<std::size_t, int>, Group> GroupRuns(const std::vector<SquareRunSet>& sets,
+                                                       const RefineOptions& options, int* runs) {
   std::map<std::pair<std::size_t, int>, Group> groups;
-  int runs = 0;
+  *runs = 0;
   for (std::size_t si = 0; si < sets.size(); ++si) {
     const SquareRunSet& set = sets[si];
     if (!std::isfinite(set.side_m) || !(set.side_m > 0.0)) {
@@ -159,25 +153,93 @@ RefineSummary RefineFromReturnErrors(const std::vector<SquareRunSet>& sets, cons
       g.set = si;
       g.direction = *dir;
       g.runs.push_back(&e);
-      ++runs;
+      ++*runs;
     }
   }
-  if (runs == 0) throw InputError(sets.empty() ? "" : sets.front().source, "no square runs to refine");
-
-  // ---- step 2: weights from the run-to-run scatter ----
+  if (*runs == 0) throw InputError(sets.empty() ? "" : sets.front().source, "no square runs to refine");
+  // Heading residual where every run of the group has it.
   for (auto& [key, g] : groups) {
     bool heading = options.use_heading;
     for (const auto* e : g.runs) heading = heading && e->etheta_rad.has_value();
     g.dim = heading ? 3 : 2;
   }
+  return groups;
+}
+
+/// Step 2, one group: its weights from the run-to-run scatter (WeightGroup)
+/// and one residual block per run added to `fit`. Narrows *dof to the
+/// group's, or sets *any_prior when the prior sigmas weigh it.
+RefineGroupWeighting AddGroupResiduals(const Group& g, const std::map<std::pair<std::size_t, int>, Group>& groups,
+                                       const SquareRunSet& set, const RobotParams& reference,
+                                       const RefineOptions& options, refine_detail::FitProblem* fit,
+                                       std::optional<double>* dof, bool* any_prior) {
+  const int d = g.dim;
+  const Weighting weighting = WeightGroup(g, groups, options);
+  Eigen::MatrixXd S = weighting.covariance;
+  const double floors[3] = {options.sigma_floor_xy_m, options.sigma_floor_xy_m, options.sigma_floor_theta_rad};
+  for (int a = 0; a < d; ++a) S(a, a) += floors[a] * floors[a];
+  if (weighting.dof) {
+    *dof = *dof ? std::min(**dof, *weighting.dof) : *weighting.dof;
+  } else {
+    *any_prior = true;
+  }
+  RefineGroupWeighting w;
+  w.set = set.source;
+  w.direction = SquareDirectionToString(g.direction);
+  w.side_m = set.side_m;
+  w.runs = static_cast<int>(g.runs.size());
+  w.heading = d == 3;
+  w.method = weighting.method;
+  w.sigma_x_m = std::sqrt(S(0, 0));
+  w.sigma_y_m = std::sqrt(S(1, 1));
+  w.sigma_theta_rad = d == 3 ? std::sqrt(S(2, 2)) : 0.0;
+  Eigen::LLT<Eigen::MatrixXd> llt(S);
+  if (llt.info() != Eigen::Success) {
+    throw InputError(set.source, fmt::format("{} runs: the scatter covariance of the return errors is not "
+                                             "positive definite (identical runs?)",
+                                             w.direction));
+  }
+  // sqrt_information = L^-1 with S = L L^T, so |L^-1 e|^2 = e^T S^-1 e.
+  const Eigen::MatrixXd L = llt.matrixL();
+  const Eigen::MatrixXd sqrt_information = L.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(d, d));
+  const Eigen::Vector3d to_set(reference.wheelbase_m / set.recorded.wheelbase_m,
+                               reference.wheel_diameter_left_m / set.recorded.wheel_diameter_left_m,
+                               reference.wheel_diameter_right_m / set.recorded.wheel_diameter_right_m);
+  const auto motions = CommandedSquare(g.direction, set.side_m, set.recorded.wheelbase_m, options.final_turn);
+  // Covariance of the whitened residual when the weights ignore part of
+  // the scatter (rule 3), else identity (omitted).
+  std::optional<Eigen::MatrixXd> omega;
+  if (weighting.actual) {
+    Eigen::MatrixXd actual = *weighting.actual;
+    for (int a = 0; a < d; ++a) actual(a, a) += floors[a] * floors[a];
+    omega = sqrt_information * actual * sqrt_information.transpose();
+  }
+  for (const auto* e : g.runs) {
+    ceres::CostFunction* cost = SquareReturnErrorResidual::Create(motions, set.recorded.wheelbase_m, to_set,
+                                                                  Measured(*e, d), sqrt_information);
+    fit->problem->AddResidualBlock(cost, nullptr, fit->theta);
+    fit->blocks.push_back(cost);
+    fit->block_residual_covariance.push_back(omega);
+  }
+  return w;
+}
+
+}  // namespace
+
+RefineSummary RefineFromReturnErrors(const std::vector<SquareRunSet>& sets, const RobotParams& reference,
+                                     const RefineOptions& options) {
+  using refine_detail::FitProblem;
+  if (auto e = options.Check(); !e.empty()) throw InvalidOptions(e);
+  if (auto e = reference.Check(); !e.empty()) throw InvalidOptions("reference robot: " + e);
+
+  // ---- step 1: validate and group the runs ----
+  int runs = 0;
+  const std::map<std::pair<std::size_t, int>, Group> groups = GroupRuns(sets, options, &runs);
 
   RefineSummary summary;
   summary.input = RefineInputKind::kReturnErrors;
   summary.reference = reference;
   summary.runs = runs;
-  bool any_prior = false;
-  std::optional<double> dof;
-
   FitProblem fit;
   fit.theta[kIndexEb] = options.start.E_b;
   fit.theta[kIndexEd] = options.start.E_d;
@@ -190,58 +252,11 @@ RefineSummary RefineFromReturnErrors(const std::vector<SquareRunSet>& sets, cons
         options.start.E_s));
   }
 
+  // ---- step 2: weights from the run-to-run scatter, residuals ----
+  bool any_prior = false;
+  std::optional<double> dof;
   for (const auto& [key, g] : groups) {
-    const SquareRunSet& set = sets[g.set];
-    const int d = g.dim;
-    const Weighting weighting = WeightGroup(g, groups, options);
-    Eigen::MatrixXd S = weighting.covariance;
-    const double floors[3] = {options.sigma_floor_xy_m, options.sigma_floor_xy_m, options.sigma_floor_theta_rad};
-    for (int a = 0; a < d; ++a) S(a, a) += floors[a] * floors[a];
-    if (weighting.dof) {
-      dof = dof ? std::min(*dof, *weighting.dof) : *weighting.dof;
-    } else {
-      any_prior = true;
-    }
-    RefineGroupWeighting w;
-    w.set = set.source;
-    w.direction = SquareDirectionToString(g.direction);
-    w.side_m = set.side_m;
-    w.runs = static_cast<int>(g.runs.size());
-    w.heading = d == 3;
-    w.method = weighting.method;
-    w.sigma_x_m = std::sqrt(S(0, 0));
-    w.sigma_y_m = std::sqrt(S(1, 1));
-    w.sigma_theta_rad = d == 3 ? std::sqrt(S(2, 2)) : 0.0;
-    Eigen::LLT<Eigen::MatrixXd> llt(S);
-    if (llt.info() != Eigen::Success) {
-      throw InputError(set.source, fmt::format("{} runs: the scatter covariance of the return errors is not "
-                                               "positive definite (identical runs?)",
-                                               w.direction));
-    }
-    // sqrt_information = L^-1 with S = L L^T, so |L^-1 e|^2 = e^T S^-1 e.
-    const Eigen::MatrixXd L = llt.matrixL();
-    const Eigen::MatrixXd sqrt_information =
-        L.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(d, d));
-    const Eigen::Vector3d to_set(reference.wheelbase_m / set.recorded.wheelbase_m,
-                                 reference.wheel_diameter_left_m / set.recorded.wheel_diameter_left_m,
-                                 reference.wheel_diameter_right_m / set.recorded.wheel_diameter_right_m);
-    const auto motions = CommandedSquare(g.direction, set.side_m, set.recorded.wheelbase_m, options.final_turn);
-    // Covariance of the whitened residual when the weights ignore part of
-    // the scatter (rule 3), else identity (omitted).
-    std::optional<Eigen::MatrixXd> omega;
-    if (weighting.actual) {
-      Eigen::MatrixXd actual = *weighting.actual;
-      for (int a = 0; a < d; ++a) actual(a, a) += floors[a] * floors[a];
-      omega = sqrt_information * actual * sqrt_information.transpose();
-    }
-    for (const auto* e : g.runs) {
-      ceres::CostFunction* cost = SquareReturnErrorResidual::Create(motions, set.recorded.wheelbase_m, to_set,
-                                                                    Measured(*e, d), sqrt_information);
-      fit.problem->AddResidualBlock(cost, nullptr, fit.theta);
-      fit.blocks.push_back(cost);
-      fit.block_residual_covariance.push_back(omega);
-    }
-    summary.groups.push_back(std::move(w));
+    summary.groups.push_back(AddGroupResiduals(g, groups, sets[g.set], reference, options, &fit, &dof, &any_prior));
   }
   if (any_prior) {
     dof.reset();

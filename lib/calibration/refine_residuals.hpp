@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -115,6 +116,19 @@ class TrajectoryRunResidual {
 
   template <typename T>
   bool operator()(const T* theta, T* residuals) const {
+    return Residuals(theta, static_cast<const T*>(nullptr), residuals);
+  }
+
+  /// The residuals with the ground truth seen through a session frame error
+  /// `frame` = [yaw a (rad), origin o_x, o_y (m)] (nullptr: none): a rigid
+  /// body whose pose is the axle pose composed with T = (o, a), expressed in
+  /// its first pose, reports T^-1 P T for the true relative pose P. So the
+  /// axle's relative position is R(a) g - (R(theta_g) - I) o, the heading
+  /// unchanged (StartPose::kSessionFrame).
+  template <typename T>
+  bool Residuals(const T* theta, const T* frame, T* residuals) const {
+    using std::cos;
+    using std::sin;
     T c_L, c_R;
     WheelFactors(theta, &c_L, &c_R);
     const T wheelbase = theta[kIndexEb] * T(reference_wheelbase_m_);
@@ -130,11 +144,46 @@ class TrajectoryRunResidual {
     if (fit_start_) AlignStart(&odo);
     for (std::size_t k = 0; k < samples_.size(); ++k) {
       const Pose2& gt = samples_[k].ground_truth;
-      T r[3] = {odo[k].x - T(gt.x), odo[k].y - T(gt.y), T(heading_length_m_) * (odo[k].theta - T(gt.theta))};
+      T gx(gt.x), gy(gt.y);
+      if (frame != nullptr) {
+        const T ca = cos(frame[0]), sa = sin(frame[0]);
+        const double ct = std::cos(gt.theta) - 1.0, st = std::sin(gt.theta);
+        gx = ca * T(gt.x) - sa * T(gt.y) - (T(ct) * frame[1] - T(st) * frame[2]);
+        gy = sa * T(gt.x) + ca * T(gt.y) - (T(st) * frame[1] + T(ct) * frame[2]);
+      }
+      T r[3] = {odo[k].x - gx, odo[k].y - gy, T(heading_length_m_) * (odo[k].theta - T(gt.theta))};
       const T f = RobustFactor(r[0] * r[0] + r[1] * r[1] + r[2] * r[2], loss_, loss_scale_m_);
       for (int i = 0; i < 3; ++i) residuals[3 * k + static_cast<std::size_t>(i)] = f * r[i];
     }
     return true;
+  }
+
+  /// The residual with a session frame block [a, o_x, o_y] (see Residuals).
+  struct Framed {
+    std::shared_ptr<const TrajectoryRunResidual> run;
+    template <typename T>
+    bool operator()(const T* theta, const T* frame, T* residuals) const {
+      return run->Residuals(theta, frame, residuals);
+    }
+  };
+  static ceres::CostFunction* CreateFramed(std::shared_ptr<const TrajectoryRunResidual> run) {
+    const int n = run->num_residuals();
+    return new ceres::AutoDiffCostFunction<Framed, ceres::DYNAMIC, kNumRefineParameters, 3>(new Framed{std::move(run)},
+                                                                                           n);
+  }
+
+  /// The same run with its ground truth seen through the fixed frame error
+  /// `frame` (a plain TrajectoryRunResidual on the corrected samples).
+  std::vector<Sample> CorrectedSamples(const double frame[3]) const {
+    std::vector<Sample> out = samples_;
+    const double ca = std::cos(frame[0]), sa = std::sin(frame[0]);
+    for (auto& s : out) {
+      const Pose2 g = s.ground_truth;
+      const double ct = std::cos(g.theta) - 1.0, st = std::sin(g.theta);
+      s.ground_truth.x = ca * g.x - sa * g.y - (ct * frame[1] - st * frame[2]);
+      s.ground_truth.y = sa * g.x + ca * g.y - (st * frame[1] + ct * frame[2]);
+    }
+    return out;
   }
 
   static ceres::CostFunction* Create(std::vector<double> d_left_m, std::vector<double> d_right_m,

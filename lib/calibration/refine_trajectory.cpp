@@ -13,7 +13,13 @@
 // ticks_per_rev), so sets recorded with different parameters share one
 // true robot: true travel = c * travel under the reference.
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <memory>
+
+#include <ceres/manifold.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
 
 #include <fmt/format.h>
 
@@ -30,6 +36,7 @@ namespace {
 struct PreparedRun {
   std::vector<double> d_left_m, d_right_m;
   std::vector<TrajectoryRunResidual::Sample> samples;
+  std::size_t set = 0;  ///< its TrajectoryRunSet (one recording session)
 };
 
 PreparedRun PrepareRun(const TrajectoryRun& run, const std::string& path, const RobotParams& conversion,
@@ -96,6 +103,55 @@ PreparedRun PrepareRun(const TrajectoryRun& run, const std::string& path, const 
   return out;
 }
 
+/// StartPose::kSessionFrame: one ground-truth frame error [yaw, o_x, o_y]
+/// per set (session), fitted jointly with theta (both free, the scale as
+/// `scale_free` says, same loss and weights) by Ceres; then every run's
+/// samples are replaced by the corrected ones, so the fit that follows (and
+/// its covariance) is conditional on the fitted frames. Notes say what was
+/// fitted.
+void FitSessionFrames(std::vector<PreparedRun>* prepared, std::size_t sets, const RobotParams& reference,
+                      double heading_length, const RefineOptions& options, bool scale_free,
+                      std::vector<std::string>* notes) {
+  double theta[kNumRefineParameters] = {options.start.E_b, options.start.E_d, options.start.E_s};
+  std::vector<std::array<double, 3>> frames(sets, {0.0, 0.0, 0.0});
+  std::vector<int> runs_of(sets, 0);
+  ceres::Problem problem;
+  std::vector<std::shared_ptr<const TrajectoryRunResidual>> residuals;
+  for (const PreparedRun& p : *prepared) {
+    auto run = std::make_shared<const TrajectoryRunResidual>(p.d_left_m, p.d_right_m, reference.wheelbase_m,
+                                                             p.samples, heading_length, options.loss,
+                                                             options.loss_scale_m, options.integrator);
+    problem.AddResidualBlock(TrajectoryRunResidual::CreateFramed(run), nullptr, theta, frames[p.set].data());
+    residuals.push_back(std::move(run));
+    ++runs_of[p.set];
+  }
+  if (!scale_free) problem.SetManifold(theta, new ceres::SubsetManifold(kNumRefineParameters, {kIndexEs}));
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = options.max_num_iterations;
+  so.function_tolerance = options.function_tolerance;
+  so.gradient_tolerance = options.gradient_tolerance;
+  so.parameter_tolerance = options.parameter_tolerance;
+  so.num_threads = options.num_threads;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary cs;
+  ceres::Solve(so, &problem, &cs);
+  if (!cs.IsSolutionUsable()) {
+    notes->push_back("session frame error: the joint fit failed (" + cs.message + "); frames taken as exact");
+    return;
+  }
+  for (std::size_t i = 0; i < prepared->size(); ++i) {
+    (*prepared)[i].samples = residuals[i]->CorrectedSamples(frames[(*prepared)[i].set].data());
+  }
+  for (std::size_t s = 0; s < sets; ++s) {
+    if (runs_of[s] == 0) continue;
+    notes->push_back(fmt::format(
+        "session frame error of set {} ({} runs), fitted jointly: ground-truth yaw {:+.2f} mrad, origin "
+        "({:+.1f}, {:+.1f}) mm from the axle midpoint; the intervals below are conditional on it",
+        s + 1, runs_of[s], frames[s][0] * 1e3, frames[s][1] * 1e3, frames[s][2] * 1e3));
+  }
+}
+
 }  // namespace
 
 RefineSummary RefineFromTrajectories(const std::vector<TrajectoryRunSet>& sets, const RobotParams& reference,
@@ -110,7 +166,8 @@ RefineSummary RefineFromTrajectories(const std::vector<TrajectoryRunSet>& sets, 
   RefineSummary summary;
   summary.input = RefineInputKind::kTrajectories;
   summary.reference = reference;
-  for (const TrajectoryRunSet& set : sets) {
+  for (std::size_t si = 0; si < sets.size(); ++si) {
+    const TrajectoryRunSet& set = sets[si];
     if (set.data == nullptr) throw InvalidOptions("TrajectoryRunSet::data is null");
     const std::string& path = set.data->path;
     if (auto e = set.recorded.Check(); !e.empty()) throw InputError(path, "recorded robot: " + e);
@@ -125,6 +182,7 @@ RefineSummary RefineFromTrajectories(const std::vector<TrajectoryRunSet>& sets, 
         continue;
       }
       summary.sampled_poses += static_cast<int>(p.samples.size());
+      p.set = si;
       prepared.push_back(std::move(p));
     }
   }
@@ -140,7 +198,13 @@ RefineSummary RefineFromTrajectories(const std::vector<TrajectoryRunSet>& sets, 
                                  RobustLossToString(options.loss), heading_length, options.loss_scale_m};
 
   // ---- step 2: build, solve and assess (E_s free unless fixed) ----
+  const std::vector<PreparedRun> as_recorded = prepared;
   auto attempt = [&](bool scale_free) {
+    std::vector<std::string> frame_notes;
+    if (options.start_pose == StartPose::kSessionFrame) {
+      prepared = as_recorded;
+      FitSessionFrames(&prepared, sets.size(), reference, heading_length, options, scale_free, &frame_notes);
+    }
     FitProblem fit;
     fit.theta[kIndexEb] = options.start.E_b;
     fit.theta[kIndexEd] = options.start.E_d;
@@ -162,6 +226,7 @@ RefineSummary RefineFromTrajectories(const std::vector<TrajectoryRunSet>& sets, 
     fit.loss_scale_m = options.loss_scale_m;
     const int p = scale_free ? 3 : 2;
     RefineSummary s = summary;
+    s.notes.insert(s.notes.end(), frame_notes.begin(), frame_notes.end());
     CovarianceKind kind = CovarianceKind::kSolverScaled;
     std::optional<double> dof;
     if (options.covariance == TrajectoryCovariance::kRunClustered) {
