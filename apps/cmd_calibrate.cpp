@@ -56,7 +56,7 @@ struct CalibrateOptions {
   double heading_weight = 2.0;
   std::string use = "recommended";
   bool per_experiment = false;
-  bool no_heldout = false;  // --no-heldout: skip the leave-one-run-out comparison
+  bool no_heldout = false;  // --no-heldout: skip the held-out comparison
 };
 
 // The parameters --ros2 and --plot use: --use classic | refined |
@@ -84,7 +84,7 @@ constexpr const char* kHeldoutSkipped = "skipped";
 HeldoutComparison SkippedHeldout() {
   HeldoutComparison h;
   h.scheme = kHeldoutSkipped;
-  h.notes.push_back("--no-heldout: the leave-one-run-out comparison of the methods was not run");
+  h.notes.push_back("--no-heldout: the held-out comparison of the methods was not run");
   return h;
 }
 
@@ -290,10 +290,10 @@ void PrintEvaluation(const char* title, const EvaluationSummary& e) {
 
 /// What the held-out scheme left out, for the table's title.
 std::string SchemeText(const HeldoutComparison& h) {
-  if (h.scheme == "unseen_paths") return "paths of other shapes, unseen by every calibration";
-  if (h.scheme == "leave_one_session_out") return fmt::format("leave-one-session-out over {} sessions", h.sessions);
-  if (h.scheme == "k_fold_over_runs") return "10-fold (over runs)";
-  return "leave-one-run-out";
+  if (h.scheme == "unseen_paths") return "paths of other shapes that no calibration saw";
+  if (h.scheme == "leave_one_session_out") return fmt::format("left-out sessions (of {})", h.sessions);
+  if (h.scheme == "k_fold_over_runs") return "left-out runs (10-fold over runs)";
+  return "left-out runs (leave-one-run-out)";
 }
 
 /// The held-out table: each method's prediction error and the recommendation.
@@ -302,7 +302,7 @@ void PrintHeldoutTable(const HeldoutComparison& h) {
                                                                       "ground-truth pose"
                               : h.measure == "max_position_error_m" ? "largest position error along the left-out run"
                                                                     : "left-out return error vs the model's prediction";
-  fmt::print("Which calibration to trust: {} prediction error ({} folds, {})\n", SchemeText(h),
+  fmt::print("Which calibration to trust: prediction error on {} ({} folds, {})\n", SchemeText(h),
              h.methods.empty() ? 0 : h.methods.front().folds, measure);
   const MethodHeldout* lowest = nullptr;
   for (const auto& m : h.methods) {
@@ -322,7 +322,7 @@ void PrintHeldoutTable(const HeldoutComparison& h) {
     fmt::print("  Put {} on the robot: wheelbase {:.6f} m, left diameter {:.6f} m, right diameter {:.6f} m\n",
                h.recommended, m->parameters.wheelbase_m, m->parameters.wheel_diameter_left_m,
                m->parameters.wheel_diameter_right_m);
-    fmt::print("  ({}; baseline {})\n", h.why, h.baseline);
+    fmt::print("  ({})\n", h.why);
     fmt::print("  Expected error on paths it has not seen: {:.2f} mm +- {:.2f} (SE){}\n", h.expected_error_m * 1e3,
                h.expected_error_sem_m * 1e3,
                h.scheme == "unseen_paths" || h.scheme == "leave_one_session_out"
@@ -338,7 +338,7 @@ void PrintHeldoutTable(const HeldoutComparison& h) {
 void PrintHeldout(const HeldoutComparison& h, const Chosen& chosen, const std::vector<std::string>& warnings,
                   const CalibrateOptions& o) {
   if (h.scheme == kHeldoutSkipped) {
-    fmt::print("Which calibration to trust: not compared (--no-heldout); run without it for the leave-one-run-out "
+    fmt::print("Which calibration to trust: not compared (--no-heldout); run without it for the held-out "
                "prediction error of each method\n");
   } else {
     PrintHeldoutTable(h);
@@ -767,7 +767,7 @@ Command SetupCalibrate(CLI::App& parent) {
                   "Write an SVG: return errors before/after (the --use calibration) on one scale, centres of gravity "
                   "with SEM ellipses, E_max,syst, and each run's path");
   app->add_flag("--no-heldout", opts->no_heldout,
-                "Skip the leave-one-run-out comparison of the methods (it calibrates every method once per run; "
+                "Skip the held-out comparison of the methods (it calibrates every method once per fold; "
                 "JSON `recommended` and `heldout_error` say \"skipped\", and --use recommended takes the classic "
                 "result). Default: compare");
   app->add_option("--use", opts->use,
