@@ -152,20 +152,12 @@ void FitSessionFrames(std::vector<PreparedRun>* prepared, std::size_t sets, cons
   }
 }
 
-}  // namespace
-
-RefineSummary RefineFromTrajectories(const std::vector<TrajectoryRunSet>& sets, const RobotParams& reference,
-                                     const RefineOptions& options) {
-  using refine_detail::CovarianceKind;
-  using refine_detail::FitProblem;
-  if (auto e = options.Check(); !e.empty()) throw InvalidOptions(e);
-  if (auto e = reference.Check(); !e.empty()) throw InvalidOptions("reference robot: " + e);
-
-  // ---- step 1: wheel travel and sampled ground truth per run ----
+/// Step 1: wheel travel and sampled ground truth of every run of every set
+/// (notes and sampled_poses into *summary). Throws InputError when no run
+/// has ground truth beyond its first sample.
+std::vector<PreparedRun> PrepareSets(const std::vector<TrajectoryRunSet>& sets, const RobotParams& reference,
+                                     const RefineOptions& options, RefineSummary* summary) {
   std::vector<PreparedRun> prepared;
-  RefineSummary summary;
-  summary.input = RefineInputKind::kTrajectories;
-  summary.reference = reference;
   for (std::size_t si = 0; si < sets.size(); ++si) {
     const TrajectoryRunSet& set = sets[si];
     if (set.data == nullptr) throw InvalidOptions("TrajectoryRunSet::data is null");
@@ -177,11 +169,11 @@ RefineSummary RefineFromTrajectories(const std::vector<TrajectoryRunSet>& sets, 
     for (const TrajectoryRun& run : set.data->runs) {
       PreparedRun p = PrepareRun(run, path, conversion, set.recorded, options);
       if (p.samples.empty()) {
-        summary.notes.push_back(fmt::format("{}: run {} skipped (ground truth at its first sample only)", path,
+        summary->notes.push_back(fmt::format("{}: run {} skipped (ground truth at its first sample only)", path,
                                             run.run));
         continue;
       }
-      summary.sampled_poses += static_cast<int>(p.samples.size());
+      summary->sampled_poses += static_cast<int>(p.samples.size());
       p.set = si;
       prepared.push_back(std::move(p));
     }
@@ -190,6 +182,23 @@ RefineSummary RefineFromTrajectories(const std::vector<TrajectoryRunSet>& sets, 
     throw InputError(sets.empty() || !sets.front().data ? "" : sets.front().data->path,
                      "no trajectory run with ground truth beyond its first sample to refine");
   }
+  return prepared;
+}
+
+}  // namespace
+
+RefineSummary RefineFromTrajectories(const std::vector<TrajectoryRunSet>& sets, const RobotParams& reference,
+                                     const RefineOptions& options) {
+  using refine_detail::CovarianceKind;
+  using refine_detail::FitProblem;
+  if (auto e = options.Check(); !e.empty()) throw InvalidOptions(e);
+  if (auto e = reference.Check(); !e.empty()) throw InvalidOptions("reference robot: " + e);
+
+  // ---- step 1: wheel travel and sampled ground truth per run ----
+  RefineSummary summary;
+  summary.input = RefineInputKind::kTrajectories;
+  summary.reference = reference;
+  std::vector<PreparedRun> prepared = PrepareSets(sets, reference, options, &summary);
   summary.runs = static_cast<int>(prepared.size());
   const double heading_length =
       options.heading_weight * (options.heading_length_m > 0.0 ? options.heading_length_m : reference.wheelbase_m);
