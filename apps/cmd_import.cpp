@@ -17,6 +17,7 @@
 #include "io/campaign_writer.hpp"
 #include "io/optiodom.hpp"
 #include "io/rosbag2/rosbag2_import.hpp"
+#include "io/rosbag2/wheel_checks.hpp"
 
 namespace umbmark::cli {
 
@@ -123,7 +124,53 @@ struct Rosbag2Options {
   JsonFlag json;
 };
 
+// One topic row of --list, and below a TFMessage topic its frames (parent,
+// rate, whether the odometry frame is in its chain): enough to choose every
+// flag of the import from the listing alone.
+void PrintListedTopic(const io::rosbag2::TopicListing& l) {
+  constexpr std::size_t kMaxFrames = 60;
+  std::string use;
+  if (l.wheels) use = l.topic.type == "sensor_msgs/msg/JointState" ? "--wheels" : "--odometry";
+  if (l.ground_truth) use += use.empty() ? "--ground-truth" : ", --ground-truth";
+  if (!l.joints.empty()) use += fmt::format(" (joints: {})", io::rosbag2::TrimmedList(l.joints, 30));
+  if (!l.tf.empty()) use += " with --ground-truth-frame FRAME:";
+  fmt::print("  {:<28} {:<44} {:>9} {:>9.1f}  {}\n", l.topic.name, l.topic.type, l.topic.count, l.topic.RateHz(), use);
+  for (std::size_t i = 0; i < l.tf.size() && i < kMaxFrames; ++i) {
+    const auto& f = l.tf[i];
+    const std::string rate = f.edge.is_static ? std::string("static") : fmt::format("{:.1f} Hz", f.edge.RateHz());
+    fmt::print("      frame {:<24} parent {:<20} {:>10}  {}\n", f.edge.child, f.edge.parent, rate,
+               !f.through_odometry.empty()
+                   ? fmt::format("odometry (chain runs through '{}'): not ground truth", f.through_odometry)
+               : f.edge.is_static ? std::string("fixed offset (composed when chosen)")
+                                  : std::string("ground-truth candidate"));
+  }
+  if (l.tf.size() > kMaxFrames) fmt::print("      ... and {} more frames (--json lists them all)\n", l.tf.size() - kMaxFrames);
+}
+
+nlohmann::json ListedTopicJson(const io::rosbag2::TopicListing& l) {
+  nlohmann::json frames = nlohmann::json::array();
+  for (const auto& f : l.tf)
+    frames.push_back({{"frame", f.edge.child},
+                      {"parent", f.edge.parent},
+                      {"static", f.edge.is_static},
+                      {"messages", f.edge.count},
+                      {"rate_hz", JsonNumber(f.edge.RateHz())},
+                      {"through_odometry", f.through_odometry}});
+  return {{"name", l.topic.name},
+          {"type", l.topic.type},
+          {"messages", l.topic.count},
+          {"rate_hz", JsonNumber(l.topic.RateHz())},
+          {"wheels", l.wheels},
+          {"ground_truth", l.ground_truth},
+          {"joints", l.joints},
+          {"child_frames", l.frames},
+          {"frames", frames}};
+}
+
+// Usable topics first (at most 200), then the others (at most 40), so
+// that 200,000 camera topics do not bury the wheel and ground-truth ones.
 int RunRosbag2List(const Rosbag2Options& o) {
+  constexpr std::size_t kMaxUsable = 200, kMaxOther = 40;
   io::OutputSet& outs = CommandOutputs();
   for (const auto& bag : o.bags) outs.AddInput(bag);
   outs.AddOutput("--json", o.json.path);
@@ -135,32 +182,30 @@ int RunRosbag2List(const Rosbag2Options& o) {
     nlohmann::json topics = nlohmann::json::array();
     if (o.json.PrintText()) {
       fmt::print("{} ({} storage file{}: {})\n", path, listing.files.size(), listing.files.size() == 1 ? "" : "s",
-                 fmt::join(listing.files, ", "));
+                 io::rosbag2::TrimmedList(listing.files, 10));
       fmt::print("  {:<28} {:<44} {:>9} {:>9}  use as\n", "topic", "type", "messages", "rate Hz");
     }
-    for (const auto& l : listing.topics) {
-      std::string use;
-      if (l.wheels) use = l.topic.type == "sensor_msgs/msg/JointState" ? "--wheels" : "--odometry";
-      if (l.ground_truth) use += use.empty() ? "--ground-truth" : ", --ground-truth";
-      if (!l.joints.empty()) use += fmt::format(" (joints: {})", fmt::join(l.joints, ", "));
-      if (!l.frames.empty()) use += fmt::format(" (child frames: {})", fmt::join(l.frames, ", "));
-      if (o.json.PrintText())
-        fmt::print("  {:<28} {:<44} {:>9} {:>9.1f}  {}\n", l.topic.name, l.topic.type, l.topic.count, l.topic.RateHz(), use);
-      topics.push_back({{"name", l.topic.name},
-                        {"type", l.topic.type},
-                        {"messages", l.topic.count},
-                        {"rate_hz", JsonNumber(l.topic.RateHz())},
-                        {"wheels", l.wheels},
-                        {"ground_truth", l.ground_truth},
-                        {"joints", l.joints},
-                        {"child_frames", l.frames}});
-    }
-    bags.push_back({{"path", path}, {"files", listing.files}, {"topics", topics}});
+    std::size_t usable = 0, other = 0, omitted = 0;
+    for (const bool want_usable : {true, false})
+      for (const auto& l : listing.topics) {
+        const bool is_usable = l.wheels || l.ground_truth;
+        if (is_usable != want_usable) continue;
+        if (is_usable ? usable++ >= kMaxUsable : other++ >= kMaxOther) {
+          ++omitted;
+          continue;
+        }
+        if (o.json.PrintText()) PrintListedTopic(l);
+        topics.push_back(ListedTopicJson(l));
+      }
+    if (omitted > 0 && o.json.PrintText())
+      fmt::print("  ... and {} more topics not listed ({} usable as wheels or ground truth)\n", omitted,
+                 usable > kMaxUsable ? usable - kMaxUsable : 0);
+    bags.push_back({{"path", path}, {"files", listing.files}, {"topics", topics}, {"topics_not_listed", omitted}});
   }
   if (o.json.PrintText()) {
     for (const auto& w : warnings) fmt::print(stderr, "warning: {}\n", w);
     fmt::print("Next: umbmark import rosbag2 BAG --out DIR --experiment square --side S --robot R.toml "
-               "--wheels TOPIC --ground-truth TOPIC\n");
+               "--wheels TOPIC [--left-joint J --right-joint J] --ground-truth TOPIC [--ground-truth-frame FRAME]\n");
   }
   o.json.Emit({{"bags", bags}, {"warnings", warnings}});
   return 0;
@@ -180,7 +225,13 @@ int RunRosbag2(Rosbag2Options o) {
   opt.side_m = o.side_m.value_or(0.0);
   opt.distance_m = o.distance_m.value_or(0.0);
   opt.integrator = *IntegratorFromString(o.integrator);
-  opt.time = o.time == "log" ? io::rosbag2::StampSource::kLog : io::rosbag2::StampSource::kHeader;
+  // --time header|log for both streams, or WHEELS,GROUND_TRUTH.
+  const auto comma = o.time.find(',');
+  auto stamp = [](const std::string& s) {
+    return s == "log" ? io::rosbag2::StampSource::kLog : io::rosbag2::StampSource::kHeader;
+  };
+  opt.time = stamp(o.time.substr(0, comma));
+  if (comma != std::string::npos) opt.ground_truth_time = stamp(o.time.substr(comma + 1));
   const RobotParams robot = o.robot.Resolve();
   // The recordings (and every file of a bag folder) are inputs; the two
   // files written must not be one of them or another output.
@@ -203,6 +254,7 @@ int RunRosbag2(Rosbag2Options o) {
   nlohmann::json recordings = nlohmann::json::array();
   for (const auto& r : result.recordings)
     recordings.push_back({{"path", r.path},
+                          {"runs_dropped", r.runs_dropped},
                           {"wheel_messages", r.wheel_messages},
                           {"ground_truth_messages", r.ground_truth_messages},
                           {"runs", r.runs},
@@ -288,9 +340,11 @@ Command SetupImport(CLI::App& parent) {
   rb->add_option("--ground-truth", ro->import.ground_truth_topic,
                  "Ground-truth pose topic: PoseStamped, PoseWithCovarianceStamped, Odometry or TFMessage");
   rb->add_option("--ground-truth-frame", ro->import.ground_truth_frame, "TFMessage: the child_frame_id to follow");
-  rb->add_option("--time", ro->time, "Time stamps: header (header.stamp) or log (receive time)")
+  rb->add_option("--time", ro->time,
+                 "Time stamps: header (header.stamp) or log (receive time), for both streams; or WHEELS,GROUND_TRUTH "
+                 "(e.g. header,log: the wheels by header stamp, the ground truth by receive time)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"header", "log"}));
+      ->check(CLI::IsMember({"header", "log", "header,log", "log,header", "header,header", "log,log"}));
   rb->add_option("--integrator", ro->integrator, "Integrator the robot's /odom used (for --odometry)")
       ->capture_default_str()
       ->check(CLI::IsMember({"arc", "midpoint"}));

@@ -98,9 +98,9 @@ std::vector<std::string> ReadMetadataFileList(const std::string& metadata_path) 
 }
 
 std::optional<std::size_t> Bag::FindTopic(std::string_view name) const {
-  for (std::size_t i = 0; i < topics_.size(); ++i)
-    if (topics_[i].name == name) return i;
-  return std::nullopt;
+  const auto it = index_.find(std::string(name));
+  if (it == index_.end()) return std::nullopt;
+  return it->second;
 }
 
 // Long because it is the one place that knows the three bag layouts (folder
@@ -148,6 +148,7 @@ Bag Bag::Open(const std::string& path, std::vector<std::string>& warnings) {
       bag.topics_.push_back({name, type, ser, 0, std::numeric_limits<std::int64_t>::max(),
                              std::numeric_limits<std::int64_t>::min()});
       idx = bag.topics_.size() - 1;
+      bag.index_.emplace(name, *idx);
     }
     TopicInfo& t = bag.topics_[*idx];
     if (t.type != type)
@@ -217,7 +218,7 @@ void Bag::Read(const std::vector<bool>& wanted, const std::function<void(const B
         w[i] = idx && *idx < wanted.size() && wanted[*idx];
       }
       db.Stream(w, [&](std::size_t i, std::int64_t ts, const std::uint8_t* d, std::size_t n) {
-        fn({map[i], ts, d, n, &file, 0});
+        fn({map[i], ts, d, n, &file, 0, false, 0});
       });
       continue;
     }
@@ -234,7 +235,8 @@ void Bag::Read(const std::vector<bool>& wanted, const std::function<void(const B
           return true;
         },
         [&](const McapMessage& m) {
-          fn({map[m.channel_id], static_cast<std::int64_t>(m.log_time_ns), m.data, m.size, &file, m.offset});
+          fn({map[m.channel_id], static_cast<std::int64_t>(m.log_time_ns), m.data, m.size, &file, m.offset,
+              m.compressed_chunk, m.chunk_byte});
         });
   }
 }

@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 namespace umbmark::io::rosbag2 {
@@ -33,7 +34,11 @@ struct BagMessage {
   const std::uint8_t* data = nullptr;
   std::size_t size = 0;
   const std::string* file = nullptr;  ///< storage file it came from
-  std::uint64_t offset = 0;           ///< MCAP: record (chunk) byte offset; SQLite: 0
+  /// MCAP: the record's byte offset in the file, or for a compressed
+  /// chunk the chunk's; SQLite: 0.
+  std::uint64_t offset = 0;
+  bool compressed_chunk = false;  ///< then chunk_byte: the record's offset in the decompressed chunk
+  std::uint64_t chunk_byte = 0;
 };
 
 class Bag {
@@ -56,6 +61,7 @@ class Bag {
   std::string path_;
   std::vector<std::string> files_;
   std::vector<TopicInfo> topics_;
+  std::unordered_map<std::string, std::size_t> index_;  ///< topic name -> index (200,000 topics happen)
 };
 
 /// The storage files a metadata.yaml lists under relative_file_paths, in

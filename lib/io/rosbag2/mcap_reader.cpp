@@ -2,8 +2,11 @@
 #include "io/rosbag2/mcap_reader.hpp"
 
 #include <cerrno>
+#include <algorithm>
 #include <cstring>
 #include <string_view>
+
+#include <unistd.h>
 
 #include <fmt/format.h>
 #include <isa-l/crc.h>
@@ -138,6 +141,14 @@ McapReader::McapReader(std::string path) : path_(std::move(path)) {
 
 McapReader::~McapReader() = default;
 
+// Half the physical memory, at most 16 GiB: what one chunk may take.
+std::uint64_t McapReader::MaxChunkBytes() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  const std::uint64_t phys = pages > 0 && page > 0 ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page)
+                                                   : (1ull << 32);
+  return std::min<std::uint64_t>(phys / 2, 1ull << 34);
+}
+
 void McapReader::Fail(std::uint64_t offset, const std::string& what) const {
   throw InputError(path_, fmt::format("byte {}: {}", offset, what));
 }
@@ -222,6 +233,55 @@ bool McapReader::ReadSummary(McapSummary& out) {
   return have_stats;
 }
 
+// Grows chunk_ for a decompression that has filled it: doubling, at most
+// to the claimed size. Returns false when it is already that large.
+bool McapReader::GrowChunk(std::size_t claimed) {
+  if (chunk_.size() >= claimed) return false;
+  chunk_.resize(std::min(claimed, std::max<std::size_t>(2 * chunk_.size(), 1 << 20)));
+  return true;
+}
+
+// Streaming zstd into chunk_ (one or more frames); returns the bytes
+// produced, or claimed + 1 when the data would exceed the claim.
+std::size_t McapReader::Unzstd(const std::uint8_t* in, std::size_t n, std::size_t claimed, std::uint64_t offset) {
+  std::unique_ptr<ZSTD_DCtx, std::size_t (*)(ZSTD_DCtx*)> z(ZSTD_createDCtx(), ZSTD_freeDCtx);
+  if (!z) Fail(offset, "cannot create a zstd context");
+  chunk_.resize(std::min<std::size_t>(claimed, (1 << 20) + 16 * n));
+  ZSTD_inBuffer src{in, n, 0};
+  std::size_t produced = 0, left = 1;
+  while (src.pos < src.size || left != 0) {
+    ZSTD_outBuffer dst{chunk_.data(), chunk_.size(), produced};
+    left = ZSTD_decompressStream(z.get(), &dst, &src);
+    if (ZSTD_isError(left)) Fail(offset, fmt::format("zstd decompression of the chunk failed: {}", ZSTD_getErrorName(left)));
+    const bool progressed = dst.pos > produced;
+    produced = dst.pos;
+    if (produced == chunk_.size() && (left != 0 || src.pos < src.size) && !GrowChunk(claimed)) return claimed + 1;
+    if (!progressed && src.pos == src.size && left != 0) Fail(offset, "zstd chunk ends inside a frame (truncated)");
+  }
+  chunk_.resize(produced);
+  return produced;
+}
+
+std::size_t McapReader::Unlz4(const std::uint8_t* in, std::size_t n, std::size_t claimed, std::uint64_t offset) {
+  LZ4F_dctx* raw = nullptr;
+  if (LZ4F_isError(LZ4F_createDecompressionContext(&raw, LZ4F_VERSION))) Fail(offset, "cannot create an LZ4 context");
+  std::unique_ptr<LZ4F_dctx, LZ4F_errorCode_t (*)(LZ4F_dctx*)> dctx(raw, LZ4F_freeDecompressionContext);
+  chunk_.resize(std::min<std::size_t>(claimed, (1 << 20) + 16 * n));
+  std::size_t in_pos = 0, out_pos = 0, hint = 1;
+  while (hint != 0 && in_pos < n) {
+    if (out_pos == chunk_.size() && !GrowChunk(claimed)) return claimed + 1;
+    std::size_t in_n = n - in_pos, out_n = chunk_.size() - out_pos;
+    hint = LZ4F_decompress(dctx.get(), chunk_.data() + out_pos, &out_n, in + in_pos, &in_n, nullptr);
+    if (LZ4F_isError(hint)) Fail(offset, std::string("lz4 decompression of the chunk failed: ") + LZ4F_getErrorName(hint));
+    in_pos += in_n;
+    out_pos += out_n;
+    if (in_n == 0 && out_n == 0 && out_pos < chunk_.size()) break;  // no progress
+  }
+  if (hint != 0) Fail(offset, fmt::format("lz4 chunk ends inside its frame after {} bytes (truncated)", out_pos));
+  chunk_.resize(out_pos);
+  return out_pos;
+}
+
 void McapReader::DecompressChunk(const std::uint8_t* content, std::size_t size, std::uint64_t offset) {
   Fields f(content, size, offset, kChunk, *this);
   f.U64();  // message_start_time
@@ -230,40 +290,28 @@ void McapReader::DecompressChunk(const std::uint8_t* content, std::size_t size, 
   const std::uint32_t crc = f.U32();
   const std::string compression = f.Str();
   const auto [records, records_size] = f.Bytes64();
-  // A chunk cannot expand beyond what the codecs allow; refuse absurd sizes
-  // before allocating (zstd and lz4 frames expand at most ~255x).
-  if (uncompressed_size > (static_cast<std::uint64_t>(records_size) + 64) * 256 || uncompressed_size > (1ull << 34))
-    Fail(offset, fmt::format("chunk claims {} uncompressed bytes from {} compressed", uncompressed_size, records_size));
-  chunk_.resize(static_cast<std::size_t>(uncompressed_size));
+  // Limited by memory, not by ratio (zstd legitimately expands a black
+  // camera image more than 1000x): the claimed size must fit in memory, and
+  // the buffer grows with what the codec actually produces, so a small
+  // chunk that claims gigabytes costs only what it really expands to.
+  chunk_compressed_ = !compression.empty();
+  chunk_records_at_ = static_cast<std::size_t>(records - content);
+  if (uncompressed_size > MaxChunkBytes())
+    Fail(offset, fmt::format("chunk claims {} uncompressed bytes (from {} compressed), more than this reader takes in "
+                             "memory ({} bytes)", uncompressed_size, records_size, MaxChunkBytes()));
+  const auto claimed = static_cast<std::size_t>(uncompressed_size);
   if (compression.empty()) {
     if (records_size != uncompressed_size)
       Fail(offset, fmt::format("uncompressed chunk holds {} bytes but says {}", records_size, uncompressed_size));
+    chunk_.resize(claimed);
     if (records_size > 0) std::memcpy(chunk_.data(), records, records_size);
-  } else if (compression == "zstd") {
-    const std::size_t got = ZSTD_decompress(chunk_.data(), chunk_.size(), records, records_size);
-    if (ZSTD_isError(got)) Fail(offset, fmt::format("zstd decompression of the chunk failed: {}", ZSTD_getErrorName(got)));
-    if (got != uncompressed_size)
-      Fail(offset, fmt::format("zstd chunk decompressed to {} bytes, header says {}", got, uncompressed_size));
-  } else if (compression == "lz4") {
-    LZ4F_dctx* dctx = nullptr;
-    if (LZ4F_isError(LZ4F_createDecompressionContext(&dctx, LZ4F_VERSION))) Fail(offset, "cannot create an LZ4 context");
-    std::size_t in_pos = 0, out_pos = 0, hint = 1;
-    while (hint != 0 && in_pos < records_size) {
-      std::size_t in_n = records_size - in_pos, out_n = chunk_.size() - out_pos;
-      hint = LZ4F_decompress(dctx, chunk_.data() + out_pos, &out_n, records + in_pos, &in_n, nullptr);
-      if (LZ4F_isError(hint)) {
-        const std::string why = LZ4F_getErrorName(hint);
-        LZ4F_freeDecompressionContext(dctx);
-        Fail(offset, "lz4 decompression of the chunk failed: " + why);
-      }
-      in_pos += in_n;
-      out_pos += out_n;
-      if (in_n == 0 && out_n == 0) break;  // output full: a frame larger than declared
-    }
-    LZ4F_freeDecompressionContext(dctx);
-    if (hint != 0 || out_pos != uncompressed_size)
-      Fail(offset, fmt::format("lz4 chunk decompressed to {} bytes (frame {}), header says {}", out_pos,
-                               hint == 0 ? "complete" : "incomplete", uncompressed_size));
+  } else if (compression == "zstd" || compression == "lz4") {
+    const std::size_t got = compression == "zstd" ? Unzstd(records, records_size, claimed, offset)
+                                                  : Unlz4(records, records_size, claimed, offset);
+    if (got > claimed)
+      Fail(offset, fmt::format("{} chunk decompresses to more than the {} bytes its header says", compression, claimed));
+    if (got != claimed)
+      Fail(offset, fmt::format("{} chunk decompressed to {} bytes, header says {}", compression, got, uncompressed_size));
   } else {
     Fail(offset, fmt::format("unsupported chunk compression '{}' (zstd, lz4 or none expected)", compression));
   }
@@ -283,7 +331,13 @@ void McapReader::HandleRecord(std::uint8_t op, const std::uint8_t* content, std:
     const std::uint16_t ch = static_cast<std::uint16_t>(content[0] | (content[1] << 8));
     if (ch >= channel_state_.size() || channel_state_[ch] < 0)
       Fail(base, fmt::format("message{} on channel {} before that channel's record", where, ch));
-    if (channel_state_[ch] > 0) on_message({ch, Le64(content + 6), content + 22, n - 22, base});
+    if (channel_state_[ch] > 0) {
+      // Inside an uncompressed chunk the record's file offset is exact;
+      // inside a compressed one, its offset in the decompressed chunk.
+      const bool compressed = in_chunk && chunk_compressed_;
+      const std::uint64_t at = !in_chunk ? base : compressed ? base : base + kRecordHeader + chunk_records_at_ + chunk_at;
+      on_message({ch, Le64(content + 6), content + 22, n - 22, at, compressed, compressed ? chunk_at : 0});
+    }
   } else if (op == kSchema) {
     Fields f(content, n, base, op, *this);
     McapSchema s;

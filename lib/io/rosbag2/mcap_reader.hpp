@@ -39,14 +39,17 @@ struct McapChannel {
 };
 
 /// One message; `data` points into the reader's buffer and is valid only
-/// during the callback. `offset` is the file offset of the record (for a
-/// message inside a chunk, of the chunk).
+/// during the callback. `offset` is the file offset of the record (inside
+/// an uncompressed chunk too); inside a compressed chunk it is the chunk's,
+/// and `chunk_byte` the record's offset in the decompressed chunk.
 struct McapMessage {
   std::uint16_t channel_id = 0;
   std::uint64_t log_time_ns = 0;
   const std::uint8_t* data = nullptr;
   std::size_t size = 0;
   std::uint64_t offset = 0;
+  bool compressed_chunk = false;
+  std::uint64_t chunk_byte = 0;
 };
 
 /// What the summary section tells without reading the data.
@@ -79,6 +82,9 @@ class McapReader {
 
   const std::string& path() const { return path_; }
   std::uint64_t file_size() const { return size_; }
+  /// The largest chunk (decompressed) the reader allocates: half the
+  /// physical memory, at most 16 GiB. Limited by memory, not by ratio.
+  static std::uint64_t MaxChunkBytes();
 
  private:
   [[noreturn]] void Fail(std::uint64_t offset, const std::string& what) const;
@@ -87,6 +93,9 @@ class McapReader {
                     std::size_t chunk_at, bool in_chunk, const std::function<bool(const McapChannel&)>& on_channel,
                     const std::function<void(const McapMessage&)>& on_message);
   void DecompressChunk(const std::uint8_t* content, std::size_t size, std::uint64_t offset);
+  bool GrowChunk(std::size_t claimed);
+  std::size_t Unzstd(const std::uint8_t* in, std::size_t n, std::size_t claimed, std::uint64_t offset);
+  std::size_t Unlz4(const std::uint8_t* in, std::size_t n, std::size_t claimed, std::uint64_t offset);
 
   std::string path_;
   struct FileCloser {
@@ -97,6 +106,8 @@ class McapReader {
   std::uint64_t pos_ = 0;
   std::vector<std::uint8_t> record_;  ///< current record's content
   std::vector<std::uint8_t> chunk_;   ///< current chunk, decompressed
+  bool chunk_compressed_ = false;     ///< current chunk's compression is not ""
+  std::size_t chunk_records_at_ = 0;  ///< offset of its records in the chunk record's content
   std::map<std::uint16_t, McapSchema> schemas_;
   std::vector<std::int8_t> channel_state_;  ///< by id: -1 unknown, 0 unwanted, 1 wanted
 };

@@ -38,7 +38,14 @@ void DecodeJointState(CdrReader& r, JointStateMsg& out) {
   const std::uint32_t positions = r.SequenceLength(8);
   out.position.resize(positions);
   for (auto& p : out.position) p = r.Float64();
-  // velocity and effort are not used.
+  // velocity[] only for its length (a velocity-only JointState is named as
+  // such); a message cut after position[] is tolerated as before.
+  out.velocity_count = 0;
+  if (r.size() - r.offset() >= 4) {
+    out.velocity_count = r.SequenceLength(8);
+    r.Skip(out.velocity_count, 8);
+  }
+  // effort is not used.
 }
 
 namespace {

@@ -35,6 +35,7 @@ struct JointStateMsg {
   Header header;
   std::vector<std::string_view> name;
   std::vector<double> position;
+  std::size_t velocity_count = 0;  ///< length of velocity[] (values not kept)
 };
 
 /// A planar-relevant pose: position and orientation quaternion.

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <map>
 #include <set>
 
 #include <fmt/format.h>
@@ -11,6 +12,8 @@
 #include "core/angles.hpp"
 #include "core/errors.hpp"
 #include "io/rosbag2/messages.hpp"
+#include "io/rosbag2/tf_tree.hpp"
+#include "io/rosbag2/wheel_checks.hpp"
 
 namespace umbmark::io::rosbag2 {
 
@@ -18,11 +21,6 @@ namespace {
 
 constexpr double kStillM = 1e-6;  // a wheel is still when its travel changes less than this
 
-struct WheelSample {
-  std::int64_t t_ns;
-  double left, right;  // cumulative travel [m] (JointState) or pose x, y, yaw (Odometry, converted later)
-  double yaw = 0.0;
-};
 struct GtSample {
   std::int64_t t_ns;
   double x, y, yaw;  // yaw unwrapped after reading
@@ -47,7 +45,6 @@ class JointPicker {
       ri = ri_;
       return true;
     }
-    const std::string names = fmt::format("{}", fmt::join(m.name, ", "));
     auto find = [&](const std::string& wanted, const char* side, std::size_t& idx, std::string& resolved) {
       if (!wanted.empty()) {
         for (std::size_t i = 0; i < m.name.size(); ++i)
@@ -56,15 +53,23 @@ class JointPicker {
             resolved = wanted;
             return true;
           }
-        why = fmt::format("joint '{}' is not in the message; its joints are: {}", wanted, names);
+        why = fmt::format("joint '{}' is not in the message; its joints are: {}", wanted, TrimmedList(m.name));
         return false;
       }
-      std::vector<std::size_t> hits;
-      for (std::size_t i = 0; i < m.name.size(); ++i)
-        if (Lower(m.name[i]).find(side) != std::string::npos) hits.push_back(i);
+      // Names with the side but not the other side ("left_right_arm" is
+      // neither wheel); among several, the ones that say "wheel".
+      const char* other = std::string_view(side) == "left" ? "right" : "left";
+      std::vector<std::size_t> hits, wheels;
+      for (std::size_t i = 0; i < m.name.size(); ++i) {
+        const std::string n = Lower(m.name[i]);
+        if (n.find(side) == std::string::npos || n.find(other) != std::string::npos) continue;
+        hits.push_back(i);
+        if (n.find("wheel") != std::string::npos) wheels.push_back(i);
+      }
+      if (hits.size() > 1 && wheels.size() == 1) hits = wheels;
       if (hits.size() != 1) {
-        why = fmt::format("{} joint names contain '{}' (joints: {}); name the wheel with --{}-joint", hits.size(), side,
-                          names.empty() ? "none" : names, side);
+        why = fmt::format("{} joint names contain '{}' and not '{}' (joints: {}); name the wheel with --{}-joint",
+                          hits.size(), side, other, TrimmedList(m.name), side);
         return false;
       }
       idx = hits[0];
@@ -72,6 +77,12 @@ class JointPicker {
       return true;
     };
     if (!find(left_, "left", li_, resolved_left_) || !find(right_, "right", ri_, resolved_right_)) return false;
+    if (li_ == ri_) {
+      why = fmt::format("joint '{}' would be both the left and the right wheel; name the two wheel joints with "
+                        "--left-joint and --right-joint (joints: {})", resolved_left_, TrimmedList(m.name));
+      resolved_left_.clear();
+      return false;
+    }
     li = li_;
     ri = ri_;
     return true;
@@ -88,19 +99,30 @@ class JointPicker {
 };
 
 std::string Where(const BagMessage& m, const TopicInfo& t, std::size_t index) {
+  if (m.compressed_chunk)
+    return fmt::format("topic {} ({}), message {} (record at byte {} of the decompressed chunk at byte {})", t.name, t.type,
+                       index, m.chunk_byte, m.offset);
   return m.offset > 0 ? fmt::format("topic {} ({}), message {} (record at byte {})", t.name, t.type, index, m.offset)
                       : fmt::format("topic {} ({}), message {}", t.name, t.type, index);
 }
 
-// Checks that a stream's stamps increase; `what` names it for the message.
-void CheckIncreasing(std::int64_t prev, std::int64_t t, std::size_t count, const BagMessage& m, const TopicInfo& topic,
-                     std::size_t index, StampSource time) {
-  if (count > 0 && t <= prev) {
-    auto sec = [](std::int64_t ns) { return fmt::format("{}.{:09d}", ns / 1000000000, std::abs(ns % 1000000000)); };
-    throw InputError(*m.file, fmt::format("{}: {} stamp {} s does not increase (previous {} s){}", Where(m, topic, index),
-                                          time == StampSource::kHeader ? "header" : "receive", sec(t), sec(prev),
-                                          time == StampSource::kHeader ? "; try --time log" : ""));
-  }
+const char* StampName(StampSource s) { return s == StampSource::kHeader ? "header" : "receive"; }
+
+// A stamp that does not increase: refused with what to try. (Equal stamps
+// with equal values are dropped by the caller before this.)
+[[noreturn]] void StampGoesBack(std::int64_t prev, std::int64_t t, const BagMessage& m, const TopicInfo& topic,
+                                std::size_t index, StampSource time, bool equal_values) {
+  std::string hint;
+  if (time == StampSource::kHeader)
+    hint = t == prev && !equal_values
+               ? "two messages with one header stamp but different values; try --time log (receive time; --time "
+                 "WHEELS,GROUND_TRUTH sets each stream)"
+               : "try --time log (receive time; --time WHEELS,GROUND_TRUTH sets each stream)";
+  else
+    hint = "receive times go back: the storage files are out of order (metadata.yaml's relative_file_paths, or the "
+           "BAGs given in the wrong order) or the recording machine's clock jumped; try --time header";
+  throw InputError(*m.file, fmt::format("{}: {} stamp {} s does not increase (previous {} s); {}", Where(m, topic, index),
+                                        StampName(time), StampText(t), StampText(prev), hint));
 }
 
 // Turns the Odometry poses (x, y in left/right, yaw) into cumulative wheel
@@ -185,6 +207,7 @@ struct TopicChoice {
   std::size_t wheels = 0;
   std::optional<std::size_t> gt;
   MessageType gt_type = MessageType::kOther;
+  std::optional<std::size_t> tf_static;  ///< /tf_static, read with a TFMessage ground truth
 };
 
 std::size_t RequireTopic(const Bag& bag, const std::string& name, const char* flag) {
@@ -220,6 +243,12 @@ TopicChoice ChooseTopics(const Bag& bag, const Rosbag2ImportOptions& o) {
                                                "geometry_msgs/msg/PoseStamped, geometry_msgs/msg/PoseWithCovarianceStamped, "
                                                "nav_msgs/msg/Odometry or tf2_msgs/msg/TFMessage", g.name, g.type));
     if (*c.gt == c.wheels) throw InputError(bag.path(), fmt::format("topic {} is both the wheel source and the ground truth", g.name));
+    if (c.gt_type == MessageType::kTfMessage) {
+      const auto st = bag.FindTopic("/tf_static");
+      if (st && *st != *c.gt && MessageTypeFromName(bag.topics()[*st].type) == MessageType::kTfMessage &&
+          bag.topics()[*st].serialization_format == "cdr")
+        c.tf_static = st;
+    }
   }
   return c;
 }
@@ -235,101 +264,257 @@ struct RecordingData {
   std::vector<WheelSample> wheels;
   std::vector<GtSample> gt;
   std::string left_joint, right_joint;
+  /// header stamp minus receive time [s] of every wheel / ground-truth message
+  std::vector<double> wheel_lag_s, gt_lag_s;
+  std::size_t wheel_duplicates = 0, gt_duplicates = 0;
+  TfTree tf;                    ///< the ground-truth TFMessage topic and /tf_static
+  std::string odom_frame;       ///< --odometry: its header.frame_id
+  std::string gt_frame_used;    ///< TFMessage: the frame whose transforms were read
+  std::optional<Pose2> gt_offset;  ///< TFMessage: /tf_static offset gt_frame_used_T_requested
 };
 
 // One streaming pass over the recording: decodes the wheel and ground-truth
-// topics into time-stamped samples (the only per-message state kept). One
-// callback handles every message type so the bag is read once.
-RecordingData ReadRecording(const Bag& bag, const TopicChoice& c, const RobotParams& robot,
-                            const Rosbag2ImportOptions& o) {
+// topics into time-stamped samples (the only per-message state kept), and
+// for a TFMessage ground truth the transform tree.
+class RecordingReader {
+ public:
+  RecordingReader(const Bag& bag, const TopicChoice& c, const Rosbag2ImportOptions& o, RecordingData& d)
+      : bag_(bag), c_(c), o_(o), d_(d), picker_(o.left_joint, o.right_joint) {}
+
+  // `frame`: the TFMessage child frame to take (the requested one, or its
+  // /tf_static anchor on a second pass with only the ground truth wanted).
+  void Read(const std::string& frame, bool ground_truth_only) {
+    frame_ = frame;
+    std::vector<bool> wanted(bag_.topics().size(), false);
+    if (!ground_truth_only) wanted[c_.wheels] = true;
+    if (c_.gt) wanted[*c_.gt] = true;
+    if (c_.tf_static && !ground_truth_only) wanted[*c_.tf_static] = true;
+    wheel_index_ = gt_index_ = 0;
+    bag_.Read(wanted, [&](const BagMessage& m) {
+      const TopicInfo& topic = bag_.topics()[m.topic];
+      const std::size_t index = m.topic == c_.wheels ? ++wheel_index_ : ++gt_index_;
+      try {
+        CdrReader r(m.data, m.size);
+        if (m.topic == c_.wheels) OnWheels(r, m, topic, index);
+        else if (c_.tf_static && m.topic == *c_.tf_static) OnStatic(r);
+        else OnGroundTruth(r, m, topic, index);
+      } catch (const CdrError& e) {
+        throw InputError(*m.file, fmt::format("{}: cannot decode: {}", Where(m, topic, index), e.what()));
+      }
+    });
+    d_.left_joint = picker_.left();
+    d_.right_joint = picker_.right();
+  }
+  std::size_t tf_matches() const { return tf_matches_; }
+
+ private:
+  void OnWheels(CdrReader& r, const BagMessage& m, const TopicInfo& topic, std::size_t index) {
+    WheelSample s{};
+    s.msg = index;
+    std::int64_t stamp;
+    if (!o_.wheels_topic.empty()) {
+      DecodeJointState(r, js_);
+      std::size_t li = 0, ri = 0;
+      std::string why;
+      if (!picker_.Pick(js_, li, ri, why)) throw InputError(*m.file, fmt::format("{}: {}", Where(m, topic, index), why));
+      if (js_.position.empty() && js_.velocity_count > 0)
+        throw InputError(*m.file, fmt::format(
+            "{}: this JointState carries velocity[] but no position[], so the wheel travel is not in it (integrating "
+            "velocities would add their noise and latency to the calibration); give the robot's nav_msgs/msg/Odometry "
+            "topic with --odometry TOPIC instead (--list shows it), or record the joint positions",
+            Where(m, topic, index)));
+      if (js_.position.size() != js_.name.size())
+        throw InputError(*m.file, fmt::format("{}: {} joint names but {} positions", Where(m, topic, index),
+                                              js_.name.size(), js_.position.size()));
+      s.left = js_.position[li];  // radians until SanitizeJointPositions
+      s.right = js_.position[ri];
+      if (!std::isfinite(s.left) || !std::isfinite(s.right))
+        throw InputError(*m.file, fmt::format("{}: wheel position is not finite", Where(m, topic, index)));
+      stamp = js_.header.stamp_ns;
+    } else {
+      const PoseMsg p = DecodeOdometry(r);
+      CheckFinite(p, m, topic, index);
+      s.left = p.x;
+      s.right = p.y;
+      s.yaw = p.Yaw();
+      stamp = p.header.stamp_ns;
+      if (d_.odom_frame.empty()) d_.odom_frame = std::string(p.header.frame_id);
+    }
+    s.t_ns = o_.time == StampSource::kHeader ? stamp : m.log_time_ns;
+    if (!d_.wheels.empty() && s.t_ns <= d_.wheels.back().t_ns) {
+      const WheelSample& b = d_.wheels.back();
+      const bool same = b.left == s.left && b.right == s.right && b.yaw == s.yaw;
+      if (s.t_ns < b.t_ns || !same) StampGoesBack(b.t_ns, s.t_ns, m, topic, index, o_.time, same);
+      ++d_.wheel_duplicates;  // a repeated message: harmless, dropped
+      return;
+    }
+    d_.wheel_lag_s.push_back(static_cast<double>(stamp - m.log_time_ns) * 1e-9);
+    d_.wheels.push_back(s);
+  }
+
+  void OnStatic(CdrReader& r) {
+    DecodeTfMessage(r, tf_);
+    for (const auto& p : tf_) d_.tf.Add(p, true);
+  }
+
+  void AddGt(const PoseMsg& p, const BagMessage& m, const TopicInfo& topic, std::size_t index) {
+    CheckFinite(p, m, topic, index);
+    const StampSource time = o_.GroundTruthTime();
+    const std::int64_t t = time == StampSource::kHeader ? p.header.stamp_ns : m.log_time_ns;
+    if (!d_.gt.empty() && t <= d_.gt.back().t_ns) {
+      const GtSample& b = d_.gt.back();
+      const bool same = b.x == p.x && b.y == p.y && b.yaw == p.Yaw();
+      if (t < b.t_ns || !same) StampGoesBack(b.t_ns, t, m, topic, index, time, same);
+      ++d_.gt_duplicates;
+      return;
+    }
+    d_.gt_lag_s.push_back(static_cast<double>(p.header.stamp_ns - m.log_time_ns) * 1e-9);
+    d_.gt.push_back({t, p.x, p.y, p.Yaw()});
+  }
+
+  void OnGroundTruth(CdrReader& r, const BagMessage& m, const TopicInfo& topic, std::size_t index) {
+    switch (c_.gt_type) {
+      case MessageType::kPoseStamped: AddGt(DecodePoseStamped(r), m, topic, index); break;
+      case MessageType::kPoseWithCovarianceStamped: AddGt(DecodePoseWithCovarianceStamped(r), m, topic, index); break;
+      case MessageType::kOdometry: AddGt(DecodeOdometry(r), m, topic, index); break;
+      case MessageType::kTfMessage:
+        DecodeTfMessage(r, tf_);
+        for (const auto& p : tf_) {
+          d_.tf.Add(p, false);
+          if (p.child_frame_id == frame_) {
+            ++tf_matches_;
+            AddGt(p, m, topic, index);
+          }
+        }
+        break;
+      default: break;
+    }
+  }
+
+  const Bag& bag_;
+  const TopicChoice& c_;
+  const Rosbag2ImportOptions& o_;
+  RecordingData& d_;
+  JointPicker picker_;
+  JointStateMsg js_;
+  std::vector<PoseMsg> tf_;
+  std::string frame_;
+  std::size_t wheel_index_ = 0, gt_index_ = 0, tf_matches_ = 0;
+};
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// The two streams' clocks, compared through the recording's receive times:
+// a motion-capture PC whose clock is off shows as header stamps far from
+// the receive times on one topic only.
+void CheckClockOffset(const Bag& bag, const TopicChoice& c, const Rosbag2ImportOptions& o, const RecordingData& d) {
+  if (!c.gt || d.gt.empty()) return;
+  const double wheel_lag = Median(d.wheel_lag_s), gt_lag = Median(d.gt_lag_s);
+  const double ow = o.time == StampSource::kHeader ? wheel_lag : 0.0;
+  const double og = o.GroundTruthTime() == StampSource::kHeader ? gt_lag : 0.0;
+  const double offset = og - ow;
+  if (std::abs(offset) <= 0.5) return;
+  const std::string& wt = bag.topics()[c.wheels].name;
+  const std::string& gt = bag.topics()[*c.gt].name;
+  throw InputError(bag.path(), fmt::format(
+      "the ground truth's clock is {:.3f} s {} the wheels' (--time {},{}): header stamps minus receive times are {:.3f} s "
+      "on {} and {:.3f} s on {} (median), so the two topics were stamped by clocks {:.1f} s apart (a motion-capture "
+      "computer not synchronised with the robot?). Take the receive time for the stream whose clock is off: --time "
+      "{}, or --time log for both",
+      std::abs(offset), offset > 0 ? "ahead of" : "behind", o.time == StampSource::kHeader ? "header" : "log",
+      o.GroundTruthTime() == StampSource::kHeader ? "header" : "log", gt_lag, gt, wheel_lag, wt, std::abs(offset),
+      std::abs(gt_lag) > std::abs(wheel_lag) ? "header,log" : "log,header"));
+}
+
+// Ground truth from a TFMessage: the requested frame's own transforms, or
+// those of the frame it is fixed to by /tf_static (composed afterwards);
+// never a frame whose chain runs through the odometry frame.
+void ResolveTfGroundTruth(const Bag& bag, const Rosbag2ImportOptions& o, RecordingData& d,
+                          RecordingReader& reader) {
+  const std::string& frame = o.ground_truth_frame;
+  std::vector<std::string> odom_frames;
+  if (!d.odom_frame.empty()) odom_frames.push_back(d.odom_frame);
+  auto describe = [&] {
+    std::vector<std::string> lines;
+    for (const auto& e : d.tf.edges()) lines.push_back(fmt::format("{} (parent {}{})", e.child, e.parent, e.is_static ? ", static" : ""));
+    return TrimmedList(lines, 30);
+  };
+  if (reader.tf_matches() == 0) {
+    const auto anchor = frame.empty() ? std::nullopt : d.tf.StaticAnchor(frame);
+    if (!anchor)
+      throw InputError(bag.path(), fmt::format("--ground-truth {}: no transform with child_frame_id '{}'{}; frames seen: {}",
+                                               o.ground_truth_topic, frame, frame.empty() ? " (set --ground-truth-frame)" : "",
+                                               describe()));
+    d.gt.clear();
+    d.gt_lag_s.clear();
+    reader.Read(anchor->first, true);
+    d.gt_frame_used = anchor->first;
+    d.gt_offset = anchor->second;
+  } else {
+    d.gt_frame_used = frame;
+  }
+  if (const auto odom = d.tf.OdometryFrameAbove(frame, odom_frames)) {
+    const auto chain = d.tf.Chain(frame);
+    std::vector<std::string> rev(chain.rbegin(), chain.rend());
+    throw InputError(bag.path(), fmt::format(
+        "--ground-truth {} --ground-truth-frame {}: the frame's chain {} runs through the odometry frame '{}' (REP 105: "
+        "odom -> base_link is the robot's own wheel odometry), so this would compare the odometry with itself; choose "
+        "the motion-capture frame (--list shows every frame with its parent)",
+        o.ground_truth_topic, frame, fmt::join(rev, " -> "), *odom));
+  }
+  if (d.gt_offset) {
+    for (auto& g : d.gt) {
+      const Pose2 p = Compose(Pose2{g.x, g.y, g.yaw}, *d.gt_offset);
+      g = {g.t_ns, p.x, p.y, p.theta};
+    }
+  }
+}
+
+// Reads the recording, then the checks that need all of it: clocks, the
+// transform tree, the wheel positions (unwrap, resets, jumps, stuck or
+// shared joints), and converts the wheel source to travel in metres.
+RecordingData ReadRecording(const Bag& bag, const TopicChoice& c, const RobotParams& robot, const Rosbag2ImportOptions& o,
+                            std::vector<std::string>& warnings) {
   RecordingData d;
-  std::vector<bool> wanted(bag.topics().size(), false);
-  wanted[c.wheels] = true;
-  if (c.gt) wanted[*c.gt] = true;
   const TopicInfo& wt = bag.topics()[c.wheels];
   const bool joints = !o.wheels_topic.empty();
-  JointPicker picker(o.left_joint, o.right_joint);
-  JointStateMsg js;
-  std::vector<PoseMsg> tf;
-  std::set<std::string> frames_seen;
-  std::size_t wheel_index = 0, gt_index = 0, tf_matches = 0;
-  const double rl = 0.5 * robot.wheel_diameter_left_m, rr = 0.5 * robot.wheel_diameter_right_m;
-  bag.Read(wanted, [&](const BagMessage& m) {
-    const TopicInfo& topic = bag.topics()[m.topic];
-    const bool is_wheels = m.topic == c.wheels;
-    const std::size_t index = is_wheels ? ++wheel_index : ++gt_index;
-    try {
-      CdrReader r(m.data, m.size);
-      if (is_wheels) {
-        WheelSample s{};
-        std::int64_t stamp;
-        if (joints) {
-          DecodeJointState(r, js);
-          std::size_t li = 0, ri = 0;
-          std::string why;
-          if (!picker.Pick(js, li, ri, why)) throw InputError(*m.file, fmt::format("{}: {}", Where(m, topic, index), why));
-          if (js.position.size() != js.name.size())
-            throw InputError(*m.file, fmt::format("{}: {} joint names but {} positions", Where(m, topic, index),
-                                                  js.name.size(), js.position.size()));
-          s.left = js.position[li] * rl;
-          s.right = js.position[ri] * rr;
-          if (!std::isfinite(s.left) || !std::isfinite(s.right))
-            throw InputError(*m.file, fmt::format("{}: wheel position is not finite", Where(m, topic, index)));
-          stamp = js.header.stamp_ns;
-        } else {
-          const PoseMsg p = DecodeOdometry(r);
-          CheckFinite(p, m, topic, index);
-          s.left = p.x;
-          s.right = p.y;
-          s.yaw = p.Yaw();
-          stamp = p.header.stamp_ns;
-        }
-        s.t_ns = o.time == StampSource::kHeader ? stamp : m.log_time_ns;
-        CheckIncreasing(d.wheels.empty() ? 0 : d.wheels.back().t_ns, s.t_ns, d.wheels.size(), m, topic, index, o.time);
-        d.wheels.push_back(s);
-        return;
-      }
-      auto add_gt = [&](const PoseMsg& p) {
-        CheckFinite(p, m, topic, index);
-        const std::int64_t t = o.time == StampSource::kHeader ? p.header.stamp_ns : m.log_time_ns;
-        CheckIncreasing(d.gt.empty() ? 0 : d.gt.back().t_ns, t, d.gt.size(), m, topic, index, o.time);
-        d.gt.push_back({t, p.x, p.y, p.Yaw()});
-      };
-      switch (c.gt_type) {
-        case MessageType::kPoseStamped: add_gt(DecodePoseStamped(r)); break;
-        case MessageType::kPoseWithCovarianceStamped: add_gt(DecodePoseWithCovarianceStamped(r)); break;
-        case MessageType::kOdometry: add_gt(DecodeOdometry(r)); break;
-        case MessageType::kTfMessage:
-          DecodeTfMessage(r, tf);
-          for (const auto& p : tf) {
-            if (frames_seen.size() < 64) frames_seen.insert(std::string(p.child_frame_id));
-            if (p.child_frame_id == o.ground_truth_frame) {
-              ++tf_matches;
-              add_gt(p);
-            }
-          }
-          break;
-        default: break;
-      }
-    } catch (const CdrError& e) {
-      throw InputError(*m.file, fmt::format("{}: cannot decode: {}", Where(m, topic, index), e.what()));
-    }
-  });
-  if (c.gt && c.gt_type == MessageType::kTfMessage && tf_matches == 0) {
-    throw InputError(bag.path(), fmt::format("--ground-truth {}: no transform with child_frame_id '{}'{}; child frames seen: {}",
-                                             o.ground_truth_topic, o.ground_truth_frame,
-                                             o.ground_truth_frame.empty() ? " (set --ground-truth-frame)" : "",
-                                             frames_seen.empty() ? std::string("none") : fmt::format("{}", fmt::join(frames_seen, ", "))));
-  }
+  RecordingReader reader(bag, c, o, d);
+  reader.Read(o.ground_truth_frame, false);
+  if (c.gt && c.gt_type == MessageType::kTfMessage) ResolveTfGroundTruth(bag, o, d, reader);
   if (d.wheels.size() < 2)
     throw InputError(bag.path(), fmt::format("wheel topic {} has {} message(s); at least two are needed", wt.name, d.wheels.size()));
   if (c.gt && d.gt.empty())
     throw InputError(bag.path(), fmt::format("--ground-truth topic {} has no messages", o.ground_truth_topic));
+  for (const auto& [n, topic] : {std::pair{d.wheel_duplicates, wt.name},
+                                 std::pair{d.gt_duplicates, c.gt ? bag.topics()[*c.gt].name : std::string()}})
+    if (n > 0)
+      warnings.push_back(fmt::format("{}: topic {}: {} message(s) repeat the previous message's stamp and values; dropped",
+                                     bag.path(), topic, n));
+  CheckClockOffset(bag, c, o, d);
   // Unwrap the ground-truth heading so that interpolation and total rotation are continuous.
   for (std::size_t i = 1; i < d.gt.size(); ++i) d.gt[i].yaw = d.gt[i - 1].yaw + WrapAngle(d.gt[i].yaw - d.gt[i - 1].yaw);
-  if (!joints) OdometryToWheels(d.wheels, robot.wheelbase_m, o.integrator);
-  d.left_joint = picker.left();
-  d.right_joint = picker.right();
+  const WheelContext ctx{bag.path(), wt.name, joints ? d.left_joint : "left wheel", joints ? d.right_joint : "right wheel",
+                         !joints};
+  if (joints) {
+    SanitizeJointPositions(d.wheels, ctx, warnings);
+    const double rl = 0.5 * robot.wheel_diameter_left_m, rr = 0.5 * robot.wheel_diameter_right_m;
+    for (auto& s : d.wheels) {
+      s.left *= rl;
+      s.right *= rr;
+    }
+  } else {
+    // A controller restart puts the pose back at the origin.
+    std::vector<bool> at_origin(d.wheels.size());
+    for (std::size_t k = 0; k < d.wheels.size(); ++k)
+      at_origin[k] = std::hypot(d.wheels[k].left, d.wheels[k].right) < 0.05 && std::abs(d.wheels[k].yaw) < 0.1;
+    OdometryToWheels(d.wheels, robot.wheelbase_m, o.integrator);
+    SanitizeOdometryTravel(d.wheels, at_origin, ctx, warnings);
+  }
+  CheckStuckWheel(d.wheels, ctx);
   return d;
 }
 
@@ -339,6 +524,9 @@ std::string Rosbag2ImportOptions::Validate() const {
   if (wheels_topic.empty() == odometry_topic.empty()) return "exactly one wheel source is needed: --wheels TOPIC or --odometry TOPIC";
   if (!odometry_topic.empty() && (!left_joint.empty() || !right_joint.empty()))
     return "--left-joint/--right-joint apply to --wheels (JointState), not to --odometry";
+  if (!left_joint.empty() && left_joint == right_joint)
+    return fmt::format("left_joint = right_joint = '{}': --left-joint and --right-joint must name two different wheel joints",
+                       left_joint);
   if (kind == ExperimentKind::kSquare && !(side_m > 0.0 && std::isfinite(side_m)))
     return fmt::format("side_m = {}: a square experiment needs --side > 0", side_m);
   if (kind == ExperimentKind::kBackAndForth && !(distance_m > 0.0 && std::isfinite(distance_m)))
@@ -350,16 +538,112 @@ std::string Rosbag2ImportOptions::Validate() const {
 }
 
 std::string DescribeTopics(const Bag& bag) {
+  // The ones that can serve as a source first; at most 40 lines whatever
+  // the recording holds.
+  constexpr std::size_t kMax = 40;
   std::string out;
-  for (const auto& t : bag.topics()) out += fmt::format("  {}  {}  ({} messages)\n", t.name, t.type, t.count);
+  std::size_t shown = 0;
+  for (const bool usable : {true, false})
+    for (const auto& t : bag.topics()) {
+      const MessageType mt = MessageTypeFromName(t.type);
+      if ((mt != MessageType::kOther) != usable) continue;
+      if (shown++ < kMax) out += fmt::format("  {}  {}  ({} messages)\n", t.name, t.type, t.count);
+    }
+  if (shown > kMax) out += fmt::format("  ... and {} more topics (umbmark import rosbag2 BAG --list)\n", shown - kMax);
   if (bag.topics().empty()) out = "  (none)\n";
   out.pop_back();
   return out;
 }
 
-// Per recording: read, split, then build each run (relative travel, ground
-// truth re-expressed, direction); kept in one function so the contract's
-// run rules read in one place.
+namespace {
+
+// One run from samples a..b: travel relative to its first sample, ground
+// truth re-expressed in the frame of its first ground-truth sample, and
+// `turn` the ground truth's total rotation (NaN without ground truth).
+TrajectoryRun BuildRun(const RecordingData& d, std::size_t a, std::size_t b, bool has_gt, GtInterpolator& interp,
+                       double& turn) {
+  TrajectoryRun run;
+  std::optional<Pose2> origin;
+  double gt_first_yaw = 0.0, gt_last_yaw = 0.0;
+  const std::int64_t t0 = d.wheels.front().t_ns;
+  for (std::size_t i = a; i <= b; ++i) {
+    const WheelSample& s = d.wheels[i];
+    run.t_s.push_back(static_cast<double>(s.t_ns - t0) * 1e-9);
+    run.dist_left_m.push_back(s.left - d.wheels[a].left);
+    run.dist_right_m.push_back(s.right - d.wheels[a].right);
+    Pose2 g = has_gt ? interp.At(s.t_ns) : Pose2{NAN, NAN, NAN};
+    if (!std::isnan(g.x)) {
+      if (!origin) {
+        origin = g;
+        gt_first_yaw = g.theta;
+      }
+      gt_last_yaw = g.theta;
+      g = RelativeTo(*origin, g);
+    }
+    run.gt_x_m.push_back(g.x);
+    run.gt_y_m.push_back(g.y);
+    run.gt_theta_rad.push_back(g.theta);
+    run.lines.push_back(0);
+  }
+  turn = origin ? gt_last_yaw - gt_first_yaw : NAN;
+  return run;
+}
+
+// What the ground truth says against the wheels, over a recording's runs:
+// wheels turning the other way than the ground truth in most runs (the
+// joints swapped), and ground truth that is the wheel odometry itself.
+void CheckAgainstGroundTruth(const std::vector<TrajectoryRun>& runs, const std::vector<double>& turns,
+                             const RobotParams& robot, const Rosbag2ImportOptions& o, const std::string& path,
+                             const RecordingData& d) {
+  std::size_t mirrored = 0, compared = 0, matching = 0;
+  std::string example;
+  double worst = 0.0, path_m = 0.0;
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    const TrajectoryRun& run = runs[r];
+    const double odo = (run.dist_right_m.back() - run.dist_left_m.back()) / robot.wheelbase_m;
+    if (std::isfinite(turns[r]) && std::abs(turns[r]) > kPi && std::abs(odo) > kPi && (odo > 0) != (turns[r] > 0)) {
+      if (mirrored++ == 0)
+        example = fmt::format("run {}: wheels {:+.0f} deg, ground truth {:+.0f} deg", run.run, Rad2Deg(odo), Rad2Deg(turns[r]));
+    }
+    // Dead reckoning from the wheel travel against the ground truth.
+    Pose2 p;
+    double dev = 0.0, run_path = 0.0;
+    bool all_gt = true;
+    for (std::size_t i = 0; i < run.size() && all_gt; ++i) {
+      if (i > 0) {
+        const double dl = run.dist_left_m[i] - run.dist_left_m[i - 1], dr = run.dist_right_m[i] - run.dist_right_m[i - 1];
+        p = DiffDriveStep(p, dl, dr, robot.wheelbase_m, o.integrator);
+        run_path += 0.5 * (std::abs(dl) + std::abs(dr));
+      }
+      all_gt = run.HasGroundTruth(i);
+      if (all_gt) dev = std::max({dev, std::hypot(p.x - run.gt_x_m[i], p.y - run.gt_y_m[i]), std::abs(p.theta - run.gt_theta_rad[i])});
+    }
+    if (!all_gt || run_path < 0.5) continue;
+    ++compared;
+    if (dev < 1e-4 * run_path) ++matching;
+    worst = std::max(worst, dev);
+    path_m += run_path;
+  }
+  if (mirrored > 0 && 2 * mirrored > runs.size() && !o.wheels_topic.empty()) {
+    throw InputError(path, fmt::format(
+        "in {} of {} runs the wheels turn the other way than the ground truth ({}): the left and right wheel joints are "
+        "swapped; run again with --left-joint {} --right-joint {}",
+        mirrored, runs.size(), example, d.right_joint, d.left_joint));
+  }
+  if (compared > 0 && matching == compared) {
+    throw InputError(path, fmt::format(
+        "--ground-truth {} follows the wheel odometry to within {:.2g} m / rad over {} run(s) and {:.1f} m: it is the "
+        "robot's own odometry (an odom frame, or an odometry topic), not an independent measurement, and would only "
+        "compare the odometry with itself; choose the motion-capture topic or frame (--list)",
+        o.ground_truth_topic, worst, compared, path_m));
+  }
+}
+
+}  // namespace
+
+// Per recording: read, split, drop runs with a gap in the wheel topic, then
+// build each run and label its direction; kept in one function so the
+// contract's run rules read in one place.
 Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotParams& robot,
                             const Rosbag2ImportOptions& o) {
   if (const std::string err = o.Validate(); !err.empty()) throw InvalidOptions(err);
@@ -373,48 +657,40 @@ Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotPar
   for (const auto& path : bags) {
     const Bag bag = Bag::Open(path, out.warnings);
     const TopicChoice choice = ChooseTopics(bag, o);
-    const RecordingData d = ReadRecording(bag, choice, robot, o);
-    RecordingSummary rs{path, d.wheels.size(), d.gt.size(), 0, d.left_joint, d.right_joint,
+    const RecordingData d = ReadRecording(bag, choice, robot, o, out.warnings);
+    const std::string& wheel_topic = bag.topics()[choice.wheels].name;
+    RecordingSummary rs{path, d.wheels.size(), d.gt.size(), 0, 0, d.left_joint, d.right_joint,
                         static_cast<double>(d.wheels.back().t_ns - d.wheels.front().t_ns) * 1e-9};
     const auto spans = SplitRuns(d.wheels, o.pause_s);
     if (spans.empty())
-      throw InputError(path, fmt::format("the wheels never move on {} ({} samples): no run to import",
-                                         bag.topics()[choice.wheels].name, d.wheels.size()));
+      throw InputError(path, fmt::format("the wheels never move on {} ({} samples): no run to import", wheel_topic,
+                                         d.wheels.size()));
+    const auto gaps = FindGaps(d.wheels);
     GtInterpolator interp{d.gt, static_cast<std::int64_t>(std::llround(o.max_gt_gap_s * 1e9))};
-    const std::int64_t t0 = d.wheels.front().t_ns;
+    std::vector<TrajectoryRun> runs;
+    std::vector<double> turns;
     for (const auto& [a, b] : spans) {
-      TrajectoryRun run;
-      run.run = std::to_string(out.runs.runs.size() + 1);
-      std::optional<Pose2> origin;
-      double gt_first_yaw = 0.0, gt_last_yaw = 0.0;
-      for (std::size_t i = a; i <= b; ++i) {
-        const WheelSample& s = d.wheels[i];
-        run.t_s.push_back(static_cast<double>(s.t_ns - t0) * 1e-9);
-        run.dist_left_m.push_back(s.left - d.wheels[a].left);
-        run.dist_right_m.push_back(s.right - d.wheels[a].right);
-        Pose2 g = choice.gt ? interp.At(s.t_ns) : Pose2{NAN, NAN, NAN};
-        if (!std::isnan(g.x)) {
-          // Ground truth re-expressed in the frame of the run's first ground-truth sample.
-          if (!origin) {
-            origin = g;
-            gt_first_yaw = g.theta;
-          }
-          gt_last_yaw = g.theta;
-          g = RelativeTo(*origin, g);
-        }
-        run.gt_x_m.push_back(g.x);
-        run.gt_y_m.push_back(g.y);
-        run.gt_theta_rad.push_back(g.theta);
-        run.lines.push_back(0);
+      const auto gap = std::find_if(gaps.begin(), gaps.end(), [&](const WheelGap& g) { return g.k > a && g.k <= b; });
+      if (gap != gaps.end()) {
+        ++rs.runs_dropped;
+        out.warnings.push_back(fmt::format(
+            "{}: topic {} has no message for {:.2f} s (usually every {:.3f} s) at stamp {} while the wheels moved {:.3f} m, "
+            "inside the run of t = {:.2f} .. {:.2f} s: the path over the gap is unknown, so that run is dropped",
+            path, wheel_topic, gap->seconds, gap->typical_s, StampText(d.wheels[gap->k - 1].t_ns), gap->travel_m,
+            static_cast<double>(d.wheels[a].t_ns - d.wheels.front().t_ns) * 1e-9,
+            static_cast<double>(d.wheels[b].t_ns - d.wheels.front().t_ns) * 1e-9));
+        continue;
       }
+      double turn = NAN;
+      TrajectoryRun run = BuildRun(d, a, b, choice.gt.has_value(), interp, turn);
+      run.run = std::to_string(out.runs.runs.size() + runs.size() + 1);
       if (choice.gt && !run.HasGroundTruth(0))
         out.warnings.push_back(fmt::format("{}: run {} has no ground truth within {} s of its first sample; its ground truth "
                                            "is relative to its first measured pose", path, run.run, o.max_gt_gap_s));
       if (o.kind == ExperimentKind::kSquare) {
         // Direction from the total rotation: ground truth, or odometry without it.
-        const bool from_gt = origin.has_value();
-        const double total = from_gt ? gt_last_yaw - gt_first_yaw
-                                     : ((run.dist_right_m.back() - run.dist_left_m.back()) / robot.wheelbase_m);
+        const bool from_gt = std::isfinite(turn);
+        const double total = from_gt ? turn : ((run.dist_right_m.back() - run.dist_left_m.back()) / robot.wheelbase_m);
         if (std::abs(std::abs(total) - 2.0 * kPi) > kPi / 2.0) {
           throw InputError(path, fmt::format("run {} (t = {:.2f} .. {:.2f} s) turns {:.1f} deg in total by its {}; a square run "
                                              "turns about +-360 deg (check --pause, now {} s, and the topics)",
@@ -425,56 +701,93 @@ Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotPar
       } else {
         run.direction = ExperimentKindToString(o.kind);
       }
-      out.runs.runs.push_back(std::move(run));
-      ++rs.runs;
+      runs.push_back(std::move(run));
+      turns.push_back(turn);
     }
+    if (runs.empty())
+      throw InputError(path, fmt::format("every run of {} has a gap in {} (see the warnings above): no run to import", path,
+                                         wheel_topic));
+    if (choice.gt) CheckAgainstGroundTruth(runs, turns, robot, o, path, d);
+    rs.runs = runs.size();
+    for (auto& r : runs) out.runs.runs.push_back(std::move(r));
     out.recordings.push_back(rs);
   }
   return out;
 }
 
+// Joint names from the first message of each JointState topic; the whole
+// of each TFMessage topic (every frame with its parent and rate: a frame
+// may first appear late). Stops as soon as only JointState topics were
+// wanted and each has given its first message.
 BagListing ListRosbag2(const std::string& path, std::vector<std::string>& warnings) {
   const Bag bag = Bag::Open(path, warnings);
   BagListing out{path, bag.files(), {}};
   std::vector<bool> wanted(bag.topics().size(), false);
   std::size_t pending = 0;
+  bool whole = false;
   for (std::size_t i = 0; i < bag.topics().size(); ++i) {
     TopicListing l;
     l.topic = bag.topics()[i];
     const MessageType t = MessageTypeFromName(l.topic.type);
     l.wheels = t == MessageType::kJointState || t == MessageType::kOdometry;
     l.ground_truth = IsPoseType(t);
-    if ((t == MessageType::kJointState || t == MessageType::kTfMessage) && l.topic.count > 0) {
+    if ((t == MessageType::kJointState || t == MessageType::kTfMessage) && l.topic.count > 0 &&
+        l.topic.serialization_format == "cdr") {
       wanted[i] = true;
       ++pending;
+      whole = whole || t == MessageType::kTfMessage;
     }
     out.topics.push_back(std::move(l));
   }
   if (pending == 0) return out;
-  // Joint names and child frames from the first message of each such topic.
   std::vector<bool> done(bag.topics().size(), false);
+  std::map<std::size_t, TfTree> trees;  // by topic index, TFMessage topics only
   JointStateMsg js;
   std::vector<PoseMsg> tf;
   try {
     bag.Read(wanted, [&](const BagMessage& m) {
-      if (done[m.topic]) return;
-      done[m.topic] = true;
       TopicListing& l = out.topics[m.topic];
+      const bool joints = MessageTypeFromName(l.topic.type) == MessageType::kJointState;
+      if (done[m.topic] && joints) return;
       try {
         CdrReader r(m.data, m.size);
-        if (MessageTypeFromName(l.topic.type) == MessageType::kJointState) {
+        if (joints) {
           DecodeJointState(r, js);
           for (auto n : js.name) l.joints.emplace_back(n);
         } else {
           DecodeTfMessage(r, tf);
-          for (const auto& p : tf) l.frames.emplace_back(p.child_frame_id);
+          for (const auto& p : tf) trees[m.topic].Add(p, l.topic.name == "/tf_static");
         }
       } catch (const CdrError& e) {
-        warnings.push_back(fmt::format("{}: first message of {} cannot be decoded: {}", *m.file, l.topic.name, e.what()));
+        if (!done[m.topic])
+          warnings.push_back(fmt::format("{}: a message of {} cannot be decoded: {}", *m.file, l.topic.name, e.what()));
       }
-      if (--pending == 0) throw StopReading{};
+      if (!done[m.topic]) {
+        done[m.topic] = true;
+        if (--pending == 0 && !whole) throw StopReading{};
+      }
     });
   } catch (const StopReading&) {
+  }
+  // Frames of every TFMessage topic; the odometry chain judged over the
+  // dynamic and static transforms together.
+  TfTree all;
+  for (const auto& [i, tree] : trees)
+    for (const auto& e : tree.edges()) {
+      PoseMsg p;
+      p.header.frame_id = e.parent;
+      p.child_frame_id = e.child;
+      all.Add(p, e.is_static);
+    }
+  for (const auto& [i, tree] : trees) {
+    for (const auto& e : tree.edges()) {
+      TopicListing& l = out.topics[i];
+      l.frames.push_back(e.child);
+      l.tf.push_back({e, all.OdometryFrameAbove(e.child, {}).value_or("")});
+    }
+    if (tree.dropped_edges() > 0)
+      warnings.push_back(fmt::format("{}: topic {} has more than {} distinct transforms; the rest are not listed", path,
+                                     out.topics[i].topic.name, TfTree::kMaxEdges));
   }
   return out;
 }

@@ -7,12 +7,14 @@
 // re-expressed relative to its first sample.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/robot.hpp"
 #include "core/runs.hpp"
 #include "io/rosbag2/bag.hpp"
+#include "io/rosbag2/tf_tree.hpp"
 #include "kinematics/diff_drive.hpp"
 
 namespace umbmark::io::rosbag2 {
@@ -32,7 +34,10 @@ struct Rosbag2ImportOptions {
   Integrator integrator = Integrator::kArc;
   /// Optional ground truth; for a TFMessage topic the child frame to follow.
   std::string ground_truth_topic, ground_truth_frame;
+  /// Time of the wheel messages, and of the ground truth (unset: the same).
   StampSource time = StampSource::kHeader;
+  std::optional<StampSource> ground_truth_time;
+  StampSource GroundTruthTime() const { return ground_truth_time.value_or(time); }
   double pause_s = 2.0;       ///< split at standstills this long; 0 = one run per recording
   double max_gt_gap_s = 0.1;  ///< interpolate only between ground truth this close
   /// Empty when valid, else a message naming the bad field.
@@ -44,6 +49,7 @@ struct RecordingSummary {
   std::string path;
   std::size_t wheel_messages = 0, ground_truth_messages = 0;
   std::size_t runs = 0;
+  std::size_t runs_dropped = 0;  ///< runs with a gap in the wheel topic (see warnings)
   std::string left_joint, right_joint;  ///< the joints used (JointState)
   double duration_s = 0.0;
 };
@@ -69,7 +75,15 @@ struct TopicListing {
   bool wheels = false;        ///< JointState or Odometry
   bool ground_truth = false;  ///< a pose type
   std::vector<std::string> joints;  ///< JointState: joint names of its first message
-  std::vector<std::string> frames;  ///< TFMessage: child frames of its first message
+  std::vector<std::string> frames;  ///< TFMessage: every child frame of the topic
+  /// TFMessage: every transform (parent -> child, rate) of the topic, with
+  /// the odometry frame its chain runs through ("" when none: a candidate
+  /// for --ground-truth-frame).
+  struct Frame {
+    TfEdge edge;
+    std::string through_odometry;
+  };
+  std::vector<Frame> tf;
 };
 struct BagListing {
   std::string path;

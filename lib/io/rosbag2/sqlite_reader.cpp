@@ -72,6 +72,19 @@ SqliteBagFile::SqliteBagFile(std::string path) : path_(std::move(path)) {
   if (sqlite3_open_v2(uri.c_str(), &db_, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX | SQLITE_OPEN_URI, nullptr) != SQLITE_OK)
     Fail(fmt::format("cannot open as SQLite3: {}", db_ ? sqlite3_errmsg(db_) : "out of memory"));
   sqlite3_busy_timeout(db_, 0);
+  file_size_ = static_cast<std::uint64_t>(std::filesystem::file_size(path_, ec));
+  // Time bounded by the file's size: a real recording's queries run a few
+  // hundred virtual-machine steps per stored byte at most.
+  budget_ = 100000000ull + 2000ull * file_size_;
+  sqlite3_limit(db_, SQLITE_LIMIT_LENGTH, static_cast<int>(std::min<std::uint64_t>(file_size_ + 1024, 1000000000ull)));
+  sqlite3_progress_handler(
+      db_, 10000,
+      [](void* self) -> int {
+        auto* me = static_cast<SqliteBagFile*>(self);
+        me->steps_ += 10000;
+        return me->steps_ > me->budget_ ? 1 : 0;
+      },
+      this);
   auto prepare = [&](Statement& st, const char* sql) {
     const int rc = sqlite3_prepare_v2(db_, sql, -1, &st.stmt, nullptr);
     if (rc == SQLITE_NOTADB) Fail("not an SQLite3 database (a rosbag2 .db3 file is one)");
@@ -82,6 +95,7 @@ SqliteBagFile::SqliteBagFile(std::string path) : path_(std::move(path)) {
     if (rc == SQLITE_BUSY || rc == SQLITE_LOCKED) Fail("the database is locked by another process (is the recorder still running?)");
     if (rc == SQLITE_NOTADB) Fail("not an SQLite3 database (a rosbag2 .db3 file is one)");
     if (rc == SQLITE_CORRUPT) Fail(fmt::format("corrupt SQLite3 database: {}", sqlite3_errmsg(db_)));
+    if (rc == SQLITE_INTERRUPT) Fail("reading the topics took far longer than a recording of this size can (a generated table?)");
     Fail(fmt::format("SQLite error: {}", sqlite3_errmsg(db_)));
   };
 
@@ -147,20 +161,43 @@ void SqliteBagFile::Stream(const std::vector<bool>& wanted,
     ids += std::to_string(topics_[i].id);
   }
   if (ids.empty()) return;
-  const std::string sql =
-      "SELECT topic_id, timestamp, data FROM messages WHERE topic_id IN (" + ids + ") ORDER BY timestamp, id";
-  Statement st;
-  if (sqlite3_prepare_v2(db_, sql.c_str(), -1, &st.stmt, nullptr) != SQLITE_OK)
+  // Sorting only the small columns keeps the sorter small whatever the
+  // data column holds; each row's data is then fetched by rowid once its
+  // length is known to fit: no message may be longer than the file, nor
+  // all of them together (a real recording stores its bytes; a generated
+  // column or a zeroblob does not), so memory and time stay bounded by the
+  // file's size.
+  const std::string sql = "SELECT rowid, topic_id, timestamp, length(data) FROM messages WHERE topic_id IN (" + ids +
+                          ") ORDER BY timestamp, id";
+  Statement st, fetch;
+  if (sqlite3_prepare_v2(db_, sql.c_str(), -1, &st.stmt, nullptr) != SQLITE_OK ||
+      sqlite3_prepare_v2(db_, "SELECT data FROM messages WHERE rowid = ?", -1, &fetch.stmt, nullptr) != SQLITE_OK)
     Fail(fmt::format("SQLite error: {}", sqlite3_errmsg(db_)));
+  std::uint64_t total = 0;
   int rc;
   while ((rc = sqlite3_step(st.stmt)) == SQLITE_ROW) {
-    const std::size_t topic = index.at(sqlite3_column_int64(st.stmt, 0));
-    const std::int64_t ts = sqlite3_column_int64(st.stmt, 1);
-    const void* blob = sqlite3_column_blob(st.stmt, 2);
-    const int n = sqlite3_column_bytes(st.stmt, 2);
+    const std::int64_t rowid = sqlite3_column_int64(st.stmt, 0);
+    const std::size_t topic = index.at(sqlite3_column_int64(st.stmt, 1));
+    const std::int64_t ts = sqlite3_column_int64(st.stmt, 2);
+    const std::int64_t len = sqlite3_column_int64(st.stmt, 3);
+    total += static_cast<std::uint64_t>(std::max<std::int64_t>(len, 0));
+    if (len < 0 || static_cast<std::uint64_t>(len) > file_size_ || total > file_size_)
+      Fail(fmt::format("messages row {} (topic {}): its data claims {} bytes, {} in all so far, in a file of {} bytes: the "
+                       "data column is generated, not stored (not a rosbag2 recording)",
+                       rowid, topics_[topic].name, len, total, file_size_));
+    sqlite3_reset(fetch.stmt);
+    sqlite3_bind_int64(fetch.stmt, 1, rowid);
+    const int frc = sqlite3_step(fetch.stmt);
+    if (frc != SQLITE_ROW) Fail(fmt::format("SQLite error while reading messages row {}: {}", rowid, sqlite3_errmsg(db_)));
+    const void* blob = sqlite3_column_blob(fetch.stmt, 0);
+    const int n = sqlite3_column_bytes(fetch.stmt, 0);
     fn(topic, ts, static_cast<const std::uint8_t*>(blob), static_cast<std::size_t>(n));
   }
   if (rc == SQLITE_BUSY || rc == SQLITE_LOCKED) Fail("the database is locked by another process (is the recorder still running?)");
+  if (rc == SQLITE_INTERRUPT) Fail("reading the messages took far longer than a recording of this size can (a generated table?)");
+  if (rc == SQLITE_TOOBIG)
+    Fail(fmt::format("a message's data is larger than the whole file ({} bytes): the data column is generated, not stored "
+                     "(not a rosbag2 recording)", file_size_));
   if (rc != SQLITE_DONE) Fail(fmt::format("SQLite error while reading messages: {}", sqlite3_errmsg(db_)));
 }
 

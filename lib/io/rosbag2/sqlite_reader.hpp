@@ -5,7 +5,10 @@
 //   messages(id INTEGER PRIMARY KEY, topic_id INTEGER, timestamp INTEGER, data BLOB)
 //   [metadata(...), schema(...)]   (newer distributions; not needed here)
 // Only the columns every distribution has are read. Messages stream in
-// timestamp order, one row in memory at a time.
+// timestamp order, one row in memory at a time. Reads are bounded by the
+// file's size in memory (no message or sum of messages longer than the
+// file: a generated zeroblob column is refused) and in time (SQLite's
+// progress handler stops queries after a budget of steps per stored byte).
 #pragma once
 
 #include <cstdint>
@@ -47,6 +50,8 @@ class SqliteBagFile {
   [[noreturn]] void Fail(const std::string& what) const;
   std::string path_;
   sqlite3* db_ = nullptr;
+  std::uint64_t file_size_ = 0;
+  std::uint64_t steps_ = 0, budget_ = 0;  ///< SQLite VM steps so far and allowed (progress handler)
   std::vector<SqliteTopic> topics_;
 };
 

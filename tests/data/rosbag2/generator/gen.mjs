@@ -295,5 +295,10 @@ async function bench(file, mb) {
   process.stdout.write(`wrote ${file}: ${sink.position()} bytes, ${js} joint states, ${poses} poses, ${seq - js - poses} images\n`);
 }
 
-if (process.argv[2] === "--bench") await bench(process.argv[3], Number(process.argv[4] ?? 1100));
-else await fixtures(process.argv[2] ?? path.resolve(path.dirname(new URL(import.meta.url).pathname), ".."));
+// Run as a script (gen_robust.mjs imports the writers without running it).
+if (path.resolve(process.argv[1] ?? "") === new URL(import.meta.url).pathname) {
+  if (process.argv[2] === "--bench") await bench(process.argv[3], Number(process.argv[4] ?? 1100));
+  else await fixtures(process.argv[2] ?? path.resolve(path.dirname(new URL(import.meta.url).pathname), ".."));
+}
+
+export { DEFS, encode, stamp, quat, writeMcap, zstd };
