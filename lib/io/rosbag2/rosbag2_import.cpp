@@ -669,8 +669,9 @@ Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotPar
     GtInterpolator interp{d.gt, static_cast<std::int64_t>(std::llround(o.max_gt_gap_s * 1e9))};
     std::vector<TrajectoryRun> runs;
     std::vector<double> turns;
-    for (const auto& [a, b] : spans) {
-      const auto gap = std::find_if(gaps.begin(), gaps.end(), [&](const WheelGap& g) { return g.k > a && g.k <= b; });
+    for (const auto& span : spans) {
+      const std::size_t a = span.first, b = span.second;
+      const auto gap = std::find_if(gaps.begin(), gaps.end(), [a, b](const WheelGap& g) { return g.k > a && g.k <= b; });
       if (gap != gaps.end()) {
         ++rs.runs_dropped;
         out.warnings.push_back(fmt::format(
