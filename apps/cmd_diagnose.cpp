@@ -2,6 +2,7 @@
 // model (E_d, E_b, k_L, k_R), which contract effect causes the gap, and how
 // far it shrinks once that effect is modelled (lib/diagnosis/diagnose.hpp).
 // Readable report on stdout, contract JSON with --json, gap bars with --plot.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <variant>
@@ -37,9 +38,58 @@ struct DiagnoseCliOptions {
   std::string report;
   bool quality_gate = false;
   std::string baseline;  ///< --baseline CAL.json
+  bool baseline_other_robot = false;  ///< --baseline-other-robot: take a baseline from another robot
   std::optional<double> k_L, k_R;
   JsonFlag json;
 };
+
+/// A --baseline whose wheelbase or a wheel diameter differs from the
+/// campaign's recorded one by more than this (relative) is another robot's
+/// (UMBmark corrections of a real robot are a few per cent at most).
+constexpr double kOtherRobotRelative = 0.10;
+
+/// Refuses (InputError, exit 1) a --baseline that belongs to another robot
+/// than the campaign's, unless --baseline-other-robot: its parameters lie
+/// more than kOtherRobotRelative from the campaign's recorded ones, or its
+/// own `recorded_parameters` (the robot file it was calibrated from) differ
+/// from the campaign's while its result is not the campaign's robot either
+/// (a second pass on a compensated robot records the corrected parameters:
+/// accepted).
+void CheckBaselineRobot(const std::string& path, const RobotParams& given, const RobotParams& campaign) {
+  const auto rel = [](double a, double b) { return std::abs(a / b - 1.0); };
+  const auto largest = [&](const RobotParams& a) {
+    return std::max({rel(a.wheelbase_m, campaign.wheelbase_m), rel(a.wheel_diameter_left_m, campaign.wheel_diameter_left_m),
+                     rel(a.wheel_diameter_right_m, campaign.wheel_diameter_right_m)});
+  };
+  const auto describe = [](const RobotParams& p) {
+    return fmt::format("wheelbase {:.6g} m, wheel diameters {:.6g} / {:.6g} m", p.wheelbase_m, p.wheel_diameter_left_m,
+                       p.wheel_diameter_right_m);
+  };
+  const std::string hint = "compare a robot with its own calibration or simulation, or give --baseline-other-robot "
+                           "to compare with this one on purpose";
+  if (largest(given) > kOtherRobotRelative) {
+    throw InputError(path, fmt::format("--baseline is another robot's: its parameters ({}) differ by {:.1f} % from "
+                                       "the campaign's recorded robot ({}), more than the {:.0f} % a calibration "
+                                       "corrects; {}",
+                                       describe(given), 100.0 * largest(given), describe(campaign),
+                                       100.0 * kOtherRobotRelative, hint));
+  }
+  nlohmann::json j = io::ParseJsonDocument(io::ReadWholeFile(path), path);
+  if (j.is_object() && j.contains("results") && j["results"].is_array() && j["results"].size() == 1) j = j["results"][0];
+  if (!j.is_object() || !j.contains("recorded_parameters")) return;  // a hand-written simulation model
+  const nlohmann::json& r = j["recorded_parameters"];
+  RobotParams recorded = campaign;
+  for (auto [key, field] : {std::pair{"wheelbase_m", &recorded.wheelbase_m},
+                            std::pair{"wheel_diameter_left_m", &recorded.wheel_diameter_left_m},
+                            std::pair{"wheel_diameter_right_m", &recorded.wheel_diameter_right_m}}) {
+    if (r.is_object() && r.contains(key) && r[key].is_number()) *field = r[key].get<double>();
+  }
+  constexpr double kSame = 1e-6;
+  if (largest(recorded) <= kSame || largest(given) <= kSame) return;
+  throw InputError(path, fmt::format("--baseline was calibrated from another robot's runs: its recorded_parameters "
+                                     "({}) are not the campaign's recorded robot ({}); {}",
+                                     describe(recorded), describe(campaign), hint));
+}
 
 /// --kl / --kr: both or neither, finite, >= 0, not both 0; only with --baseline.
 void CheckGivenNoise(const DiagnoseCliOptions& o) {
@@ -93,6 +143,7 @@ int RunDiagnose(DiagnoseCliOptions o) {
   if (!o.baseline.empty()) {
     diag::GivenModel g;
     g.params = io::ReadParamsJson(o.baseline, campaign.robot);
+    if (!o.baseline_other_robot) CheckBaselineRobot(o.baseline, g.params, campaign.robot);
     g.source = o.baseline;
     g.noise_given = o.k_L.has_value();
     g.k_L = o.k_L.value_or(0.0);
@@ -179,6 +230,10 @@ Command SetupDiagnose(CLI::App& parent) {
   app->add_option("--baseline", opts->baseline,
                   "Compare the runs with your simulation's parameters (a `calibrate` JSON: refined.parameters if "
                   "present) instead of a model fitted to them; also names wheelbase_error and diameter_ratio_error");
+  app->add_flag("--baseline-other-robot", opts->baseline_other_robot,
+                "Accept a --baseline from another robot (parameters more than 10 % from the campaign's, or "
+                "calibrated from runs recorded with another robot file); refused without it")
+      ->needs(app->get_option("--baseline"));
   app->add_option("--kl", opts->k_L,
                   "With --baseline: your simulation's left wheel noise k_L [m^1/2] (with --kr; also names "
                   "wheel_noise_error; without them the noise is fitted)");

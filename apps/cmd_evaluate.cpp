@@ -21,6 +21,7 @@
 #include "io/html_report.hpp"
 #include "io/data_file.hpp"
 #include "io/params_json.hpp"
+#include "io/run_prefetch.hpp"
 #include "io/manifest.hpp"
 #include "io/svg_plot.hpp"
 
@@ -304,7 +305,9 @@ int RunEvaluate(const EvaluateOptions& o) {
     manifests_with_trajectories.insert(src.manifest);
     TrajectoryDataCheck check(src.recorded);
     TrajectoryRun run;
-    while (reader->NextRun(run)) {
+    // The next run is read on a second thread while this one is evaluated.
+    io::RunPrefetcher prefetch(*reader);
+    while (prefetch.NextRun(run)) {
       check.Add(run);
       base_runs.push_back(EvaluateRun(run, src.path, src.label, src.recorded, src.recorded, integ));
       if (params) param_runs.push_back(EvaluateRun(run, src.path, src.label, *params, src.recorded, integ));

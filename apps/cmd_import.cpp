@@ -27,23 +27,19 @@ struct ImportOptions {
   std::string dir;
   std::string out;
   std::string category;
+  bool force = false;
   JsonFlag json;
 };
 
-void EnsureOutDir(const std::string& out) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec || !fs::is_directory(out)) throw InputError(out, "cannot create output directory: " + ec.message());
-}
-
 // Registers an import's inputs (each path, and every file of a folder) and
-// its two outputs, OUTDIR/runs.csv and OUTDIR/campaign.toml (plus --json),
-// with CommandOutputs(), and checks them before anything is read or written.
+// its output folder OUTDIR (runs.csv and campaign.toml; new or empty unless
+// --force) plus --json with CommandOutputs(), and checks them (and takes the
+// writer lock) before anything is read or written.
 struct CampaignPaths {
   std::string runs, manifest;
 };
-CampaignPaths CheckImportOutputs(const std::vector<std::string>& inputs, const std::string& out, const JsonFlag& json) {
+CampaignPaths CheckImportOutputs(const std::vector<std::string>& inputs, const std::string& out, const JsonFlag& json,
+                                 bool force) {
   namespace fs = std::filesystem;
   io::OutputSet& outs = CommandOutputs();
   for (const auto& in : inputs) {
@@ -53,11 +49,22 @@ CampaignPaths CheckImportOutputs(const std::vector<std::string>& inputs, const s
       for (const auto& entry : fs::directory_iterator(in, ec)) outs.AddInput(entry.path().string());
   }
   CampaignPaths p{(fs::path(out) / "runs.csv").string(), (fs::path(out) / "campaign.toml").string()};
-  outs.AddOutput("--out", p.runs);
-  outs.AddOutput("--out", p.manifest);
+  outs.AddOutputDirectory("--out", out, {"runs.csv", "campaign.toml"}, force);
   outs.AddOutput("--json", json.path);
   outs.Check();
   return p;
+}
+
+// The imported campaign as the folder `out`, written into a staging folder
+// and renamed into place as a whole (io::WriteCampaign): a reader or an
+// interrupted import sees the complete old folder or the complete new one,
+// and with --force no file of the previous campaign stays beside the new ones.
+void WriteImportedCampaign(const RobotParams& robot, const Experiment& experiment, TrajectoryData runs,
+                           const std::string& out, const std::vector<std::string>& comment, bool force) {
+  Manifest m;
+  m.robot = robot;
+  m.experiments.push_back(experiment);
+  io::WriteCampaign(m, {ExperimentData(std::move(runs))}, out, comment, {}, force);
 }
 
 int RunImportOptiOdom(const ImportOptions& o) {
@@ -66,18 +73,12 @@ int RunImportOptiOdom(const ImportOptions& o) {
   if (!o.category.empty()) category = o.category;
   // The output folder must not hold the dataset; the two files it gets must
   // not be other outputs.
-  const auto [runs_path, manifest_path] = CheckImportOutputs({o.dir}, o.out, o.json);
-  io::OutputSet& outs = CommandOutputs();
+  const auto [runs_path, manifest_path] = CheckImportOutputs({o.dir}, o.out, o.json, o.force);
   const io::OptiOdomDataset ds = io::ImportOptiOdom(o.dir, category);
 
-  EnsureOutDir(o.out);
   const std::string source = fmt::format("OptiOdom dataset {} ({}), imported by umbmark import optiodom", ds.id,
                                          ds.category);
-  Manifest m;
-  m.robot = ds.robot;
-  m.experiments.push_back(ds.experiment);
-  outs.Write(runs_path, io::FormatTrajectoryCsv(ds.runs, {source}));
-  outs.Write(manifest_path, io::FormatManifest(m, {source}));
+  WriteImportedCampaign(ds.robot, ds.experiment, ds.runs, o.out, {source}, o.force);
 
   std::size_t samples = 0;
   nlohmann::json runs = nlohmann::json::array();
@@ -120,6 +121,7 @@ struct Rosbag2Options {
   std::string integrator = "arc";
   std::string time = "header";
   io::rosbag2::Rosbag2ImportOptions import;
+  bool force = false;
   RobotFlags robot;
   JsonFlag json;
 };
@@ -235,21 +237,15 @@ int RunRosbag2(Rosbag2Options o) {
   const RobotParams robot = o.robot.Resolve();
   // The recordings (and every file of a bag folder) are inputs; the two
   // files written must not be one of them or another output.
-  const auto [runs_path, manifest_path] = CheckImportOutputs(o.bags, o.out, o.json);
-  io::OutputSet& outs = CommandOutputs();
+  const auto [runs_path, manifest_path] = CheckImportOutputs(o.bags, o.out, o.json, o.force);
   const auto result = io::rosbag2::ImportRosbag2(o.bags, robot, opt);
 
-  EnsureOutDir(o.out);
   std::vector<std::string> comment = {
       fmt::format("ROS 2 recording(s) {}, imported by umbmark import rosbag2", fmt::join(o.bags, ", ")),
       fmt::format("wheels: {} {}; ground truth: {}; time: {}", opt.wheels_topic.empty() ? "--odometry" : "--wheels",
                   opt.wheels_topic.empty() ? opt.odometry_topic : opt.wheels_topic,
                   opt.ground_truth_topic.empty() ? "none" : opt.ground_truth_topic, o.time)};
-  Manifest m;
-  m.robot = robot;
-  m.experiments.push_back(result.experiment);
-  outs.Write(runs_path, io::FormatTrajectoryCsv(result.runs, comment));
-  outs.Write(manifest_path, io::FormatManifest(m, {comment[0]}));
+  WriteImportedCampaign(robot, result.experiment, result.runs, o.out, comment, o.force);
 
   nlohmann::json recordings = nlohmann::json::array();
   for (const auto& r : result.recordings)
@@ -318,6 +314,7 @@ Command SetupImport(CLI::App& parent) {
   od->add_option("--category", opts->category,
                  "Dataset category (square|circular|ivanjko|free); default: the parent folder's name")
       ->check(CLI::IsMember({"square", "circular", "ivanjko", "free"}));
+  od->add_flag("--force", opts->force, "Replace a non-empty --out folder (and everything in it)");
   opts->json.Bind(*od);
 
   auto ro = std::make_shared<Rosbag2Options>();
@@ -328,6 +325,7 @@ Command SetupImport(CLI::App& parent) {
       ->required();
   rb->add_flag("--list", ro->list, "Print every topic with type, message count and rate, and what it can serve as; write nothing");
   rb->add_option("--out", ro->out, "Output directory");
+  rb->add_flag("--force", ro->force, "Replace a non-empty --out folder (and everything in it)");
   rb->add_option("--experiment", ro->experiment, "Experiment kind")->check(CLI::IsMember({"square", "back_and_forth", "free"}));
   rb->add_option("--side", ro->side_m, "Square side [m] (square)")->check(Plausible("side_m"));
   rb->add_option("--distance", ro->distance_m, "Leg length [m] (back_and_forth)")->check(Plausible("distance_m"));

@@ -3,6 +3,7 @@
 // `results` count one robot each): one row per robot, the fleet's median and
 // robust spread of each parameter, and the robots that stand out (robust
 // z-score, calibration/fleet.hpp) with the reasons in words.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -16,6 +17,7 @@
 #include "io/atomic_write.hpp"
 #include "io/csv_writer.hpp"
 #include "io/html_report.hpp"
+#include "io/params_json.hpp"
 #include "io/svg_plot.hpp"
 
 namespace umbmark::cli {
@@ -35,6 +37,24 @@ struct Robot {
   std::string source;  // "refined" or "umbmark"
 };
 
+/// Wheelbase and diameters of `obj` (a `parameters` object): refused naming
+/// the file when missing, not numbers or impossible (negative, 1e308: a
+/// robot with such parameters is no robot of the fleet).
+RobotParams ParamsFrom(const nlohmann::json& obj, const std::string& file, const char* what) {
+  RobotParams p;
+  double* fields[] = {&p.wheelbase_m, &p.wheel_diameter_left_m, &p.wheel_diameter_right_m};
+  const char* keys[] = {"wheelbase_m", "wheel_diameter_left_m", "wheel_diameter_right_m"};
+  for (int k = 0; k < 3; ++k) {
+    if (!obj.is_object() || !obj.contains(keys[k]) || !obj[keys[k]].is_number())
+      throw InputError(file, fmt::format("calibration JSON without a numeric {}.{}", what, keys[k]));
+    *fields[k] = obj[keys[k]].get<double>();
+  }
+  if (auto e = io::ImplausibleParams(p); !e.empty())
+    throw InputError(file, fmt::format("{}: {} (impossible for a robot; this is no calibrate output of a real robot)",
+                                       what, e));
+  return p;
+}
+
 // One calibrate result (an object with `parameters`) -> a fleet robot.
 Robot RobotFromResult(const nlohmann::json& j, const std::string& file) {
   Robot r;
@@ -45,13 +65,19 @@ Robot RobotFromResult(const nlohmann::json& j, const std::string& file) {
   auto number = [&](const nlohmann::json& obj, const char* key, FleetQuantity q) {
     if (obj.contains(key) && obj[key].is_number()) r.fleet.values[q] = obj[key].get<double>();
   };
-  for (const char* key : {"wheelbase_m", "wheel_diameter_left_m", "wheel_diameter_right_m"}) {
-    if (!r.parameters.contains(key) || !r.parameters[key].is_number())
-      throw InputError(file, fmt::format("calibration JSON without a numeric parameters.{}", key));
+  ParamsFrom(r.parameters, file, refined ? "refined.parameters" : "parameters");
+  if (j.contains("recorded_parameters")) {
+    const RobotParams rec = ParamsFrom(j["recorded_parameters"], file, "recorded_parameters");
+    r.fleet.recorded = FleetRecordedKey(rec.wheelbase_m, rec.wheel_diameter_left_m, rec.wheel_diameter_right_m);
   }
   number(r.parameters, "wheelbase_m", FleetQuantity::kWheelbase);
   number(r.parameters, "wheel_diameter_left_m", FleetQuantity::kDiameterLeft);
   number(r.parameters, "wheel_diameter_right_m", FleetQuantity::kDiameterRight);
+  for (const char* key : {"E_d", "E_b"}) {
+    if (j.contains(key) && j[key].is_number() && !(j[key].get<double>() > 0.0 && j[key].get<double>() < 10.0))
+      throw InputError(file, fmt::format("{} = {} is impossible (a ratio of positive lengths near 1)", key,
+                                         j[key].get<double>()));
+  }
   number(j, "E_d", FleetQuantity::kEd);
   number(j, "E_b", FleetQuantity::kEb);
   number(j, "E_max_syst_m", FleetQuantity::kEmaxBefore);
@@ -61,13 +87,7 @@ Robot RobotFromResult(const nlohmann::json& j, const std::string& file) {
 }
 
 std::vector<Robot> ReadRobots(const std::string& path) {
-  nlohmann::json j;
-  const std::string text = io::ReadWholeFile(path);
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path, fmt::format("not JSON (byte {}): {}", e.byte, e.what()));
-  }
+  const nlohmann::json j = io::ParseJsonDocument(io::ReadWholeFile(path), path);
   std::vector<Robot> out;
   try {
     if (j.contains("results") && j["results"].is_array()) {  // a batch calibrate output
@@ -82,6 +102,23 @@ std::vector<Robot> ReadRobots(const std::string& path) {
     }
   } catch (const nlohmann::json::exception& e) {
     throw InputError(path, fmt::format("not a calibrate JSON output: {}", e.what()));
+  }
+  return out;
+}
+
+/// The inputs with each file once: the same file given twice (a.json and
+/// ./a.json, a symbolic or hard link: same device and inode) would count one
+/// robot twice and pull the fleet's median towards it. A warning names each
+/// repeat. Files that cannot be read are kept for the reader to report.
+std::vector<std::string> DistinctInputs(const std::vector<std::string>& inputs, std::vector<std::string>& warnings) {
+  std::vector<std::string> out;
+  for (const auto& path : inputs) {
+    const auto same = std::find_if(out.begin(), out.end(), [&](const std::string& p) { return io::SameFile(p, path); });
+    if (same == out.end()) {
+      out.push_back(path);
+    } else {
+      warnings.push_back(fmt::format("{} is the same file as {} (given twice): counted once", path, *same));
+    }
   }
   return out;
 }
@@ -244,15 +281,22 @@ int RunSummarize(const SummarizeOptions& o) {
   outs.AddOutput("--csv", o.csv);
   outs.AddOutput("--report", o.report);
   outs.Check();
+  std::vector<std::string> warnings;
   std::vector<Robot> robots;
-  for (const auto& path : o.inputs) {
+  for (const auto& path : DistinctInputs(o.inputs, warnings)) {
     auto more = ReadRobots(path);
     robots.insert(robots.end(), more.begin(), more.end());
   }
   std::vector<FleetRobot> fr;
   for (const auto& r : robots) fr.push_back(r.fleet);
   const FleetSummary s = SummarizeFleet(fr, o.fleet);
-  std::vector<std::string> warnings;
+  if (s.groups > 1) {
+    warnings.push_back(fmt::format(
+        "the robots were recorded with {} different parameter sets (recorded_parameters: robot files); E_d, E_b and "
+        "E_max_syst_m are relative to them and compared only between robots with the same set (at least 3); the "
+        "corrected parameters are compared across the whole fleet",
+        s.groups));
+  }
   if (robots.size() < 3) warnings.push_back(fmt::format("{} robot(s): a fleet spread needs at least 3; no outliers are flagged", robots.size()));
   std::size_t n_out = 0;
   for (const auto& r : s.robots) n_out += r.outlier ? 1 : 0;

@@ -136,6 +136,37 @@ CLI::Validator SeedValidator() {
       "SEED");
 }
 
+namespace {
+/// Options and arguments that name a file or folder.
+bool IsPathOption(const CLI::Option& opt) {
+  static const char* const kLong[] = {"json", "report", "plot", "csv", "out", "params", "baseline", "ros2", "robot",
+                                      "truth-out"};
+  static const char* const kPositional[] = {"DATA", "MANIFEST", "CAL", "DIR", "BAG"};
+  for (const auto& n : opt.get_lnames())
+    for (const char* k : kLong)
+      if (n == k) return true;
+  if (!opt.get_positional()) return false;
+  for (const char* k : kPositional)
+    if (opt.get_name() == k) return true;
+  return false;
+}
+}  // namespace
+
+void CheckPathArguments(const CLI::App& app) {
+  for (const CLI::Option* opt : app.get_options()) {
+    if (opt->count() == 0 || !IsPathOption(*opt)) continue;
+    const std::string name = opt->get_positional() ? opt->get_name() : "--" + opt->get_lnames().front();
+    for (const auto& v : opt->results()) {
+      if (v.empty()) {
+        throw InvalidOptions(fmt::format("{}: empty path; give a file name{}", name,
+                                         name == "--json" ? " or '-' for standard output" : ""));
+      }
+      if (v.find('\0') != std::string::npos) throw InvalidOptions(fmt::format("{}: the path contains a NUL byte", name));
+    }
+  }
+  for (const CLI::App* sub : app.get_subcommands()) CheckPathArguments(*sub);
+}
+
 io::OutputSet& CommandOutputs() {
   static io::OutputSet set;
   return set;

@@ -70,6 +70,14 @@ CLI::Validator Plausible(std::string_view key);
 /// (CLI11 would turn "-1" silently into 2^64-1).
 CLI::Validator SeedValidator();
 
+/// Refuses (InvalidOptions, exit 2) an empty value given to a file or folder
+/// option or argument of the parsed command (`--json ""` would otherwise
+/// mean "not requested" and the output would silently not be written;
+/// `--out ""`, `--report ""`, `DATA ""` likewise) and a path holding a NUL
+/// byte. Walks the parsed subcommands of `app`; main() calls it before the
+/// command runs.
+void CheckPathArguments(const CLI::App& app);
+
 /// The process's output set: every command registers its inputs and outputs
 /// here, calls Check() before writing anything, and writes through Write()
 /// (see io/output_set.hpp). One command runs per process.

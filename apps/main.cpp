@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "common.hpp"
 #include "core/errors.hpp"
 #include "core/utf8.hpp"
 #include "io/atomic_write.hpp"
@@ -33,9 +34,10 @@ void Report(const std::string& text) { fmt::print(stderr, "{}\n", umbmark::Escap
 
 /// Runs the parsed subcommand; every exception becomes a message and a
 /// documented exit status.
-int RunCommand(const std::vector<umbmark::cli::Command>& commands) {
+int RunCommand(const CLI::App& app, const std::vector<umbmark::cli::Command>& commands) {
   using namespace umbmark;
   try {
+    cli::CheckPathArguments(app);
     for (const auto& c : commands) {
       if (c.app->parsed()) return c.run();
     }
@@ -145,7 +147,7 @@ int main(int argc, char** argv) {
     fmt::print("{}", topic->get_formatter()->make_help(topic, topic->get_name(), CLI::AppFormatMode::Normal));
     return 0;
   }
-  int status = RunCommand(commands);
+  int status = RunCommand(app, commands);
   // Output that could not be written (a full disk, `> /dev/full`, a closed
   // pipe) is a failure, never a silent success.
   if (std::fflush(stdout) != 0 || std::ferror(stdout)) {

@@ -7,8 +7,11 @@
 #   - umbmark evaluate FILE --robot R.toml   (read + parse + odometry + errors)
 #   - pandas.read_csv(FILE)                  (parse only, inside Python, import excluded)
 # and prints MB/s of both, their ratio (wall clock and CPU time), and the
-# peak memory of each process (/usr/bin/time -v). Targets: ratio >= 3, umbmark
-# peak memory < 64 MB + the largest run. The file is deleted at the end.
+# peak memory of each process (/usr/bin/time -v). Targets (issue 23): ratio
+# >= 3 (wall clock), umbmark peak memory <= 128 MB. evaluate reads the next
+# run on a second thread while it evaluates the one before (io/run_prefetch),
+# so on one core the wall ratio falls back to about the CPU-time ratio.
+# The file is deleted at the end.
 #   usage: bench/evaluate_bench.sh [BUILD_DIR]      (default: build)
 #   env:   EVAL_BENCH_RUNS (200), EVAL_BENCH_ROWS (20000), EVAL_BENCH_REPEATS (3),
 #          EVAL_BENCH_DIR (default: $TMPDIR/umbmark_eval_bench), PYTHON (python3 with pandas)
@@ -94,4 +97,4 @@ echo "pandas.read_csv (parse only):     $(mbps "$best_p_wall") MB/s wall, $(mbps
 awk -v uw="$best_u_wall" -v pw="$best_p_wall" -v uc="$best_u_cpu" -v pc="$best_p_cpu" \
   'BEGIN { printf "ratio umbmark / pandas: %.2fx (wall), %.2fx (CPU time)   target >= 3x\n", pw / uw, pc / uc }'
 awk -v u="$peak_u" -v p="$peak_p" -v r="$largest_run_mb" \
-  'BEGIN { printf "peak memory: umbmark %.1f MB, pandas process %.1f MB   target: umbmark < 64 MB + largest run (%.1f MB)\n", u / 1024, p / 1024, r }'
+  'BEGIN { printf "peak memory: umbmark %.1f MB, pandas process %.1f MB   target: umbmark <= 128 MB (largest run %.1f MB)\n", u / 1024, p / 1024, r }'

@@ -120,3 +120,72 @@ TEST_CASE("umbmark summarize: JSON keys, CSV, report, and a real calibrate outpu
   CHECK(bad.status == 1);
   CHECK(bad.err.find("bad.json") != std::string::npos);
 }
+
+// Issue 23: E_d, E_b and E_max_syst_m are relative to the parameters the
+// odometry used (recorded_parameters); a robot recorded with another robot
+// file (0.205 m instead of 0.2 m) whose true wheelbase is the fleet's has
+// E_b = 0.2 / 0.205 = 0.9756 and must not be called mis-assembled, while a
+// robot recorded with 0.2 m whose wheelbase really is 3 % long still is.
+TEST_CASE("summarize compares E_b and E_d only between robots with the same recorded parameters", "[fleet][cli]") {
+  const fs::path dir = TempDir("fleet-recorded");
+  std::mt19937_64 rng(77);
+  std::normal_distribution<double> n(0.0, 5e-4);
+  std::string args = "summarize";
+  for (int i = 0; i < 12; ++i) {
+    const double recorded_b = i == 4 ? 0.205 : 0.2;
+    double b = 0.2 * (1 + n(rng));
+    if (i == 9) b *= 1.03;
+    const double dl = 0.084 * (1 + n(rng)), dr = 0.084 * (1 + n(rng));
+    const nlohmann::json j = {
+        {"E_d", dr / dl},
+        {"E_b", b / recorded_b},
+        {"E_max_syst_m", 0.01 * (1 + n(rng)) * (i == 4 ? 3.0 : 1.0)},
+        {"parameters", {{"wheelbase_m", b}, {"wheel_diameter_left_m", dl}, {"wheel_diameter_right_m", dr}}},
+        {"recorded_parameters",
+         {{"wheelbase_m", recorded_b}, {"wheel_diameter_left_m", 0.084}, {"wheel_diameter_right_m", 0.084}}}};
+    const fs::path f = dir / ("r" + std::to_string(i) + ".json");
+    std::ofstream(f) << j.dump();
+    args += " " + Q(f);
+  }
+  const auto r = RunCli(args + " --json -");
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  REQUIRE(j["robots"].size() == 12);
+  // Robot 4 (another robot file, the fleet's true wheelbase): nothing about
+  // its wheelbase, E_b or its error before calibration. (Its diameters are
+  // random production spread like everyone's, scored as usual.)
+  INFO("robot 4: " << j["robots"][4]["outlier_reasons"].dump());
+  for (const auto& reason : j["robots"][4]["outlier_reasons"]) {
+    const std::string text = reason.get<std::string>();
+    CHECK(text.find("wheelbase") == std::string::npos);
+    CHECK(text.find("E_b") == std::string::npos);
+    CHECK(text.find("systematic error") == std::string::npos);
+  }
+  // Robot 9 (recorded 0.2 m, truly 3 % wide): mis-assembled, by its absolute wheelbase and by E_b.
+  INFO("robot 9: " << j["robots"][9]["outlier_reasons"].dump());
+  CHECK(j["robots"][9]["outlier"] == true);
+  CHECK(j["robots"][9]["outlier_reasons"][0].get<std::string>().find("mis-assembled") != std::string::npos);
+  // Robot 4 alone in its group: no relative z-score at all; its absolute wheelbase is scored.
+  CHECK_FALSE(j["robots"][4]["robust_z"].contains("E_b"));
+  CHECK(j["robots"][4]["robust_z"].contains("wheelbase_m"));
+  CHECK(j["robots"][9]["robust_z"]["E_b"].get<double>() > 3.5);
+  bool warned = false;
+  for (const auto& w : j["warnings"]) warned = warned || w.get<std::string>().find("2 different parameter sets") != std::string::npos;
+  CHECK(warned);
+
+  // The library on its own: the same split by FleetRobot::recorded.
+  std::vector<FleetRobot> robots(6);
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    robots[i].recorded = FleetRecordedKey(i < 3 ? 0.2 : 0.3, 0.084, 0.084);
+    robots[i].values[FleetQuantity::kEb] = (i < 3 ? 1.0 : 1.1) + 1e-3 * static_cast<double>(i % 3);
+    robots[i].values[FleetQuantity::kWheelbase] = 0.2 + 1e-4 * static_cast<double>(i);
+  }
+  const FleetSummary s = SummarizeFleet(robots);
+  CHECK(s.groups == 2);
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    INFO("robot " << i);
+    CHECK_FALSE(s.robots[i].outlier);  // 1.0 vs 1.1 is the robot files' difference, not the robots'
+    CHECK(s.robots[i].reference.at(FleetQuantity::kEb).median == Approx(i < 3 ? 1.001 : 1.101));
+  }
+}

@@ -17,6 +17,9 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "io/output_set.hpp"
 #include "support/run_cli.hpp"
 
 namespace fs = std::filesystem;
@@ -292,4 +295,47 @@ TEST_CASE("SIGKILL leaves temporaries; the next write of the same output deletes
     CHECK(Temporaries(dir) == 0);
     CHECK(fs::exists(dir / "out" / "sq.csv"));
   }
+}
+
+// One writer per output set (issue 23): two calibrates with different robot
+// files writing the same --json and --ros2 at once must leave both files
+// from the same run (before the lock: 6 of 40 trials mixed them); a writer
+// that cannot get the lock within UMBMARK_LOCK_WAIT_S exits 1 naming the
+// output, and gets it once the holder is gone.
+TEST_CASE("concurrent writers of the same outputs run one after the other", "[safety][cli][lock]") {
+  const fs::path dir = CopyExamples("lock");
+  Write(dir / "other.toml", "wheelbase_m = 0.21\nwheel_diameter_left_m = 0.084\nwheel_diameter_right_m = 0.084\n"
+                            "ticks_per_rev = 2796.8\n");  // robot.toml has 0.2: the wheelbase tells the runs apart
+  const auto calibrate = [&](const char* robot) {
+    return "'" + std::string(UMBMARK_EXE) + "' calibrate " + Q(dir / "endpoints.csv") + " --robot " + Q(dir / robot) +
+           " --side 4 --json " + Q(dir / "o.json") + " --ros2 " + Q(dir / "o.yaml") + " >/dev/null 2>&1";
+  };
+  const std::string both = "(" + calibrate("robot.toml") + " & " + calibrate("other.toml") + " & wait)";
+  for (int trial = 0; trial < 12; ++trial) {
+    INFO("trial " << trial);
+    REQUIRE(std::system(both.c_str()) == 0);
+    const std::string json = Slurp((dir / "o.json").string()), yaml = Slurp((dir / "o.yaml").string());
+    const bool json_b = nlohmann::json::parse(json)["recorded_parameters"]["wheelbase_m"].get<double>() == 0.21;
+    const bool yaml_b = yaml.find("wheel_separation: 0.21 ") != std::string::npos;
+    CHECK(json_b == yaml_b);
+  }
+  CHECK(Temporaries(dir) == 0);
+}
+
+TEST_CASE("a writer waits for the lock, then gives up with a clear message", "[safety][cli][lock]") {
+  const fs::path dir = CopyExamples("lockwait");
+  const std::string cmd = "calibrate " + Q(dir / "endpoints.csv") + " --robot " + Q(dir / "robot.toml") +
+                          " --side 4 --json " + Q(dir / "o.json");
+  ScopedEnv wait("UMBMARK_LOCK_WAIT_S", "0.3");
+  {
+    umbmark::io::OutputSet holder;  // another writer of o.json, in this process
+    holder.AddOutput("--json", (dir / "o.json").string());
+    holder.Check();
+    const auto r = RunCli(cmd);
+    CHECK(r.status == 1);
+    CHECK_THAT(r.err, Catch::Contains("o.json") && Catch::Contains("another umbmark process is writing this output"));
+    CHECK_FALSE(fs::exists(dir / "o.json"));
+  }
+  CHECK(RunCli(cmd).status == 0);  // the holder is gone
+  CHECK(fs::exists(dir / "o.json"));
 }

@@ -21,6 +21,14 @@ const char* FleetQuantityKey(FleetQuantity q) {
   return "?";
 }
 
+bool FleetQuantityIsRelative(FleetQuantity q) {
+  return q == FleetQuantity::kEd || q == FleetQuantity::kEb || q == FleetQuantity::kEmaxBefore;
+}
+
+std::string FleetRecordedKey(double wheelbase_m, double diameter_left_m, double diameter_right_m) {
+  return fmt::format("{:.9g},{:.9g},{:.9g}", wheelbase_m, diameter_left_m, diameter_right_m);
+}
+
 std::string FleetOptions::Check() const {
   if (!(threshold > 0.0)) return fmt::format("threshold = {} must be > 0", threshold);
   if (!(min_relative_spread >= 0.0)) return fmt::format("min_relative_spread = {} must be >= 0", min_relative_spread);
@@ -70,31 +78,61 @@ std::string Reason(FleetQuantity q, double value, double z, const FleetStat& s) 
   }
   return "";
 }
+
+/// The value of `q` of robot `r`, when it has a finite one.
+const double* ValueOf(const FleetRobot& r, FleetQuantity q) {
+  const auto it = r.values.find(q);
+  return it != r.values.end() && std::isfinite(it->second) ? &it->second : nullptr;
+}
+
+/// Median and robust spread of `q` over the robots `members` that give it.
+FleetStat StatOf(const std::vector<FleetRobot>& robots, const std::vector<std::size_t>& members, FleetQuantity q,
+                 const FleetOptions& options) {
+  std::vector<double> v;
+  for (std::size_t i : members)
+    if (const double* x = ValueOf(robots[i], q)) v.push_back(*x);
+  FleetStat s;
+  s.n = v.size();
+  if (v.empty()) return s;
+  s.median = Median(v);
+  std::vector<double> dev;
+  for (double x : v) dev.push_back(std::abs(x - s.median));
+  s.mad = 1.4826 * Median(dev);
+  s.spread = std::max(s.mad, options.min_relative_spread * std::abs(s.median));
+  return s;
+}
+
+/// Robust z-scores of `q` for the robots `members` against their own stat.
+void Score(const std::vector<FleetRobot>& robots, const std::vector<std::size_t>& members, FleetQuantity q,
+           const FleetOptions& options, FleetSummary& out) {
+  const FleetStat s = StatOf(robots, members, q, options);
+  if (s.n < 3 || !(s.spread > 0.0)) return;
+  for (std::size_t i : members) {
+    const double* x = ValueOf(robots[i], q);
+    if (x == nullptr) continue;
+    out.robots[i].z[q] = (*x - s.median) / s.spread;
+    out.robots[i].reference[q] = s;
+  }
+}
 }  // namespace
 
 FleetSummary SummarizeFleet(const std::vector<FleetRobot>& robots, const FleetOptions& options) {
   FleetSummary out;
   out.robots.resize(robots.size());
+  std::vector<std::size_t> all(robots.size());
+  for (std::size_t i = 0; i < robots.size(); ++i) all[i] = i;
+  std::map<std::string, std::vector<std::size_t>> groups;  // recorded parameters -> robots
+  for (std::size_t i = 0; i < robots.size(); ++i) groups[robots[i].recorded].push_back(i);
+  out.groups = groups.size();
   for (FleetQuantity q : kFleetQuantities) {
-    std::vector<double> v;
-    for (const auto& r : robots)
-      if (auto it = r.values.find(q); it != r.values.end() && std::isfinite(it->second)) v.push_back(it->second);
-    if (v.empty()) continue;
-    FleetStat s;
-    s.n = v.size();
-    s.median = Median(v);
-    std::vector<double> dev;
-    for (double x : v) dev.push_back(std::abs(x - s.median));
-    s.mad = 1.4826 * Median(dev);
-    s.spread = std::max(s.mad, options.min_relative_spread * std::abs(s.median));
+    const FleetStat s = StatOf(robots, all, q, options);
+    if (s.n == 0) continue;
     out.fleet[q] = s;
-    if (s.n < 3 || !(s.spread > 0.0)) continue;
-    for (std::size_t i = 0; i < robots.size(); ++i) {
-      const auto it = robots[i].values.find(q);
-      if (it == robots[i].values.end() || !std::isfinite(it->second)) continue;
-      const double z = (it->second - s.median) / s.spread;
-      out.robots[i].z[q] = z;
+    if (!FleetQuantityIsRelative(q)) {
+      Score(robots, all, q, options, out);
+      continue;
     }
+    for (const auto& [key, members] : groups) Score(robots, members, q, options, out);
   }
   for (std::size_t i = 0; i < robots.size(); ++i) {
     auto& r = out.robots[i];
@@ -102,7 +140,7 @@ FleetSummary SummarizeFleet(const std::vector<FleetRobot>& robots, const FleetOp
     for (const auto& [q, z] : r.z)
       if (std::abs(z) > options.threshold) flagged.emplace_back(std::abs(z), q);
     std::sort(flagged.begin(), flagged.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-    for (const auto& [az, q] : flagged) r.reasons.push_back(Reason(q, robots[i].values.at(q), r.z.at(q), out.fleet.at(q)));
+    for (const auto& [az, q] : flagged) r.reasons.push_back(Reason(q, robots[i].values.at(q), r.z.at(q), r.reference.at(q)));
     r.outlier = !flagged.empty();
   }
   return out;

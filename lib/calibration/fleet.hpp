@@ -30,10 +30,26 @@ inline constexpr FleetQuantity kFleetQuantities[] = {
 /// "E_max_syst_m", "residual_after_m".
 const char* FleetQuantityKey(FleetQuantity q);
 
+/// True for the quantities that are relative to the parameters the robot's
+/// odometry used when its runs were recorded (E_d, E_b, E_max_syst_m): two
+/// robots recorded with different robot files have different E_b for the
+/// same true wheelbase, so these are compared only between robots with the
+/// same recorded parameters. The corrected parameters and the error left
+/// after correction are absolute and compared across the whole fleet.
+bool FleetQuantityIsRelative(FleetQuantity q);
+
 struct FleetRobot {
   std::string file;
   std::map<FleetQuantity, double> values;  ///< a quantity the calibration did not give is absent
+  /// The recorded parameters (robot file) the calibration started from, as a
+  /// key (FleetRecordedKey); robots with equal keys are compared in the
+  /// relative quantities. Empty: not known (all such robots form one group).
+  std::string recorded;
 };
+
+/// The group key of recorded parameters: the three values to 9 significant
+/// digits (a robot file written twice compares equal; 0.2 and 0.205 do not).
+std::string FleetRecordedKey(double wheelbase_m, double diameter_left_m, double diameter_right_m);
 
 struct FleetOptions {
   /// |robust z| above which a robot is an outlier (default 3.5, Iglewicz &
@@ -55,16 +71,24 @@ struct FleetStat {
 
 struct FleetRobotResult {
   std::map<FleetQuantity, double> z;  ///< robust z-score per quantity present
+  /// The statistics each z-score was taken against: the fleet's, or for a
+  /// relative quantity those of the robots with the same recorded parameters.
+  std::map<FleetQuantity, FleetStat> reference;
   bool outlier = false;
   std::vector<std::string> reasons;  ///< why, in words, largest |z| first
 };
 
 struct FleetSummary {
+  /// Over every robot that gives the quantity (for a relative quantity a
+  /// mix of recorded-parameter groups when there are several; see groups).
   std::map<FleetQuantity, FleetStat> fleet;
+  /// Number of distinct recorded-parameter groups (1 for a uniform fleet).
+  std::size_t groups = 0;
   std::vector<FleetRobotResult> robots;  ///< in input order
 };
 
-/// Needs at least 3 robots for a spread; fewer give no outliers.
+/// Needs at least 3 robots for a spread (for a relative quantity: 3 with the
+/// same recorded parameters); fewer give no z-score and no outlier.
 FleetSummary SummarizeFleet(const std::vector<FleetRobot>& robots, const FleetOptions& options = {});
 
 }  // namespace umbmark

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
+#include "core/utf8.hpp"
 #include "io/atomic_write.hpp"
 #include "io/csv_writer.hpp"
 
@@ -37,11 +38,32 @@ std::string TomlString(const std::string& s) {
   }
   return out + "\"";
 }
+
+// The comment lines, each "# LINE\n". A comment holds user text (a folder
+// name): bytes that are not UTF-8 are written as \xNN and control
+// characters (a newline in a folder name would end the comment and leave
+// the rest as TOML or CSV data) as \xNN too, so the file stays valid UTF-8
+// TOML / CSV (TOML 1.0 forbids control characters other than tab in
+// comments).
+std::string CommentLines(const std::vector<std::string>& comment) {
+  std::string out;
+  for (const auto& line : comment) {
+    out += "# ";
+    for (const char c : EscapeInvalidUtf8(line)) {
+      const auto u = static_cast<unsigned char>(c);
+      if ((u < 0x20 && c != '\t') || u == 0x7F)
+        out += fmt::format("\\x{:02X}", static_cast<unsigned>(u));
+      else
+        out += c;
+    }
+    out += "\n";
+  }
+  return out;
+}
 }  // namespace
 
 std::string FormatTrajectoryCsv(const TrajectoryData& data, const std::vector<std::string>& comment) {
-  std::string out;
-  for (const auto& line : comment) out += "# " + line + "\n";
+  std::string out = CommentLines(comment);
   const bool ticks = data.runs.empty() || data.runs.front().has_ticks();
   out += ticks ? "run,direction,t_s,ticks_left,ticks_right,x_gt_m,y_gt_m,theta_gt_rad\n"
                : "run,direction,t_s,dist_left_m,dist_right_m,x_gt_m,y_gt_m,theta_gt_rad\n";
@@ -73,8 +95,7 @@ std::string FormatTrajectoryCsv(const TrajectoryData& data, const std::vector<st
 // `kind`) and it writes no comments. fmt's {} gives the shortest digits
 // that read back bit for bit (test_io_manifest_writer).
 std::string FormatManifest(const Manifest& manifest, const std::vector<std::string>& comment) {
-  std::string out;
-  for (const auto& line : comment) out += "# " + line + "\n";
+  std::string out = CommentLines(comment);
   const RobotParams& r = manifest.robot;
   out += "[robot]\n";
   out += fmt::format("wheelbase_m = {}\n", r.wheelbase_m);
@@ -97,8 +118,7 @@ std::string FormatManifest(const Manifest& manifest, const std::vector<std::stri
 }
 
 std::string FormatEndpointCsv(const EndpointData& data, const std::vector<std::string>& comment) {
-  std::string out;
-  for (const auto& line : comment) out += "# " + line + "\n";
+  std::string out = CommentLines(comment);
   out += "run,direction,ex_m,ey_m,etheta_rad\n";
   for (const auto& r : data.runs) {
     out += fmt::format("{},{},{},{},", CsvField(r.run), CsvField(r.direction), r.ex_m, r.ey_m);

@@ -6,10 +6,12 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <system_error>
 #include <unordered_map>
 
 #include <fast_float/fast_float.h>
+
 #include <fmt/format.h>
 
 #include "core/angles.hpp"
@@ -283,6 +285,10 @@ std::vector<ResolvedColumn> CsvReader::Resolve(std::span<const ColumnSpec> specs
     r.header = std::string(name);
     r.multiply = multiply;
     r.divide = divide;
+    r.max_abs = spec.quantity == Quantity::kLength  ? kMaxLengthM
+                : spec.quantity == Quantity::kAngle ? kMaxAngleRad
+                : spec.quantity == Quantity::kTime  ? kMaxTimeS
+                                                    : std::numeric_limits<double>::infinity();
   }
   return out;
 }
@@ -532,6 +538,12 @@ void CsvReader::FailHeader(std::size_t i, const std::string& message) const {
 
 void CsvReader::FailNumber(const ResolvedColumn& c, std::string_view cell, const char* what) const {
   FailCell(c.index, fmt::format("{}: {} {}", c.header, QuoteForMessage(cell), what));
+}
+
+void CsvReader::FailMagnitude(const ResolvedColumn& c, std::string_view cell) const {
+  const char* unit = c.max_abs == kMaxLengthM ? "m" : c.max_abs == kMaxAngleRad ? "rad" : "s";
+  FailCell(c.index, fmt::format("{}: {} is beyond any measured value (|value| > {:g} {}): an export or unit error?",
+                                c.header, QuoteForMessage(cell), c.max_abs, unit));
 }
 
 void CsvReader::FailEmpty(const ResolvedColumn& c) const {

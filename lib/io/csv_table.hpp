@@ -22,6 +22,7 @@
 #include <cstring>
 #include <memory>
 #include <span>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -43,6 +44,14 @@ enum class Quantity {
   kTime,    ///< _s
 };
 
+/// The largest magnitudes a number cell may have, in SI units: no robot run
+/// measures 10,000 km or turns 1.6 million times, and 1e12 s (31,700 years)
+/// still holds any time stamp in seconds (ROS epoch stamps are ~1.7e9 s).
+/// Beyond them a value is an export or unit error, refused with its cell.
+inline constexpr double kMaxLengthM = 1e7;
+inline constexpr double kMaxAngleRad = 1e7;
+inline constexpr double kMaxTimeS = 1e12;
+
 /// A column a reader knows, by its base name (without unit suffix).
 struct ColumnSpec {
   std::string_view base;
@@ -56,6 +65,9 @@ struct ResolvedColumn {
   std::string header;           ///< the name as written, for messages
   double multiply = 1.0;        ///< SI value = cell * multiply / divide
   double divide = 1.0;
+  /// Largest |SI value| accepted (kMaxLengthM, ... by quantity): beyond it a
+  /// number is no measurement (1e308 m) and would overflow the statistics.
+  double max_abs = std::numeric_limits<double>::infinity();
   bool present() const { return index != kAbsent; }
 };
 
@@ -156,6 +168,8 @@ class CsvReader {
   [[noreturn]] void FailEmpty(const ResolvedColumn& c) const;
   [[noreturn]] void FailHeader(std::size_t i, const std::string& message) const;
   [[noreturn]] void FailNumber(const ResolvedColumn& c, std::string_view cell, const char* what) const;
+  /// A finite number beyond the column's max_abs.
+  [[noreturn]] void FailMagnitude(const ResolvedColumn& c, std::string_view cell) const;
 
   InputStream in_;
   std::string name_;
@@ -322,6 +336,7 @@ inline bool CsvReader::OptionalNumber(const ResolvedColumn& c, double& out) cons
     v = v * c.multiply / c.divide;
     if (!std::isfinite(v)) FailNumber(c, s, "is infinite or out of range");
   }
+  if (!(std::abs(v) <= c.max_abs)) FailMagnitude(c, s);
   out = v;
   return true;
 }

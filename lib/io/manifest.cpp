@@ -81,6 +81,13 @@ Experiment ReadExperiment(const toml::table& t, std::size_t number, const std::f
   if (file == nullptr) FailAt(name, t.source(), fmt::format("experiment {}: missing key 'file'", number));
   e.file = detail::StringValue(*file, "file", name);
   if (e.file.empty()) FailAt(name, file->source(), fmt::format("experiment {}: file is empty", number));
+  // A NUL byte would end the path for the operating system: "a.csv\0b"
+  // would read a.csv, another file than the one written.
+  if (const auto nul = e.file.find('\0'); nul != std::string::npos) {
+    FailAt(name, file->source(),
+           fmt::format("experiment {}: file contains a NUL byte (\\u0000 at character {}); a path cannot hold one",
+                       number, nul + 1));
+  }
   const std::filesystem::path file_path(e.file);
   e.resolved_file = file_path.is_absolute() || base.empty() ? e.file : (base / file_path).string();
   return e;

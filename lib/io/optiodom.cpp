@@ -12,6 +12,7 @@
 
 #include "core/angles.hpp"
 #include "core/errors.hpp"
+#include "core/plausible_units.hpp"
 #include "io/atomic_write.hpp"
 
 namespace umbmark::io {
@@ -203,15 +204,26 @@ OptiOdomDataset ImportOptiOdom(const std::string& dir, const std::optional<std::
     const auto& v = Require(meta, meta_path, key, idx + 1);
     return ParseNumber(meta_path, v.line, v.values[idx], key.c_str());
   };
+  // A value outside its plausible range (core/plausible_units.hpp: a
+  // negative side, a wheelbase in millimetres) is refused at its cell rather
+  // than written into the campaign.
+  auto plausible = [&](const std::string& key, std::size_t idx, std::string_view range) {
+    const double x = number(key, idx);
+    if (auto why = ImplausibleValue(range, x); !why.empty()) {
+      const auto& v = Require(meta, meta_path, key, idx + 1);
+      throw InputError(meta_path, v.line, v.values[idx].column, fmt::format("{}: {}", key, why));
+    }
+    return x;
+  };
   const double ngear = number("ngear", 0), enc = number("encRes", 0);
-  ds.robot.wheelbase_m = number("Li", 0);
-  ds.robot.wheel_diameter_right_m = number("Di", 0);  // Di = [right, left]
-  ds.robot.wheel_diameter_left_m = number("Di", 1);
+  ds.robot.wheelbase_m = plausible("Li", 0, "wheelbase_m");
+  ds.robot.wheel_diameter_right_m = plausible("Di", 0, "wheel_diameter_right_m");  // Di = [right, left]
+  ds.robot.wheel_diameter_left_m = plausible("Di", 1, "wheel_diameter_left_m");
   ds.robot.ticks_per_rev = ngear * enc;
   if (auto err = ds.robot.Check(); !err.empty()) throw InputError(meta_path, "robot parameters: " + err);
 
   std::optional<double> side;
-  if (auto it = meta.find("L"); it != meta.end() && !it->second.values.empty()) side = number("L", 0);
+  if (auto it = meta.find("L"); it != meta.end() && !it->second.values.empty()) side = plausible("L", 0, "side_m");
   if (auto it = meta.find("N"); it != meta.end() && !it->second.values.empty()) {
     const double n = number("N", 0);
     if (n != static_cast<double>(files.runs.size())) {

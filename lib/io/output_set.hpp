@@ -16,6 +16,19 @@
 //   ... compute ...
 //   outs.Write(o.report, html);                // re-checks, then writes atomically
 //
+// One writer per output set: Check() also takes an exclusive lock on every
+// output (file or folder) before anything is written, held until the
+// OutputSet is destroyed (for the apps: until the process ends). A second
+// umbmark writing any of the same outputs waits for it (up to
+// UMBMARK_LOCK_WAIT_S seconds, default 60), then fails with InputError
+// (exit 1) naming the output; so two imports or calibrates into the same
+// place run one after the other and never leave a mix of their files. The
+// locks are flock(2) locks on files named by a hash of the output's absolute
+// path in $TMPDIR/umbmark-locks (nothing is added beside the outputs),
+// removed by their holder when it is done; the kernel releases a lock when
+// its process ends, however it ends (a SIGKILL leaves an unlocked empty file,
+// reused and removed by the next writer).
+//
 // For outputs whose name is only known later (batch names such as
 // out-run1.svg), Write() checks the name against the inputs and the outputs
 // written so far before writing.
@@ -46,8 +59,15 @@ class OutputSet {
 
   /// Throws InvalidOptions (exit 2) naming the flag and both paths for a
   /// collision or a non-empty folder, InputError (exit 1) for an output that
-  /// cannot be a regular file (device, FIFO, directory, /dev/stdout).
-  void Check() const;
+  /// cannot be a regular file (device, FIFO, directory, /dev/stdout). Then
+  /// takes the writer locks of every output (see above; InputError when
+  /// another process holds one longer than the wait).
+  void Check();
+
+  OutputSet() = default;
+  OutputSet(const OutputSet&) = delete;
+  OutputSet& operator=(const OutputSet&) = delete;
+  ~OutputSet();
 
   /// Checks `path` against the inputs and the other outputs, then writes it
   /// atomically (WriteFileAtomically). `path` "-" writes to stdout.
@@ -60,6 +80,14 @@ class OutputSet {
     std::string target;  ///< after following links (outputs) / absolute (inputs)
   };
   void CheckOutput(const Entry& out, std::size_t self) const;
+  /// Takes the writer lock of `path` (an absolute output path) unless held.
+  void Lock(const std::string& flag, const std::string& path);
+  struct HeldLock {
+    std::string key;   ///< normalised output path
+    std::string file;  ///< the lock file
+    int fd = -1;
+  };
+  std::vector<HeldLock> locks_;
   std::vector<Entry> inputs_;
   std::vector<Entry> outputs_;
   struct Folder {
@@ -72,5 +100,9 @@ class OutputSet {
 /// True when the two paths name the same file (same device and inode, or,
 /// for files that do not exist yet, the same absolute normalised path).
 bool SameFile(const std::string& a, const std::string& b);
+
+/// Seconds a writer waits for another process's lock on one of its outputs
+/// (UMBMARK_LOCK_WAIT_S, a number >= 0; default 60).
+double LockWaitSeconds();
 
 }  // namespace umbmark::io
