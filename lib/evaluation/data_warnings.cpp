@@ -90,6 +90,25 @@ void TrajectoryDataCheck::Add(const TrajectoryRun& run) {
   }
 }
 
+void TrajectoryDataCheck::Merge(const TrajectoryDataCheck& later) {
+  if (later.runs_ == 0) return;
+  if (runs_ == 0) {
+    *this = later;
+    return;
+  }
+  all_same_end_ = all_same_end_ && later.all_same_end_ && std::equal(end_, end_ + 3, later.end_);
+  runs_ += later.runs_;
+  samples_ += later.samples_;
+  gt_samples_ += later.gt_samples_;
+  for (const auto& id : later.still_ids_)
+    if (still_ids_.size() < kExampleIds) still_ids_.push_back(id);
+  for (const auto& id : later.gt_still_ids_)
+    if (gt_still_ids_.size() < kExampleIds) gt_still_ids_.push_back(id);
+  still_ += later.still_;
+  gt_still_wheels_move_ += later.gt_still_wheels_move_;
+  for (const auto& [direction, n] : later.square_runs_) square_runs_[direction] += n;
+}
+
 std::vector<std::string> TrajectoryDataCheck::Warnings(const std::string& what) const {
   std::vector<std::string> w;
   if (runs_ == 0) return w;

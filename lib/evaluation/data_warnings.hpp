@@ -35,6 +35,9 @@ class TrajectoryDataCheck {
   explicit TrajectoryDataCheck(RobotParams robot) : robot_(std::move(robot)) {}
 
   void Add(const TrajectoryRun& run);
+  /// Adds the runs `later` has seen, as if they had been Add()ed here after
+  /// this object's own (a file evaluated in parts, in file order).
+  void Merge(const TrajectoryDataCheck& later);
 
   /// The warnings so far (empty when there is nothing to say); `what` names
   /// the data in the messages (a file or manifest).

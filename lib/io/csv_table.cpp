@@ -196,6 +196,18 @@ CsvReader::CsvReader(InputStream in, std::string name, std::size_t buffer_bytes)
   cells_.resize(header_.size());
 }
 
+CsvReader::CsvReader(InputStream in, std::string name, const CsvReader& header_from, std::size_t first_line)
+    : in_(std::move(in)), name_(std::move(name)) {
+  capacity_ = kDefaultBufferBytes;
+  buf_ = std::make_unique<char[]>(capacity_ + kPadding);
+  bom_checked_ = true;
+  header_line_ = header_from.header_line_;
+  header_text_ = header_from.header_text_;
+  CheckHeader();
+  cells_.resize(header_.size());
+  next_line_ = first_line;
+}
+
 void CsvReader::CheckHeader() {
   // Split, keeping each name's 1-based column (counted once, left to right,
   // so a long header costs linear time).

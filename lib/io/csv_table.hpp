@@ -89,6 +89,10 @@ class CsvReader {
   /// Text in memory, read through the same buffer (in chunks of at most
   /// `max_chunk` bytes when given).
   CsvReader(std::string_view text, std::string name, std::size_t max_chunk = 0, std::size_t buffer_bytes = 0);
+  /// A part of a file that starts at a row boundary: no header of its own,
+  /// `header_from`'s header instead, and `first_line` the file's line number
+  /// of its first byte (messages name the file's lines).
+  CsvReader(InputStream in, std::string name, const CsvReader& header_from, std::size_t first_line);
   CsvReader(const CsvReader&) = delete;
   CsvReader& operator=(const CsvReader&) = delete;
 
@@ -113,6 +117,9 @@ class CsvReader {
   bool HasNoDataRows();
 
   std::size_t line() const { return line_; }
+  /// Byte offset in the input of the next unread byte, and the line number there.
+  std::uint64_t offset() const { return in_.bytes_read() - (len_ - pos_); }
+  std::size_t next_line() const { return next_line_; }
   std::string_view cell(std::size_t i) const { return cells_[i]; }
 
   /// 1-based column (UTF-8 characters) of cell i of the current row.

@@ -53,6 +53,13 @@ InputStream::InputStream(const std::string& path) : name_(path) {
   }
 }
 
+InputStream::InputStream(const std::string& path, std::uint64_t begin, std::uint64_t end) : InputStream(path) {
+  if (!sized_ || begin > end || end > size_) throw InputError(path, "cannot read a part of it: not a regular file");
+  if (::lseek(fd_, static_cast<off_t>(begin), SEEK_SET) < 0)
+    throw InputError(path, fmt::format("cannot read: {}", ErrnoText(errno)));
+  limit_ = end - begin;
+}
+
 InputStream::InputStream(std::string_view text, std::size_t max_chunk)
     : text_(text), max_chunk_(max_chunk), sized_(true), size_(text.size()) {}
 
@@ -63,7 +70,8 @@ InputStream::InputStream(InputStream&& other) noexcept
       max_chunk_(other.max_chunk_),
       sized_(other.sized_),
       size_(other.size_),
-      bytes_read_(other.bytes_read_) {}
+      bytes_read_(other.bytes_read_),
+      limit_(other.limit_) {}
 
 InputStream::~InputStream() {
   if (fd_ >= 0) ::close(fd_);
@@ -82,6 +90,8 @@ std::size_t InputStream::Read(char* dst, std::size_t n) {
                                         "devices; save it to a file first",
                                         FormatBytes(kMaxStreamBytes)));
   }
+  n = static_cast<std::size_t>(std::min<std::uint64_t>(n, limit_ - bytes_read_));
+  if (n == 0) return 0;
   for (;;) {
     const ssize_t got = ::read(fd_, dst, n);
     if (got < 0) {

@@ -41,6 +41,9 @@ class InputStream {
   /// Opens `path` for reading. Throws InputError(path, reason) when it cannot
   /// be opened or is a directory.
   explicit InputStream(const std::string& path);
+  /// The bytes [begin, end) of the regular file `path` (a part of a large
+  /// file read by one of several threads).
+  InputStream(const std::string& path, std::uint64_t begin, std::uint64_t end);
   /// Text in memory (not copied: it must outlive the stream); Read() hands
   /// out at most `max_chunk` bytes per call (0 = no limit).
   InputStream(std::string_view text, std::size_t max_chunk = 0);
@@ -70,6 +73,7 @@ class InputStream {
   bool sized_ = false;
   std::uint64_t size_ = 0;
   std::uint64_t bytes_read_ = 0;
+  std::uint64_t limit_ = UINT64_MAX;  ///< bytes Read() hands out at most (a range)
 };
 
 /// Reads a whole text file of at most `max_bytes` (regular or not). Throws

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <unordered_map>
@@ -234,6 +235,87 @@ void TrajectoryReader::State::AddRow() {
 
 TrajectoryReader::TrajectoryReader(std::unique_ptr<detail::CsvReader> csv)
     : state_(std::make_unique<State>(std::move(csv))) {}
+
+TrajectoryReader::TrajectoryReader(const TrajectoryReader& header_from, std::uint64_t begin, std::uint64_t end,
+                                   std::size_t first_line)
+    : TrajectoryReader(std::make_unique<CsvReader>(detail::InputStream(header_from.path(), begin, end),
+                                                   header_from.path(), *header_from.state_->csv, first_line)) {}
+
+std::vector<std::string> TrajectoryReader::RunIds() const {
+  std::vector<std::string> out;
+  out.reserve(state_->finished.size());
+  for (const auto& [id, line] : state_->finished) out.push_back(id);
+  return out;
+}
+
+std::size_t TrajectoryReader::run_column() const { return state_->c_run->index; }
+std::uint64_t TrajectoryReader::offset() const { return state_->csv->offset(); }
+std::size_t TrajectoryReader::next_line() const { return state_->csv->next_line(); }
+
+namespace {
+/// [b, e) without blanks and a trailing \r.
+std::string_view TrimRow(const char* b, const char* e) {
+  while (e > b && (e[-1] == '\r' || e[-1] == ' ' || e[-1] == '\t')) --e;
+  while (b < e && (*b == ' ' || *b == '\t')) ++b;
+  return std::string_view(b, static_cast<std::size_t>(e - b));
+}
+
+/// Cell `column` of the row [b, e) (no quotes in it), or nullopt.
+std::optional<std::string_view> CellOf(const char* b, const char* e, std::size_t column) {
+  for (std::size_t k = 0; k < column; ++k) {
+    const auto* comma = static_cast<const char*>(std::memchr(b, ',', static_cast<std::size_t>(e - b)));
+    if (comma == nullptr) return std::nullopt;
+    b = comma + 1;
+  }
+  const auto* comma = static_cast<const char*>(std::memchr(b, ',', static_cast<std::size_t>(e - b)));
+  return TrimRow(b, comma != nullptr ? comma : e);
+}
+}  // namespace
+
+std::optional<std::uint64_t> FindRunBoundary(const std::string& path, std::uint64_t target, std::size_t run_column) {
+  constexpr std::uint64_t kWindow = std::uint64_t{8} << 20;
+  detail::InputStream probe(path);
+  if (!probe.sized() || target == 0 || target >= probe.size()) return std::nullopt;
+  const std::uint64_t end = std::min(probe.size(), target + kWindow);
+  detail::InputStream in(path, target - 1, end);  // from the byte before: a row may start at target
+  std::string window(static_cast<std::size_t>(end - target + 1), '\0');
+  std::size_t got = 0;
+  while (got < window.size()) {
+    const std::size_t n = in.Read(window.data() + got, window.size() - got);
+    if (n == 0) break;
+    got += n;
+  }
+  window.resize(got);
+  if (window.find('"') != std::string::npos) return std::nullopt;
+  std::size_t pos = window.find('\n');  // the first row that starts at or after target
+  std::optional<std::string_view> previous;
+  while (pos != std::string::npos && pos + 1 < window.size()) {
+    const std::size_t b = pos + 1;
+    const std::size_t e = window.find('\n', b);
+    if (e == std::string::npos) break;  // the last row may be cut by the window
+    const std::string_view row = TrimRow(window.data() + b, window.data() + e);
+    if (!row.empty() && row.front() != '#') {
+      const auto id = CellOf(window.data() + b, window.data() + e, run_column);
+      if (!id) return std::nullopt;
+      if (previous && *id != *previous) return target - 1 + b;
+      previous = id;
+    }
+    pos = e;
+  }
+  return std::nullopt;
+}
+
+std::size_t LineAtOffset(const std::string& path, std::uint64_t offset) {
+  detail::InputStream in(path, 0, offset);
+  std::vector<char> buf(std::size_t{1} << 20);
+  std::size_t lines = 1;
+  for (;;) {
+    const std::size_t n = in.Read(buf.data(), buf.size());
+    if (n == 0) break;
+    lines += static_cast<std::size_t>(std::count(buf.data(), buf.data() + n, '\n'));
+  }
+  return lines;
+}
 
 TrajectoryReader::TrajectoryReader(const std::string& path)
     : TrajectoryReader(std::make_unique<CsvReader>(detail::InputStream(path), path)) {}

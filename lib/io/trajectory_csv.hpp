@@ -14,9 +14,12 @@
 // after another run: an error naming both lines).
 #pragma once
 
+#include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "core/runs.hpp"
 
@@ -48,6 +51,11 @@ class TrajectoryReader {
                    std::size_t buffer_bytes = 0);
   /// Continues from a tokenizer whose header has been read (ReadRunFile).
   explicit TrajectoryReader(std::unique_ptr<detail::CsvReader> csv);
+  /// The bytes [begin, end) of the file `header_from` reads, a part that
+  /// starts at a run boundary (FindRunBoundary), with `header_from`'s header;
+  /// `first_line` is the file's line number at `begin`.
+  TrajectoryReader(const TrajectoryReader& header_from, std::uint64_t begin, std::uint64_t end,
+                   std::size_t first_line);
   ~TrajectoryReader();
   TrajectoryReader(TrajectoryReader&&) noexcept;
   TrajectoryReader& operator=(TrajectoryReader&&) noexcept;
@@ -64,10 +72,29 @@ class TrajectoryReader {
   /// Reads every remaining run.
   TrajectoryData ReadAll();
 
+  /// The ids of the runs handed out so far.
+  std::vector<std::string> RunIds() const;
+  /// Index of the run column in each row.
+  std::size_t run_column() const;
+  /// Byte offset of the next unread row (after the header: where the data
+  /// start) and its line number.
+  std::uint64_t offset() const;
+  std::size_t next_line() const;
+
  private:
   struct State;
   std::unique_ptr<State> state_;
 };
+
+/// Where a trajectory CSV file may be cut into parts read in parallel: the
+/// byte offset of the first row at or after `target` whose run id differs
+/// from the row before it (so no run spans the cut), searched within a few
+/// MiB; `run_column` is TrajectoryReader::run_column(). Nullopt when there is
+/// none there or the rows there hold a quote (a quoted cell may span lines).
+std::optional<std::uint64_t> FindRunBoundary(const std::string& path, std::uint64_t target, std::size_t run_column);
+
+/// The line number of byte `offset` of the file (1 + the line breaks before it).
+std::size_t LineAtOffset(const std::string& path, std::uint64_t offset);
 
 /// Reads a whole trajectory CSV file (TrajectoryReader(path).ReadAll()).
 TrajectoryData ReadTrajectoryCsv(const std::string& path);

@@ -1,0 +1,127 @@
+// `evaluate` reads a large trajectory CSV in two parts on two threads
+// (io::FindRunBoundary, TrajectoryReader over a byte range): the parts give
+// exactly the runs (and line numbers) of one sequential read; the whole
+// command gives the same JSON as the sequential path (taken with --plot);
+// a run split across the two parts is still refused with the sequential
+// read's message; a quote near the middle means no cut.
+#include <catch2/catch.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "io/trajectory_csv.hpp"
+#include "support/run_cli.hpp"
+
+namespace fs = std::filesystem;
+using umbmark::testing::Q;
+using umbmark::testing::RunCli;
+using umbmark::testing::Slurp;
+
+namespace {
+
+/// `runs` straight runs of `rows` samples (ticks, ground truth on 4 of 5
+/// samples, a comment line now and then), run ids r1, r2, ...
+std::string Log(int runs, int rows) {
+  std::string out = "# a recorder's log\nrun,direction,t_s,ticks_left,ticks_right,x_gt_m,y_gt_m,theta_gt_rad\n";
+  auto buf = fmt::memory_buffer();
+  for (int r = 1; r <= runs; ++r) {
+    for (int i = 0; i < rows; ++i) {
+      const double x = 0.0004 * i * (1.0 + 0.001 * r);
+      fmt::format_to(std::back_inserter(buf), "r{},{},{:.3f},{},{},", r, r % 2 ? "cw" : "ccw", 0.01 * i, 7 * i,
+                     7 * i + (i * r) / 50);
+      if (i % 5 == 3 && i + 1 < rows)
+        fmt::format_to(std::back_inserter(buf), ",,\n");
+      else
+        fmt::format_to(std::back_inserter(buf), "{:.6f},{:.6f},{:.6f}\n", x, 1e-5 * i * r, 1e-6 * i);
+      if (i == rows / 2 && r % 7 == 0) fmt::format_to(std::back_inserter(buf), "# marker\n");
+    }
+  }
+  out.append(buf.data(), buf.size());
+  return out;
+}
+
+void Put(const fs::path& p, const std::string& s) { std::ofstream(p, std::ios::binary) << s; }
+
+}  // namespace
+
+TEST_CASE("two parts cut at a run boundary read exactly like the whole file", "[io][parts]") {
+  const fs::path dir = umbmark::testing::TempDir("parts");
+  const fs::path file = dir / "log.csv";
+  const std::string text = Log(40, 500);
+  Put(file, text);
+  umbmark::io::TrajectoryReader whole(file.string());
+  const auto cut = umbmark::io::FindRunBoundary(file.string(), text.size() / 2, whole.run_column());
+  REQUIRE(cut.has_value());
+  // The cut is the start of a row whose run differs from the row before.
+  REQUIRE(text[*cut - 1] == '\n');
+  const std::string next = text.substr(*cut, text.find(',', *cut) - *cut);
+  std::size_t prev_start = text.rfind('\n', *cut - 2) + 1;
+  while (text[prev_start] == '#') prev_start = text.rfind('\n', prev_start - 2) + 1;
+  CHECK(next != text.substr(prev_start, text.find(',', prev_start) - prev_start));
+  CHECK(*cut >= text.size() / 2);
+  // Line numbers: 1 + line breaks before the offset.
+  const auto line = umbmark::io::LineAtOffset(file.string(), *cut);
+  CHECK(line == 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<long>(*cut), '\n')));
+
+  umbmark::io::TrajectoryReader first(whole, whole.offset(), *cut, whole.next_line());
+  umbmark::io::TrajectoryReader second(whole, *cut, text.size(), line);
+  umbmark::io::TrajectoryReader sequential(file.string());
+  umbmark::TrajectoryRun a, b;
+  int runs = 0;
+  while (sequential.NextRun(a)) {
+    if (!first.NextRun(b)) REQUIRE(second.NextRun(b));
+    ++runs;
+    INFO("run " << a.run);
+    CHECK(b.run == a.run);
+    CHECK(b.direction == a.direction);
+    CHECK(b.lines == a.lines);
+    CHECK(b.t_s == a.t_s);
+    CHECK(b.ticks_right == a.ticks_right);
+    CHECK(b.gt_y_m.size() == a.gt_y_m.size());
+  }
+  CHECK(runs == 40);
+  CHECK_FALSE(first.NextRun(b));
+  CHECK_FALSE(second.NextRun(b));
+
+  // A quote in the window: no cut.
+  std::string quoted = text;
+  quoted.replace(quoted.find("\nr25,") + 1, 3, "\"r25\"");
+  Put(dir / "quoted.csv", quoted);
+  CHECK_FALSE(umbmark::io::FindRunBoundary((dir / "quoted.csv").string(), quoted.size() / 2, 0).has_value());
+}
+
+TEST_CASE("evaluate on a large file: the parallel parts give the sequential result", "[cli][parts]") {
+  const fs::path dir = umbmark::testing::TempDir("parts-cli");
+  Put(dir / "robot.toml", "wheelbase_m = 0.34\nwheel_diameter_left_m = 0.1524\nwheel_diameter_right_m = 0.1524\n"
+                          "ticks_per_rev = 2048\n");
+  const std::string text = Log(140, 5000);  // about 34 MB: above the 32 MB from which evaluate cuts
+  REQUIRE(text.size() > (std::size_t{32} << 20));
+  Put(dir / "log.csv", text);
+  const std::string base = "evaluate " + Q(dir / "log.csv") + " --robot " + Q(dir / "robot.toml");
+  const auto parts = RunCli(base + " --json -");
+  const auto sequential = RunCli(base + " --json - --plot " + Q(dir / "p.svg"));  // --plot: one pass
+  INFO(parts.err << sequential.err);
+  REQUIRE(parts.status == 0);
+  REQUIRE(sequential.status == 0);
+  auto a = nlohmann::json::parse(parts.out), b = nlohmann::json::parse(sequential.out);
+  CHECK(a["runs"].size() == 140);
+  CHECK(a["runs"] == b["runs"]);
+  CHECK(a["summary"] == b["summary"]);
+  CHECK(a["warnings"] == b["warnings"]);
+
+  // Run r3 comes back at the very end (in the second part): the sequential message, naming the line.
+  std::string split = text;
+  const std::size_t r3 = split.find("\nr3,") + 1;
+  split += split.substr(r3, split.find('\n', r3) + 1 - r3);
+  Put(dir / "log.csv", split);
+  const auto bad = RunCli(base);
+  const auto bad_sequential = RunCli(base + " --plot " + Q(dir / "p.svg"));
+  CHECK(bad.status == 1);
+  CHECK_THAT(bad.err, Catch::Contains("run 'r3' appears again after run 'r140'"));
+  CHECK(bad.err == bad_sequential.err);
+}
