@@ -232,6 +232,76 @@ RobotParams CalibrateWrites(const io::OptiOdomDataset& ds, bool refine, const st
   return m ? m->parameters : r.umbmark.corrected;
 }
 
+/// --sessions, second part: what `calibrate` recommends when the input
+/// itself holds several sessions or other shapes, tested on 25 June
+/// sessions it did not see. (a) The square sessions recorded with the same
+/// robot parameters pooled (leave-one-session-out); (b) each square session with one circle session
+/// as unseen paths (unseen_paths), tested on the 9 other 25 June sessions.
+void SelectionSchemes(const std::vector<io::OptiOdomDataset>& sets) {
+  auto input = [](const io::OptiOdomDataset& ds) {
+    return InputFromTrajectories(ds.runs, ds.robot, ds.experiment.side_m, Integrator::kArc, ds.id);
+  };
+  auto tested = [&](const RobotParams& p, const std::vector<std::size_t>& skip) {
+    double sum = 0.0;
+    int n = 0;
+    for (std::size_t t = 0; t < sets.size(); ++t) {
+      if (sets[t].category == "square" || std::find(skip.begin(), skip.end(), t) != skip.end()) continue;
+      sum += Summarise(EvaluateRuns(sets[t].runs, sets[t].id, p, sets[t].robot, Integrator::kArc))
+                 .mean_final_position_error_m;
+      ++n;
+    }
+    return 1e3 * sum / n;
+  };
+  auto report = [&](const std::string& what, const CalibrateInput& in, bool refine,
+                    const std::vector<std::size_t>& skip) {
+    CalibrateJobOptions o;
+    if (refine) o.refine = RefineOptions{};
+    o.keep_classic_on_refine_failure = true;
+    const CalibrateJobResult r = RunCalibrateJob(in, o);
+    const HeldoutComparison h = CompareMethodsHeldout(in, o, r);
+    fmt::print("| {}{} | {} | {} | {:.2f} +- {:.2f} | {:.2f} | {:.2f} | {:.2f} |\n", what, refine ? " --refine" : "",
+               h.scheme, h.recommended, 1e3 * h.expected_error_m, 1e3 * h.expected_error_sem_m,
+               tested(h.Find(h.recommended)->parameters, skip), tested(h.Find("plain_least_squares")->parameters, skip),
+               tested(h.Find("refined")->parameters, skip));
+  };
+  fmt::print("\n| input | scheme | recommended | expected error [mm] | tested: recommended [mm] | plain LS [mm] | "
+             "refined [mm] |\n|---|---|---|---|---|---|---|\n");
+  std::vector<CalibrateInput> squares;
+  std::vector<std::string> tags;
+  std::size_t circle = sets.size();
+  for (std::size_t s = 0; s < sets.size(); ++s) {
+    if (sets[s].category == "square") {
+      squares.push_back(input(sets[s]));
+      tags.push_back(std::to_string(squares.size()));
+    } else if (sets[s].category == "circular" && circle == sets.size()) {
+      circle = s;
+    }
+  }
+  // Pooling needs one recorded robot: the square sessions recorded with the
+  // first one's parameters (230620202042 and 230620202317: 0.2 m, 84 mm).
+  std::vector<CalibrateInput> same;
+  std::vector<std::string> same_tags;
+  for (std::size_t k = 0; k < squares.size(); ++k) {
+    const RobotParams& a = squares[k].recorded;
+    const RobotParams& b = squares.front().recorded;
+    if (a.wheelbase_m == b.wheelbase_m && a.wheel_diameter_left_m == b.wheel_diameter_left_m &&
+        a.wheel_diameter_right_m == b.wheel_diameter_right_m) {
+      same.push_back(squares[k]);
+      same_tags.push_back(tags[k]);
+    }
+  }
+  for (bool refine : {false, true}) {
+    report(fmt::format("{} square sessions pooled", same.size()), PoolInputs(same, same_tags, "pooled"), refine, {});
+  }
+  for (std::size_t k = 0; k < squares.size(); ++k) {
+    CalibrateInput in = squares[k];
+    in.unseen = {sets[circle].runs};
+    for (bool refine : {false, true}) {
+      report(fmt::format("{} + circles {} as unseen", in.label, sets[circle].id), in, refine, {circle});
+    }
+  }
+}
+
 /// --sessions: every recording set of the folder (4 square, 6 circular, 4
 /// ivanjko sessions) calibrates in turn; each calibration is tested on
 /// every OTHER set's runs (mean final position error, odometry from the
@@ -353,6 +423,7 @@ int Sessions(const fs::path& root) {
                cell(c, "square", nullptr), cell(c, "circular", nullptr), cell(c, nullptr, nullptr), better, n,
                1e3 * worst);
   }
+  SelectionSchemes(sets);
   return 0;
 }
 
