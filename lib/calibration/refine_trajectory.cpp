@@ -15,8 +15,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 #include <memory>
 
+#include <ceres/covariance.h>
 #include <ceres/manifold.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
@@ -137,18 +139,38 @@ void FitSessionFrames(std::vector<PreparedRun>* prepared, std::size_t sets, cons
   ceres::Solver::Summary cs;
   ceres::Solve(so, &problem, &cs);
   if (!cs.IsSolutionUsable()) {
-    notes->push_back("session frame error: the joint fit failed (" + cs.message + "); frames taken as exact");
+    notes->push_back("session frame error: the joint fit failed (" + cs.message + "); no frame error assumed");
     return;
   }
   for (std::size_t i = 0; i < prepared->size(); ++i) {
     (*prepared)[i].samples = residuals[i]->CorrectedSamples(frames[(*prepared)[i].set].data());
   }
+  // Standard errors of each frame: Ceres' inverse information scaled by the
+  // residual variance (the solver covariance: a guide, optimistic where
+  // poses along a run are correlated; the parameters' intervals are the
+  // run-clustered ones of the fit that follows, conditional on the frame).
+  std::vector<std::array<double, 3>> se(sets, {0.0, 0.0, 0.0});
+  ceres::Covariance covariance{ceres::Covariance::Options{}};
+  std::vector<std::pair<const double*, const double*>> blocks;
+  for (std::size_t s = 0; s < sets; ++s) {
+    if (runs_of[s] > 0) blocks.emplace_back(frames[s].data(), frames[s].data());
+  }
+  const double dof = static_cast<double>(cs.num_residuals - cs.num_effective_parameters);
+  const bool with_se = dof > 0.0 && covariance.Compute(blocks, &problem);
+  for (std::size_t s = 0; with_se && s < sets; ++s) {
+    double C[9];
+    if (runs_of[s] == 0 || !covariance.GetCovarianceBlock(frames[s].data(), frames[s].data(), C)) continue;
+    for (int i = 0; i < 3; ++i) se[s][static_cast<std::size_t>(i)] = std::sqrt(std::max(0.0, C[4 * i] * 2.0 * cs.final_cost / dof));
+  }
   for (std::size_t s = 0; s < sets; ++s) {
     if (runs_of[s] == 0) continue;
     notes->push_back(fmt::format(
         "session frame error of set {} ({} runs), fitted jointly: ground-truth yaw {:+.2f} mrad, origin "
-        "({:+.1f}, {:+.1f}) mm from the axle midpoint; the intervals below are conditional on it",
-        s + 1, runs_of[s], frames[s][0] * 1e3, frames[s][1] * 1e3, frames[s][2] * 1e3));
+        "({:+.1f}, {:+.1f}) mm from the axle midpoint{}; the intervals below are conditional on it",
+        s + 1, runs_of[s], frames[s][0] * 1e3, frames[s][1] * 1e3, frames[s][2] * 1e3,
+        with_se ? fmt::format(" (solver standard errors {:.2f} mrad, {:.1f} and {:.1f} mm)", se[s][0] * 1e3,
+                              se[s][1] * 1e3, se[s][2] * 1e3)
+                : std::string()));
   }
 }
 
