@@ -549,7 +549,7 @@ void PrintText(const FitNoiseOptions& o, const Loaded& data, const FitResult& f,
   if (f.estimate) {
     const SystematicErrors& e = f.systematic;
     fmt::print("  systematic errors estimated jointly: E_d = {:.5f}{}, E_b = {:.5f}{}\n", e.c_R / e.c_L,
-               f.estimate->E_d_determined ? fmt::format(" +- {:.5f} (from the scatter)", f.estimate->E_d_se)
+               f.estimate->E_d_determined ? fmt::format(" +- {:.5f} (from the means and the scatter)", f.estimate->E_d_se)
                                           : std::string(" (from the means; see the warning)"),
                e.E_b,
                f.estimate->E_b_determined ? fmt::format(" +- {:.5f} (from the means)", f.estimate->E_b_se) : "");
@@ -749,7 +749,7 @@ Command SetupFitNoise(CLI::App& parent) {
                   "calibrated robot really drove, so uncorrected systematic errors do not bias k")
       ->check(CLI::ExistingFile);
   app->add_option("--systematic", opts->systematic,
-                  "estimate: estimate E_d (from the scatter) and E_b (from the means) jointly with k, so k is unbiased "
+                  "estimate: estimate E_d (from the means and the scatter) and E_b (from the means) jointly with k, so k is unbiased "
                   "on an uncalibrated robot; none: assume a calibrated robot (the odometry's path). Ignored with --params")
       ->check(CLI::IsMember({"none", "estimate"}))
       ->capture_default_str()

@@ -8,9 +8,9 @@
 # The runs (written once by awk, seed 22): a robot with wheelbase 0.4 m,
 # wheels of 0.1 m, 4096 ticks per revolution, E_d = 1.004, E_b = 1.01;
 # each run drives one arc of 1-2 m (curvature -0.5..0.5 1/m, forward) from
-# rest, the wheels slipping by N(0, k^2 |travel|) (k_L = 0.0008,
-# k_R = 0.0012 m^1/2); the ground truth (0.3 mm, 1 mrad noise) at the start
-# and the end. Directions alternate "a" and "b" (two groups).
+# rest, simulated in 16 pieces in each of which the wheels slip by
+# N(0, k^2 |travel|) (k_L = 0.0008, k_R = 0.0012 m^1/2); the ground truth
+# (0.3 mm, 1 mrad noise) at the start and the end. Directions alternate "a" and "b" (two groups).
 #
 # Usage: bench/fit_noise_scale.sh [BUILD_DIR [N]]   (default build, 1000000)
 set -euo pipefail
@@ -29,17 +29,23 @@ ticks_per_rev = 4096
 EOF
 if [[ ! -s "$OUT/runs.csv" ]]; then
   awk -v n="$N" 'BEGIN {
-    srand(22); pi = 3.141592653589793; b = 0.4; D = 0.1; tpr = 4096
+    srand(22); pi = 3.141592653589793; b = 0.4; D = 0.1; tpr = 4096; m = 16
     Ed = 1.004; Eb = 1.01; kl = 0.0008; kr = 0.0012
     cl = 2 / (Ed + 1); cr = 2 * Ed / (Ed + 1)
     print "run,direction,t_s,ticks_left,ticks_right,x_gt_m,y_gt_m,theta_gt_rad"
     for (i = 1; i <= n; ++i) {
       s = 1 + rand(); kap = rand() - 0.5
       tl = int((s * (1 - kap * b / 2)) / (pi * D) * tpr + 0.5); tr = int((s * (1 + kap * b / 2)) / (pi * D) * tpr + 0.5)
-      L = cl * tl * pi * D / tpr; R = cr * tr * pi * D / tpr
-      L += kl * sqrt(L) * N(); R += kr * sqrt(R) * N()
-      th = (R - L) / (Eb * b); ds = (L + R) / 2
-      if (th * th > 1e-18) { x = ds / th * sin(th); y = ds / th * (1 - cos(th)) } else { x = ds; y = 0 }
+      # The true robot in m pieces, each wheel slipping independently in each.
+      x = 0; y = 0; th = 0
+      for (j = 0; j < m; ++j) {
+        L = cl * tl * pi * D / tpr / m; R = cr * tr * pi * D / tpr / m
+        L += kl * sqrt(L) * N(); R += kr * sqrt(R) * N()
+        dth = (R - L) / (Eb * b); ds = (L + R) / 2
+        if (dth * dth > 1e-18) { x += ds / dth * (sin(th + dth) - sin(th)); y += ds / dth * (cos(th) - cos(th + dth)) }
+        else { x += ds * cos(th); y += ds * sin(th) }
+        th += dth
+      }
       dir = i % 2 ? "a" : "b"
       printf "%d,%s,0,0,0,%.6g,%.6g,%.6g\n", i, dir, 3e-4 * N(), 3e-4 * N(), 1e-3 * N()
       printf "%d,%s,5,%d,%d,%.9g,%.9g,%.9g\n", i, dir, tl, tr, x + 3e-4 * N(), y + 3e-4 * N(), th + 1e-3 * N()

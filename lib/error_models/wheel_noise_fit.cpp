@@ -27,9 +27,12 @@ PoseCovariance MeasurementCovariance(double sigma_xy_m, double sigma_theta_rad, 
 std::string WheelNoiseFitOptions::Check() const {
   if (!(confidence > 0.0 && confidence < 1.0)) return fmt::format("confidence = {} must be in (0, 1)", confidence);
   if (max_iterations < 10) return fmt::format("max_iterations = {} must be >= 10", max_iterations);
+  if (threads < 0) return fmt::format("threads = {} must be >= 0 (0: all hardware threads)", threads);
   if (!(E_d_prior_sigma > 0.0) || !std::isfinite(E_d_prior_sigma))
     return fmt::format("E_d_prior_sigma = {} must be positive and finite", E_d_prior_sigma);
   if (!std::isfinite(E_d_prior_centre)) return fmt::format("E_d_prior_centre = {} must be finite", E_d_prior_centre);
+  if (start && !start->allFinite())
+    return fmt::format("start = ({}, {}, {}) must be finite", (*start)(0), (*start)(1), (*start)(2));
   return {};
 }
 
@@ -105,6 +108,8 @@ void GoodnessOfFit(const LikelihoodModel& model, const Eigen::Vector3d& theta, W
   std::array<int, 6> cnt{};
   std::array<std::vector<int>, 6> groups_seen;
   const std::vector<Eigen::Vector3d>& mu = out.group_means;
+  out.residuals.reserve(runs.size());
+  out.predicted_run_covariance.reserve(runs.size());
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const WheelNoiseFitRun& r = runs[i];
     const PoseCovariance S = noise_fit::RunCovariance(model, i, qL, qR, eps);
@@ -166,13 +171,17 @@ WheelNoiseFitSummary FitWheelNoise(const std::vector<WheelNoiseFitRun>& runs, co
   CheckIdentifiable(runs, grp, options.sources);
   LikelihoodModel model{&runs, &grp, E_d_sensitivity, options.restricted, options.E_d_prior_centre,
                         options.E_d_prior_sigma};
+  model.threads = options.threads;
   // 2. Maximum likelihood from the method-of-moments start.
   const Eigen::Vector2d start = StartingPoint(runs, grp);
   Eigen::Vector3d theta0(start(0), start(1), 0.0);  // eps = 0: the value the bases were built at
-  if (!noise_fit::Evaluate(model, theta0).ok)
-    throw QualityGateError("fit-noise: the starting point has a singular run covariance");
   ProgressCounter progress(options.progress, options.intervals ? 3.0 : 1.0);
-  const Optimum best = noise_fit::Minimise(model, theta0, {true, true, true}, options.max_iterations);
+  Optimum best;
+  if (options.start) best = noise_fit::Minimise(model, *options.start, {true, true, true}, options.max_iterations);
+  if (!best.ok) {  // no warm start, or a singular run covariance there
+    best = noise_fit::Minimise(model, theta0, {true, true, true}, options.max_iterations);
+    if (!best.ok) throw QualityGateError("fit-noise: the starting point has a singular run covariance");
+  }
   progress.Add();
   if (!best.ok || !std::isfinite(best.at.nll))
     throw QualityGateError("fit-noise: the maximum-likelihood search failed (a run covariance became singular)");

@@ -36,6 +36,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -113,7 +114,11 @@ PoseCovariance MeasurementCovariance(double sigma_xy_m, double sigma_theta_rad, 
 /// (under 0.001 at the optimum) is far below the noise, and leaving out
 /// their sensitivities saves 430 bytes per run.
 struct WheelNoiseRunSensitivity {
-  CovarianceBasis d1, d2;
+  /// d1, d2 of A_L and A_R in single precision: eps d1 and eps^2 d2 are
+  /// corrections of at most a few % of the basis, so 1e-7 relative is far
+  /// below the noise; half the memory (144 bytes per run).
+  Eigen::Matrix3f d1_L = Eigen::Matrix3f::Zero(), d1_R = Eigen::Matrix3f::Zero();
+  Eigen::Matrix3f d2_L = Eigen::Matrix3f::Zero(), d2_R = Eigen::Matrix3f::Zero();
 };
 
 struct WheelNoiseFitOptions {
@@ -144,6 +149,13 @@ struct WheelNoiseFitOptions {
   /// means give.
   double E_d_prior_centre = 0.0;
   double E_d_prior_sigma = 0.02;
+  /// Warm start (log k_L, log k_R, eps) from an earlier fit of the same
+  /// runs (FitWheelNoiseWithSystematics: the fit without intervals, then the
+  /// one with them); empty: the method-of-moments start.
+  std::optional<Eigen::Vector3d> start;
+  /// Worker threads of the likelihood passes over many runs (more than
+  /// 16384; 0: all hardware threads). The result does not depend on it.
+  int threads = 0;
   /// File names that WheelNoiseFitRun::source indexes; an InputError about
   /// a run names its file and line.
   std::vector<std::string> sources;

@@ -198,12 +198,13 @@ double HeadingSweep(const std::vector<WheelSegment>& travel, double b) {
 // each count with their own prediction.
 SystematicEstimate EstimateSystematicErrorsWithSe(const std::vector<WheelNoiseFitRun>& runs,
                                                   const WheelNoiseFitSummary& fit) {
-  // The runs that can predict their error, with their weights (heading
-  // dropped for runs without it).
+  // The runs that can predict their error; their weights S_i^-1 (heading
+  // dropped for runs without it), computed where used (no per-run copy:
+  // memory with 10^6 runs).
   std::vector<std::size_t> members;
-  std::vector<Eigen::Matrix3d> weight;
-  for (std::size_t i = 0; i < runs.size() && i < fit.predicted_run_covariance.size(); ++i) {
-    if (runs[i].odometry_travel.empty()) continue;
+  for (std::size_t i = 0; i < runs.size() && i < fit.predicted_run_covariance.size(); ++i)
+    if (!runs[i].odometry_travel.empty()) members.push_back(i);
+  auto weight = [&](std::size_t i) {
     Eigen::Matrix3d W = Eigen::Matrix3d::Zero();
     const PoseCovariance& S = fit.predicted_run_covariance[i];
     if (runs[i].has_theta) {
@@ -211,9 +212,8 @@ SystematicEstimate EstimateSystematicErrorsWithSe(const std::vector<WheelNoiseFi
     } else {
       W.topLeftCorner<2, 2>() = S.topLeftCorner<2, 2>().inverse();
     }
-    members.push_back(i);
-    weight.push_back(W);
-  }
+    return W;
+  };
   constexpr double kPriorSigma = 0.05;
   SystematicEstimate out;
   for (const WheelNoiseFitRun& r : runs)
@@ -233,8 +233,8 @@ SystematicEstimate EstimateSystematicErrorsWithSe(const std::vector<WheelNoiseFi
   for (int it = 0; it < 20; ++it) {
     Eigen::Matrix3d H = Eigen::Matrix3d::Identity() / (kPriorSigma * kPriorSigma);
     Eigen::Vector3d grad = (x - Eigen::Vector3d::Ones()) / (kPriorSigma * kPriorSigma);
-    for (std::size_t m = 0; m < members.size(); ++m) {
-      const std::size_t i = members[m];
+    for (const std::size_t i : members) {
+      const Eigen::Matrix3d W = weight(i);
       Eigen::Vector3d r = predict(i, x) - runs[i].error;
       r(2) = WrapAngle(r(2));
       Eigen::Matrix3d J;
@@ -245,14 +245,14 @@ SystematicEstimate EstimateSystematicErrorsWithSe(const std::vector<WheelNoiseFi
         xm(k) -= h;
         J.col(k) = (predict(i, xp) - predict(i, xm)) / (2.0 * h);
       }
-      H += J.transpose() * weight[m] * J;
-      grad += J.transpose() * weight[m] * r;
+      H += J.transpose() * W * J;
+      grad += J.transpose() * W * r;
     }
     const Eigen::Vector3d step = H.ldlt().solve(grad);
     x -= step;
     H_last = H;
     if (!x.allFinite()) return {};
-    if (step.norm() < 1e-10) break;
+    if (step.norm() < 1e-9) break;  // far below any standard error of x (1e-6 with 10^6 runs)
   }
   out.value = {x(0), x(1), x(2)};
   // Posterior standard deviations: near the prior's, the runs do not show it.
@@ -281,13 +281,18 @@ std::vector<WheelNoiseRunSensitivity> Sensitivities(const std::vector<WheelNoise
     side.recorded_wheelbase_m = c.recorded_wheelbase_m;
     side.kelly_basis = c.kelly_basis;
     side.with_second_order = false;  // only the first-order bases move (WheelNoiseRunSensitivity)
+    PoseCovariance d1L = PoseCovariance::Zero(), d1R = d1L, d2L = d1L, d2R = d1L;
     for (const double sign : {-1.0, 1.0}) {
       RebuildNoiseRun(side, sign < 0.0 ? lo : hi);
-      d.d1.A_L += sign / (2.0 * h) * side.basis.A_L;  // (f+ - f-) / 2h
-      d.d1.A_R += sign / (2.0 * h) * side.basis.A_R;
-      d.d2.A_L += (side.basis.A_L - c.basis.A_L) / (2.0 * h * h);  // (f+ - 2 f0 + f-) / 2h^2
-      d.d2.A_R += (side.basis.A_R - c.basis.A_R) / (2.0 * h * h);
+      d1L += sign / (2.0 * h) * side.basis.A_L;  // (f+ - f-) / 2h
+      d1R += sign / (2.0 * h) * side.basis.A_R;
+      d2L += (side.basis.A_L - c.basis.A_L) / (2.0 * h * h);  // (f+ - 2 f0 + f-) / 2h^2
+      d2R += (side.basis.A_R - c.basis.A_R) / (2.0 * h * h);
     }
+    d.d1_L = d1L.cast<float>();
+    d.d1_R = d1R.cast<float>();
+    d.d2_L = d2L.cast<float>();
+    d.d2_R = d2R.cast<float>();
   }
   return s;
 }
@@ -327,7 +332,7 @@ WheelNoiseFitSummary FitWheelNoiseWithSystematics(std::vector<WheelNoiseFitRun>&
     // the means leave it open (a path that retraces itself).
     o.E_d_prior_centre = E_means - E0;
     o.E_d_prior_sigma = std::min(options.E_d_prior_sigma, std::max(from_means.E_d_se_means, 1e-6));
-    const WheelNoiseFitSummary f = FitWheelNoise(runs, o, &sens);
+    WheelNoiseFitSummary f = FitWheelNoise(runs, o, &sens);
     if (std::abs(E0 + f.E_d_offset - E_means) > kMaxJointEdShift) {
       determined = false;  // keep the means' E_d (see SystematicEstimate::E_d_determined)
       E0 = E_means;
@@ -339,6 +344,11 @@ WheelNoiseFitSummary FitWheelNoiseWithSystematics(std::vector<WheelNoiseFitRun>&
     }
     o.intervals = options.intervals;
     o.progress = options.progress;
+    if (f.k_L > 0.0 && f.k_R > 0.0) o.start = Eigen::Vector3d(std::log(f.k_L), std::log(f.k_R), f.E_d_offset);
+    if (options.intervals) {  // f's per-run vectors are not needed by the final fit (memory with 10^6 runs)
+      std::vector<Eigen::Vector3d>().swap(f.residuals);
+      std::vector<PoseCovariance>().swap(f.predicted_run_covariance);
+    }
     out = options.intervals ? FitWheelNoise(runs, o, &sens) : f;
     out.likelihood_passes += options.intervals ? f.likelihood_passes : 0;
     break;

@@ -9,6 +9,8 @@
 
 #include <Eigen/Dense>
 
+#include "core/parallel_for.hpp"
+
 namespace umbmark::noise_fit {
 
 namespace {
@@ -16,6 +18,10 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 /// log k below which a free k counts as having reached its boundary 0.
 constexpr double kBoundaryLog = -40.0;
+/// Twice the predicted decrease below which a profile's minimisation stops:
+/// the interval search needs the profile NLL to 1e-4 (2e-4 on its signed
+/// root near 2), and a Newton step below 1e-6 leaves an error of ~1e-12.
+constexpr double kProfileDecrement = 1e-6;
 
 using Bases = std::array<const PoseCovariance*, 5>;
 
@@ -33,11 +39,12 @@ void BasesAt(const LikelihoodModel& m, std::size_t i, double eps, std::array<Pos
     return;
   }
   const WheelNoiseRunSensitivity& s = (*m.sensitivity)[i];
-  const std::array<const PoseCovariance*, 2> b1{&s.d1.A_L, &s.d1.A_R}, b2{&s.d2.A_L, &s.d2.A_R};
+  const std::array<PoseCovariance, 2> b1{s.d1_L.cast<double>(), s.d1_R.cast<double>()};
+  const std::array<PoseCovariance, 2> b2{s.d2_L.cast<double>(), s.d2_R.cast<double>()};
   for (std::size_t k = 0; k < 5; ++k) {
     if (k < 2) {
-      B[k] = *b0[k] + eps * *b1[k] + (eps * eps) * *b2[k];
-      if (dB) (*dB)[k] = *b1[k] + (2.0 * eps) * *b2[k];
+      B[k] = *b0[k] + eps * b1[k] + (eps * eps) * b2[k];
+      if (dB) (*dB)[k] = b1[k] + (2.0 * eps) * b2[k];
     } else {  // second-order terms: fixed at E_d0 (WheelNoiseRunSensitivity)
       B[k] = *b0[k];
       if (dB) (*dB)[k].setZero();
@@ -106,13 +113,25 @@ PoseCovariance RunCovariance(const LikelihoodModel& m, std::size_t i, double qL,
   return S;
 }
 
-// One pass, storing nothing per run: with d_i = e_i - c_g (c_g the group's
-// centre), b_g = sum S_i^-1 d_i and W_g = sum S_i^-1,
-//   sum_i (d_i - m_g)^T S_i^-1 (d_i - m_g) = sum_i d_i^T S_i^-1 d_i - b_g^T m_g
-// at the GLS mean m_g = W_g^-1 b_g; the derivatives follow from
-// dS^-1 = -S^-1 dS S^-1 and, for the profiled means, the envelope theorem.
-Evaluation Evaluate(const LikelihoodModel& m, const Eigen::Vector3d& theta, std::vector<Eigen::Vector3d>* means) {
-  ++m.passes;
+namespace {
+
+/// The per-run sums of one pass over runs [begin, end): the NLL terms,
+/// gradient and information terms and the groups' sums.
+struct PassSums {
+  bool ok = true;
+  double total = 0.0;
+  Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+  std::vector<GroupSums> groups;
+};
+
+/// Runs per block of a parallel pass; a pass over fewer runs is one block.
+/// The blocks depend on the run count only, and their sums are added in
+/// block order, so the result does not depend on the threads.
+constexpr std::size_t kPassBlock = 1 << 14;
+
+void AccumulateRuns(const LikelihoodModel& m, const Eigen::Vector3d& theta, std::size_t begin, std::size_t end,
+                    PassSums& out) {
   const std::vector<WheelNoiseFitRun>& runs = *m.runs;
   const Grouping& grp = *m.groups;
   const int P = m.Dimension();
@@ -122,36 +141,44 @@ Evaluation Evaluate(const LikelihoodModel& m, const Eigen::Vector3d& theta, std:
   // d c / d log k_L and d c / d log k_R.
   const std::array<std::array<double, 5>, 2> dc{{{2.0 * qL, 0.0, 4.0 * qL * qL, 2.0 * qL * qR, 0.0},
                                                  {0.0, 2.0 * qR, 0.0, 2.0 * qL * qR, 4.0 * qR * qR}}};
-  std::vector<GroupSums> sums(grp.names.size());
-  Evaluation ev;
-  double total = 0.0;
-  std::array<PoseCovariance, 5> B, dB;
+  out.groups.assign(grp.names.size(), GroupSums{});
   std::array<Eigen::Matrix3d, 3> D, E;
-  for (std::size_t i = 0; i < runs.size(); ++i) {
+  for (std::size_t i = begin; i < end; ++i) {
     const WheelNoiseFitRun& r = runs[i];
-    BasesAt(m, i, eps, B, &dB);
-    PoseCovariance S = r.measurement;
-    for (int j = 0; j < P; ++j) D[static_cast<std::size_t>(j)].setZero();
-    for (std::size_t k = 0; k < 5; ++k) {
-      S += c[k] * B[k];
-      D[0] += dc[0][k] * B[k];
-      D[1] += dc[1][k] * B[k];
-      if (P == 3) D[2] += c[k] * dB[k];
+    // S and its derivatives straight from the stored bases (no copies: this
+    // loop is most of fit-noise's time with many runs). The first-order
+    // bases move with eps (WheelNoiseRunSensitivity), the second-order ones
+    // do not.
+    PoseCovariance A_L = r.basis.A_L, A_R = r.basis.A_R;
+    if (P == 3) {
+      const WheelNoiseRunSensitivity& sn = (*m.sensitivity)[i];
+      const PoseCovariance d1L = sn.d1_L.cast<double>(), d1R = sn.d1_R.cast<double>();
+      const PoseCovariance d2L = sn.d2_L.cast<double>(), d2R = sn.d2_R.cast<double>();
+      A_L += eps * d1L + (eps * eps) * d2L;
+      A_R += eps * d1R + (eps * eps) * d2R;
+      D[2] = c[0] * (d1L + (2.0 * eps) * d2L) + c[1] * (d1R + (2.0 * eps) * d2R);
     }
+    const SecondOrderTerms& q = r.second_order;
+    const PoseCovariance S = r.measurement + c[0] * A_L + c[1] * A_R + c[2] * q.LL + c[3] * q.LR + c[4] * q.RR;
+    D[0] = dc[0][0] * A_L + dc[0][2] * q.LL + dc[0][3] * q.LR;
+    D[1] = dc[1][1] * A_R + dc[1][3] * q.LR + dc[1][4] * q.RR;
     Eigen::Matrix3d Si;
     double logdet = 0.0;
-    if (!InverseAndLogDet(S, r.has_theta, Si, logdet)) return ev;
+    if (!InverseAndLogDet(S, r.has_theta, Si, logdet)) {
+      out.ok = false;
+      return;
+    }
     const auto g = static_cast<std::size_t>(grp.of_run[i]);
     const Eigen::Vector3d d = r.error - r.systematic - grp.centre[g];  // d(2) meets only zeros of Si without etheta
     const Eigen::Vector3d Sd = Si * d;
-    GroupSums& gs = sums[g];
+    GroupSums& gs = out.groups[g];
     gs.W += Si;
     gs.b += Sd;
-    total += 0.5 * (d.dot(Sd) + logdet);
+    out.total += 0.5 * (d.dot(Sd) + logdet);
     for (int j = 0; j < P; ++j) {
       const auto u = static_cast<std::size_t>(j);
       E[u] = Si * D[u];
-      ev.gradient(j) += 0.5 * (E[u].trace() - Sd.dot(D[u] * Sd));
+      out.gradient(j) += 0.5 * (E[u].trace() - Sd.dot(D[u] * Sd));
       const Eigen::Matrix3d SiDSi = E[u] * Si;
       gs.dW[u] -= SiDSi;
       gs.db[u] -= SiDSi * d;
@@ -159,9 +186,47 @@ Evaluation Evaluate(const LikelihoodModel& m, const Eigen::Vector3d& theta, std:
     for (int j = 0; j < P; ++j)
       for (int k = j; k < P; ++k) {
         const double v = 0.5 * E[static_cast<std::size_t>(j)].cwiseProduct(E[static_cast<std::size_t>(k)].transpose()).sum();
-        ev.information(j, k) += v;
-        if (k != j) ev.information(k, j) += v;
+        out.information(j, k) += v;
+        if (k != j) out.information(k, j) += v;
       }
+  }
+}
+
+}  // namespace
+
+// One pass, storing nothing per run: with d_i = e_i - c_g (c_g the group's
+// centre), b_g = sum S_i^-1 d_i and W_g = sum S_i^-1,
+//   sum_i (d_i - m_g)^T S_i^-1 (d_i - m_g) = sum_i d_i^T S_i^-1 d_i - b_g^T m_g
+// at the GLS mean m_g = W_g^-1 b_g; the derivatives follow from
+// dS^-1 = -S^-1 dS S^-1 and, for the profiled means, the envelope theorem.
+// The runs are summed in blocks (in parallel with m.threads).
+Evaluation Evaluate(const LikelihoodModel& m, const Eigen::Vector3d& theta, std::vector<Eigen::Vector3d>* means) {
+  ++m.passes;
+  const std::vector<WheelNoiseFitRun>& runs = *m.runs;
+  const Grouping& grp = *m.groups;
+  const int P = m.Dimension();
+  const double eps = P == 3 ? theta(2) : 0.0;
+  const std::size_t blocks = (runs.size() + kPassBlock - 1) / kPassBlock;
+  std::vector<PassSums> part(std::max<std::size_t>(blocks, 1));
+  ParallelFor(blocks > 1 ? ResolveThreads(m.threads) : 1, part.size(), [&](std::size_t k) {
+    AccumulateRuns(m, theta, k * kPassBlock, std::min(runs.size(), (k + 1) * kPassBlock), part[k]);
+  });
+  Evaluation ev;
+  double total = 0.0;
+  std::vector<GroupSums> sums(grp.names.size());
+  for (const PassSums& p : part) {
+    if (!p.ok) return ev;
+    total += p.total;
+    ev.gradient += p.gradient;
+    ev.information += p.information;
+    for (std::size_t g = 0; g < sums.size(); ++g) {
+      sums[g].W += p.groups[g].W;
+      sums[g].b += p.groups[g].b;
+      for (std::size_t u = 0; u < 3; ++u) {
+        sums[g].dW[u] += p.groups[g].dW[u];
+        sums[g].db[u] += p.groups[g].db[u];
+      }
+    }
   }
   if (means) means->assign(grp.names.size(), Eigen::Vector3d::Zero());
   for (std::size_t g = 0; g < grp.names.size(); ++g) {
@@ -197,7 +262,7 @@ Evaluation Evaluate(const LikelihoodModel& m, const Eigen::Vector3d& theta, std:
 }
 
 Optimum Minimise(const LikelihoodModel& m, Eigen::Vector3d start, const std::array<bool, 3>& free,
-                 int max_iterations) {
+                 int max_iterations, double min_decrement) {
   Optimum o;
   o.theta = start;
   o.at = Evaluate(m, start);
@@ -225,7 +290,7 @@ Optimum Minimise(const LikelihoodModel& m, Eigen::Vector3d start, const std::arr
     // rounding with 10^6 runs, and far inside the interval search's
     // tolerance (2e-4 on the signed root, about 4e-4 in NLL).
     const double decrement = -g.dot(step);
-    if (!(decrement > 1e-7)) break;
+    if (!(decrement > min_decrement)) break;
     // Trust caps: a factor e^3 in k, 0.01 in E_d per step.
     double scale = 1.0;
     for (Eigen::Index a = 0; a < n; ++a) {
@@ -263,14 +328,39 @@ double IntervalEnd(const LikelihoodModel& m, const Optimum& best, int j, int sid
   if (!std::isfinite(se) || se <= 0.0) se = 1.0;
   se = std::min(se, 5.0);
   Eigen::Vector3d warm = best.theta;
+  // Along the profile the other entries move by about -I_oo^-1 I_oj per unit
+  // of theta_j (the conditional mean of a quadratic NLL): each profile
+  // starts there, a pass or two from its minimum.
+  Eigen::Vector3d ridge = Eigen::Vector3d::Zero();
+  {
+    std::vector<int> other;
+    for (int k = 0; k < P; ++k)
+      if (k != j) other.push_back(k);
+    const auto n = static_cast<Eigen::Index>(other.size());
+    Eigen::MatrixXd Ioo(n, n);
+    Eigen::VectorXd Ioj(n);
+    for (Eigen::Index a = 0; a < n; ++a) {
+      Ioj(a) = I(other[static_cast<std::size_t>(a)], j);
+      for (Eigen::Index b = 0; b < n; ++b) Ioo(a, b) = I(other[static_cast<std::size_t>(a)], other[static_cast<std::size_t>(b)]);
+    }
+    const Eigen::VectorXd slope = -Ioo.ldlt().solve(Ioj);
+    if (slope.allFinite())
+      for (Eigen::Index a = 0; a < n; ++a) ridge(other[static_cast<std::size_t>(a)]) = slope(a);
+  }
   // Signed root r and dr/ds at s = side (log k - log k_hat) >= 0.
   struct Point {
     double r = kInf, drds = std::numeric_limits<double>::quiet_NaN();
   };
   auto profile = [&](double u) {
     Eigen::Vector3d t = warm;
+    if (std::isfinite(u) && std::isfinite(warm(j))) t += (u - warm(j)) * ridge;
     t(j) = u;
-    const Optimum o = Minimise(m, t, free, max_iterations);
+    Optimum o = Minimise(m, t, free, max_iterations, kProfileDecrement);
+    if (!o.ok && t != warm) {  // the prediction left the valid region: from the last profile
+      t = warm;
+      t(j) = u;
+      o = Minimise(m, t, free, max_iterations, kProfileDecrement);
+    }
     Point p;
     if (!o.ok) return p;
     warm = o.theta;
@@ -278,7 +368,11 @@ double IntervalEnd(const LikelihoodModel& m, const Optimum& best, int j, int sid
     p.drds = side * o.at.gradient(j) / std::max(p.r, 1e-12);  // envelope: dP/du is the partial derivative
     return p;
   };
-  if (side < 0 && !(profile(-kInf).r > target)) return 0.0;
+  // Below the optimum, whether the profile at k = 0 stays within delta (the
+  // end is 0) is asked only once a profile short of the target says the end
+  // lies beyond the first guess (with many runs it never does: no pass at
+  // k = 0, whose minimum is also a poor warm start).
+  bool zero_checked = side > 0;
   constexpr double kMaxS = 60.0;  // a factor e^60: unbounded
   double s_in = 0.0, s_out = kInf, s = target * se;
   for (int it = 0; it < 40; ++it) {
@@ -286,6 +380,12 @@ double IntervalEnd(const LikelihoodModel& m, const Optimum& best, int j, int sid
     if (std::isfinite(p.r) && std::abs(p.r - target) < 2e-4) return std::exp(uhat + side * s);
     if (std::isfinite(p.r) && p.r < target) {
       s_in = std::max(s_in, s);
+      if (!zero_checked) {
+        zero_checked = true;
+        const Eigen::Vector3d keep = warm;
+        if (!(profile(-kInf).r > target)) return 0.0;
+        warm = keep;
+      }
     } else {
       s_out = std::min(s_out, s);
     }

@@ -43,6 +43,9 @@ struct LikelihoodModel {
   bool restricted = false;  ///< REML term
   /// Weak Gaussian prior on eps (joint fit): centre and sigma.
   double eps_prior_centre = 0.0, eps_prior_sigma = 0.02;
+  /// Worker threads of a pass over more than 16384 runs (0: all hardware
+  /// threads); the sums do not depend on it.
+  int threads = 0;
   /// Likelihood passes so far (each Evaluate is one).
   mutable int passes = 0;
 
@@ -72,10 +75,11 @@ struct Optimum {
 };
 
 /// Minimum of the NLL over the entries of theta marked free, from `start`,
-/// by Fisher scoring with backtracking (Armijo). A k walking to its
-/// boundary 0 stops once it is below e^-40 m^1/2.
+/// by Fisher scoring with backtracking (Armijo), until twice the predicted
+/// decrease is at most `min_decrement`. A k walking to its boundary 0 stops
+/// once it is below e^-40 m^1/2.
 Optimum Minimise(const LikelihoodModel& m, Eigen::Vector3d start, const std::array<bool, 3>& free,
-                 int max_iterations);
+                 int max_iterations, double min_decrement = 1e-7);
 
 /// One end of the profile-likelihood interval of k_j (j = 0: k_L, 1: k_R):
 /// the k on side +1 (above) or -1 (below) the optimum where the profile
