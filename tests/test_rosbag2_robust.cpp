@@ -163,6 +163,8 @@ TEST_CASE("Wheel encoders: a jump, a stuck joint, one joint twice, velocity only
   CHECK_THAT(jump, Catch::Contains("topic /joint_states, joint left_wheel_joint: position jumps by 6.") &&
                        Catch::Contains("at stamp 1700000011.000000000 (message 221)"));
   CHECK_THAT(ImportError("stuck.mcap"), Catch::Contains("joint right_wheel_joint travels 0 m in all"));
+  CHECK_THAT(ImportError("backwards_joint.mcap"), Catch::Contains("run 1: joint right_wheel_joint travels -3.372 m") &&
+                                                      Catch::Contains("--odometry"));
   CHECK_THAT(ImportError("same_joint.mcap"),
              Catch::Contains("joints left_wheel_joint and right_wheel_joint report the same position in all 1140 messages"));
   CHECK_THAT(ImportError("velocity_only.mcap"), Catch::Contains("velocity[] but no position[]") &&

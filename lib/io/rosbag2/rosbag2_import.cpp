@@ -589,6 +589,23 @@ TrajectoryRun BuildRun(const RecordingData& d, std::size_t a, std::size_t b, boo
   return run;
 }
 
+// In a square both wheels drive forward on every leg: a joint whose travel
+// is negative while the other's is positive runs backwards (its joint axis
+// points the other way), which is neither a swap nor a turn, and is said so.
+void CheckWheelsForward(const TrajectoryRun& run, const Rosbag2ImportOptions& o, const std::string& path,
+                        const RecordingData& d) {
+  if (o.kind != ExperimentKind::kSquare || o.wheels_topic.empty()) return;
+  const double l = run.dist_left_m.back(), r = run.dist_right_m.back();
+  if ((l > 0) == (r > 0) || std::min(std::abs(l), std::abs(r)) < o.side_m) return;
+  const bool left_back = l < 0;
+  throw InputError(path, fmt::format(
+      "run {}: joint {} travels {:+.3f} m while joint {} travels {:+.3f} m around a {} m square: the position of {} falls "
+      "while the robot drives forward (its joint axis points the other way); umbmark takes wheel positions that grow "
+      "when the robot drives forward: import the controller's nav_msgs/msg/Odometry with --odometry instead",
+      run.run, left_back ? d.left_joint : d.right_joint, left_back ? l : r, left_back ? d.right_joint : d.left_joint,
+      left_back ? r : l, o.side_m, left_back ? d.left_joint : d.right_joint));
+}
+
 // What the ground truth says against the wheels, over a recording's runs:
 // wheels turning the other way than the ground truth in most runs (the
 // joints swapped), and ground truth that is the wheel odometry itself.
@@ -685,6 +702,7 @@ Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotPar
       double turn = NAN;
       TrajectoryRun run = BuildRun(d, a, b, choice.gt.has_value(), interp, turn);
       run.run = std::to_string(out.runs.runs.size() + runs.size() + 1);
+      CheckWheelsForward(run, o, path, d);
       if (choice.gt && !run.HasGroundTruth(0))
         out.warnings.push_back(fmt::format("{}: run {} has no ground truth within {} s of its first sample; its ground truth "
                                            "is relative to its first measured pose", path, run.run, o.max_gt_gap_s));

@@ -144,6 +144,7 @@ async function main(outDir) {
   await write("gap.mcap", [JS, MOCAP], sorted(basic(sim, { js: (s) => (s.t >= 8 && s.t < 14 ? null : jointState(s.t, s)) })));
   await write("jump.mcap", [JS, MOCAP], sorted(basic(sim, { js: (s, i) => (i === mid ? pos(s, s.wl + 6, s.wr) : jointState(s.t, s)) })));
   await write("stuck.mcap", [JS, MOCAP], sorted(basic(sim, { js: (s) => pos(s, s.wl, 0.3) })));
+  await write("backwards_joint.mcap", [JS, MOCAP], sorted(basic(sim, { js: (s) => pos(s, s.wl, -s.wr) })));
   await write("same_joint.mcap", [JS, MOCAP], sorted(basic(sim, { js: (s) => pos(s, s.wl, s.wl) })));
   await write("velocity_only.mcap", [JS, MOCAP], sorted(basic(sim, { js: (s) => jointState(s.t, s, { position: [],
     velocity: [0, 1, 1] }) })));
