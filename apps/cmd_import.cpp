@@ -3,6 +3,7 @@
 // trajectory CSV (OUTDIR/runs.csv).
 // `umbmark import rosbag2 BAG... --out OUTDIR ...` does the same for ROS 2
 // recordings (contract section "ROS 2 recordings"); `--list` shows topics.
+#include <cmath>
 #include <filesystem>
 #include <memory>
 
@@ -60,11 +61,14 @@ CampaignPaths CheckImportOutputs(const std::vector<std::string>& inputs, const s
 // interrupted import sees the complete old folder or the complete new one,
 // and with --force no file of the previous campaign stays beside the new ones.
 void WriteImportedCampaign(const RobotParams& robot, const Experiment& experiment, TrajectoryData runs,
-                           const std::string& out, const std::vector<std::string>& comment, bool force) {
+                           const std::string& out, const std::vector<std::string>& comment, bool force,
+                           const std::optional<GroundTruthNoise>& ground_truth = std::nullopt,
+                           const std::vector<io::ManifestKey>& ground_truth_keys = {}) {
   Manifest m;
   m.robot = robot;
   m.experiments.push_back(experiment);
-  io::WriteCampaign(m, {ExperimentData(std::move(runs))}, out, comment, {}, force);
+  m.ground_truth = ground_truth;
+  io::WriteCampaign(m, {ExperimentData(std::move(runs))}, out, comment, {}, force, ground_truth_keys);
 }
 
 int RunImportOptiOdom(const ImportOptions& o) {
@@ -120,11 +124,105 @@ struct Rosbag2Options {
   std::optional<double> side_m, distance_m;
   std::string integrator = "arc";
   std::string time = "header";
+  std::string scan_pose;  ///< --scan-pose X,Y,YAW
   io::rosbag2::Rosbag2ImportOptions import;
   bool force = false;
   RobotFlags robot;
   JsonFlag json;
 };
+
+// --scan-pose X,Y,YAW (metres, metres, radians).
+Pose2 ParseScanPose(const std::string& text) {
+  std::vector<double> v;
+  std::size_t pos = 0;
+  while (pos <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', pos), text.size());
+    const std::string item = text.substr(pos, comma - pos);
+    std::size_t used = 0;
+    double x = 0.0;
+    try {
+      x = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || !std::isfinite(x))
+      throw InvalidOptions(fmt::format("--scan-pose '{}': '{}' is not a number (expected X,Y,YAW in m, m, rad)", text, item));
+    v.push_back(x);
+    pos = comma + 1;
+  }
+  if (v.size() != 3) throw InvalidOptions(fmt::format("--scan-pose '{}': expected three numbers X,Y,YAW (m, m, rad)", text));
+  return {v[0], v[1], v[2]};
+}
+
+// What the lidar and gyro gave: per recording the lidar pose and gyro, per
+// run the registration (readable summary of `import rosbag2 --scan`).
+void PrintScanSummary(const io::rosbag2::Rosbag2Import& r) {
+  if (!r.ground_truth || r.scan.empty()) return;
+  const GroundTruthNoise& g = *r.ground_truth;
+  for (const auto& rec : r.scan) {
+    fmt::print("  lidar {}: {} scans; pose in the robot frame x {:.4f} m, y {:.4f} m, yaw {:.4f} rad ({})\n",
+               rec.scan_frame, rec.scans, rec.mount.x, rec.mount.y, rec.mount.theta, rec.mount_source);
+    if (rec.gyro)
+      fmt::print("  gyro: bias {:.6f} rad/s (+- {:.1e}, {} still readings), scale {:.5f} (measured / true yaw rate)\n",
+                 rec.gyro->bias_rad_s, rec.gyro->bias_sd_rad_s, rec.gyro->still_samples, rec.gyro->scale);
+    for (const auto& run : rec.runs) {
+      const auto& t = run.track;
+      fmt::print("  run {:>3}  scans: {} still before, {} after, {} chained ({} keyframes); end {} the start: "
+                 "x {:+.4f} m, y {:+.4f} m, heading {:+.5f} rad (sd {:.2f} mm, {:.3f} mrad){}\n",
+                 run.run, t.still_before, t.still_after, t.chained, t.keyframes, t.end_direct ? "registered on" : "chained to",
+                 t.end.x, t.end.y, t.end.theta, 1e3 * std::sqrt(0.5 * (t.end_covariance[0] + t.end_covariance[4])),
+                 1e3 * std::sqrt(t.end_covariance[8]),
+                 std::isnan(run.gyro_heading_change_rad) ? std::string()
+                                                         : fmt::format("; gyro {:+.5f} rad", run.gyro_heading_change_rad));
+    }
+  }
+  fmt::print("  ground truth from the scans: noise per pose {:.2f} mm, {:.3f} mrad (in the manifest's [ground_truth])\n",
+             1e3 * g.sigma_xy_m, 1e3 * g.sigma_theta_rad);
+}
+
+nlohmann::json ScanJson(const io::rosbag2::Rosbag2Import& r) {
+  const GroundTruthNoise& g = *r.ground_truth;
+  nlohmann::json j = {{"sigma_xy_m", JsonNumber(g.sigma_xy_m)}, {"sigma_theta_rad", JsonNumber(g.sigma_theta_rad)}};
+  for (const auto& k : io::rosbag2::ScanManifestKeys(r.scan)) {
+    if (const double* v = std::get_if<double>(&k.value)) j[k.key] = JsonNumber(*v);
+    else j[k.key] = std::get<std::string>(k.value);
+  }
+  nlohmann::json recs = nlohmann::json::array();
+  for (const auto& rec : r.scan) {
+    nlohmann::json runs = nlohmann::json::array();
+    for (const auto& run : rec.runs) {
+      const auto& t = run.track;
+      nlohmann::json jr = {{"run", run.run},
+                           {"still_scans_before", t.still_before},
+                           {"still_scans_after", t.still_after},
+                           {"chained_scans", t.chained},
+                           {"keyframes", t.keyframes},
+                           {"end_registered_on_start", t.end_direct},
+                           {"end", {JsonNumber(t.end.x), JsonNumber(t.end.y), JsonNumber(t.end.theta)}},
+                           {"end_sd", {JsonNumber(std::sqrt(t.end_covariance[0])), JsonNumber(std::sqrt(t.end_covariance[4])),
+                                       JsonNumber(std::sqrt(t.end_covariance[8]))}},
+                           {"still_scan_sd_xy_m", JsonNumber(t.still_sd_xy_m)},
+                           {"still_scan_sd_theta_rad", JsonNumber(t.still_sd_theta_rad)},
+                           {"moved_while_still", t.still_moved},
+                           {"max_residual_sd_m", JsonNumber(t.max_residual_sd_m)}};
+      if (!std::isnan(run.gyro_heading_change_rad)) jr["gyro_heading_change_rad"] = JsonNumber(run.gyro_heading_change_rad);
+      runs.push_back(jr);
+    }
+    nlohmann::json jrec = {{"scan_frame", rec.scan_frame},
+                           {"scans", rec.scans},
+                           {"scan_pose", {JsonNumber(rec.mount.x), JsonNumber(rec.mount.y), JsonNumber(rec.mount.theta)}},
+                           {"scan_pose_from", rec.mount_source},
+                           {"runs", runs}};
+    if (rec.gyro) {
+      jrec["gyro_bias_rad_s"] = JsonNumber(rec.gyro->bias_rad_s);
+      jrec["gyro_scale"] = JsonNumber(rec.gyro->scale);
+      jrec["imu_messages"] = rec.imu_messages;
+    }
+    recs.push_back(jrec);
+  }
+  j["recordings"] = recs;
+  return j;
+}
 
 // One topic row of --list, and below a TFMessage topic its frames (parent,
 // rate, whether the odometry frame is in its chain): enough to choose every
@@ -234,6 +332,7 @@ int RunRosbag2(Rosbag2Options o) {
   };
   opt.time = stamp(o.time.substr(0, comma));
   if (comma != std::string::npos) opt.ground_truth_time = stamp(o.time.substr(comma + 1));
+  if (!o.scan_pose.empty()) opt.scan_pose = ParseScanPose(o.scan_pose);
   const RobotParams robot = o.robot.Resolve();
   // The recordings (and every file of a bag folder) are inputs; the two
   // files written must not be one of them or another output.
@@ -245,7 +344,12 @@ int RunRosbag2(Rosbag2Options o) {
       fmt::format("wheels: {} {}; ground truth: {}; time: {}", opt.wheels_topic.empty() ? "--odometry" : "--wheels",
                   opt.wheels_topic.empty() ? opt.odometry_topic : opt.wheels_topic,
                   opt.ground_truth_topic.empty() ? "none" : opt.ground_truth_topic, o.time)};
-  WriteImportedCampaign(robot, result.experiment, result.runs, o.out, comment, o.force);
+  if (!opt.scan_topic.empty()) comment[1] = fmt::format("wheels: {} {}; ground truth: lidar {} (scan registration){}; time: {}",
+                                                        opt.wheels_topic.empty() ? "--odometry" : "--wheels",
+                                                        opt.wheels_topic.empty() ? opt.odometry_topic : opt.wheels_topic,
+                                                        opt.scan_topic, opt.imu_topic.empty() ? "" : ", gyro " + opt.imu_topic, o.time);
+  WriteImportedCampaign(robot, result.experiment, result.runs, o.out, comment, o.force, result.ground_truth,
+                        io::rosbag2::ScanManifestKeys(result.scan));
 
   nlohmann::json recordings = nlohmann::json::array();
   for (const auto& r : result.recordings)
@@ -286,17 +390,20 @@ int RunRosbag2(Rosbag2Options o) {
     for (const auto& r : result.runs.runs)
       fmt::print("  run {:>3}  {:<14} {:>6} samples  t {:8.2f} .. {:8.2f} s  travel L {:7.3f} m  R {:7.3f} m\n", r.run,
                  r.direction, r.size(), r.t_s.front(), r.t_s.back(), r.dist_left_m.back(), r.dist_right_m.back());
+    PrintScanSummary(result);
     for (const auto& w : warnings) fmt::print("warning: {}\n", w);
     fmt::print("  wrote {}\n  wrote {}\nNext: umbmark calibrate {} (squares) or umbmark fit-noise {}\n", manifest_path,
                runs_path, manifest_path, manifest_path);
   }
-  o.json.Emit({{"manifest", manifest_path},
-               {"runs_csv", runs_path},
-               {"robot", JsonParams(robot)},
-               {"experiment", o.experiment},
-               {"recordings", recordings},
-               {"runs", runs},
-               {"warnings", warnings}});
+  nlohmann::json j = {{"manifest", manifest_path},
+                      {"runs_csv", runs_path},
+                      {"robot", JsonParams(robot)},
+                      {"experiment", o.experiment},
+                      {"recordings", recordings},
+                      {"runs", runs},
+                      {"warnings", warnings}};
+  if (!result.scan.empty()) j["ground_truth"] = ScanJson(result);
+  o.json.Emit(j);
   return 0;
 }
 
@@ -338,6 +445,13 @@ Command SetupImport(CLI::App& parent) {
   rb->add_option("--ground-truth", ro->import.ground_truth_topic,
                  "Ground-truth pose topic: PoseStamped, PoseWithCovarianceStamped, Odometry or TFMessage");
   rb->add_option("--ground-truth-frame", ro->import.ground_truth_frame, "TFMessage: the child_frame_id to follow");
+  auto* scan = rb->add_option("--scan", ro->import.scan_topic,
+                              "Ground truth from the robot's lidar instead: sensor_msgs/msg/LaserScan topic (scan registration)");
+  rb->add_option("--scan-pose", ro->scan_pose,
+                 "The lidar's pose in the robot frame X,Y,YAW [m, m, rad] when /tf_static does not give it")->needs(scan);
+  rb->add_option("--imu", ro->import.imu_topic,
+                 "sensor_msgs/msg/Imu topic: gyro bias and scale against the scans, a second heading reference")->needs(scan);
+  scan->excludes(rb->get_option("--ground-truth"));
   rb->add_option("--time", ro->time,
                  "Time stamps: header (header.stamp) or log (receive time), for both streams; or WHEELS,GROUND_TRUTH "
                  "(e.g. header,log: the wheels by header stamp, the ground truth by receive time)")

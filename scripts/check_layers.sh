@@ -4,7 +4,7 @@
 # layers, lowest first (docs/architecture.md):
 #
 #   0 core                          data types, angles, poses, errors
-#   1 stats, kinematics             numerics; wheel travel -> pose
+#   1 stats, kinematics, scan       numerics; wheel travel -> pose; scan registration
 #   2 model                         the true robot and its controller
 #   3 io, error_models, evaluation  files; noise propagation; return errors
 #   4 calibration, simulation       UMBmark + refine; simulators
@@ -18,7 +18,7 @@
 # Usage: check_layers.sh [repo root]   (exit 0 clean, 1 on a violation)
 set -euo pipefail
 root=${1:-$(cd "$(dirname "$0")/.." && pwd)}
-declare -A rank=([core]=0 [stats]=1 [kinematics]=1 [model]=2 [io]=3 [error_models]=3 [evaluation]=3
+declare -A rank=([core]=0 [stats]=1 [kinematics]=1 [scan]=1 [model]=2 [io]=3 [error_models]=3 [evaluation]=3
   [calibration]=4 [simulation]=4 [diagnosis]=5 [apps]=6)
 declare -A io_allowed=([io]=1 [diagnosis]=1 [apps]=1)
 status=0

@@ -94,7 +94,8 @@ std::string FormatTrajectoryCsv(const TrajectoryData& data, const std::vector<st
 // round trip), it sorts keys (an experiment would start with `file`, not
 // `kind`) and it writes no comments. fmt's {} gives the shortest digits
 // that read back bit for bit (test_io_manifest_writer).
-std::string FormatManifest(const Manifest& manifest, const std::vector<std::string>& comment) {
+std::string FormatManifest(const Manifest& manifest, const std::vector<std::string>& comment,
+                           const std::vector<ManifestKey>& ground_truth_keys) {
   std::string out = CommentLines(comment);
   const RobotParams& r = manifest.robot;
   out += "[robot]\n";
@@ -106,6 +107,10 @@ std::string FormatManifest(const Manifest& manifest, const std::vector<std::stri
     out += "\n[ground_truth]\n";
     out += fmt::format("sigma_xy_m = {}\n", manifest.ground_truth->sigma_xy_m);
     out += fmt::format("sigma_theta_rad = {}\n", manifest.ground_truth->sigma_theta_rad);
+    for (const auto& k : ground_truth_keys) {
+      if (const double* v = std::get_if<double>(&k.value)) out += fmt::format("{} = {}\n", k.key, *v);
+      else out += k.key + " = " + TomlString(std::get<std::string>(k.value)) + "\n";
+    }
   }
   for (const auto& e : manifest.experiments) {
     out += "\n[[experiment]]\n";
@@ -130,7 +135,7 @@ std::string FormatEndpointCsv(const EndpointData& data, const std::vector<std::s
 
 std::string WriteCampaign(const Manifest& manifest, const std::vector<ExperimentData>& data, const std::string& dir,
                           const std::vector<std::string>& comment, const std::vector<ExtraFile>& extra_files,
-                          bool replace) {
+                          bool replace, const std::vector<ManifestKey>& ground_truth_keys) {
   namespace fs = std::filesystem;
   if (data.size() != manifest.experiments.size())
     throw InputError(manifest.path, fmt::format("{} experiments but {} data sets to write", manifest.experiments.size(), data.size()));
@@ -169,7 +174,7 @@ std::string WriteCampaign(const Manifest& manifest, const std::vector<Experiment
         WriteFileAtomically(target.string(), FormatEndpointCsv(std::get<EndpointData>(d), comment));
     }
     for (const auto& x : extra_files) WriteFileAtomically((fs::path(staging) / x.name).string(), x.content);
-    WriteFileAtomically((fs::path(staging) / "campaign.toml").string(), FormatManifest(manifest, comment));
+    WriteFileAtomically((fs::path(staging) / "campaign.toml").string(), FormatManifest(manifest, comment, ground_truth_keys));
   } catch (...) {
     DiscardStagingDirectory(staging);
     throw;

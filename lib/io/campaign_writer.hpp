@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "core/runs.hpp"
@@ -15,9 +16,19 @@ namespace umbmark::io {
 /// written as empty cells. `comment` lines are written first, prefixed "# ".
 std::string FormatTrajectoryCsv(const TrajectoryData& data, const std::vector<std::string>& comment = {});
 
+/// A key of the manifest's [ground_truth] beyond the two sigmas that an
+/// importer knows (`import rosbag2 --scan`: source, the lidar's pose, the
+/// gyro; docs/formats.md).
+struct ManifestKey {
+  std::string key;
+  std::variant<double, std::string> value;
+};
+
 /// Campaign manifest TOML text for `manifest` (experiment `file` entries are
-/// written as given, relative to the manifest).
-std::string FormatManifest(const Manifest& manifest, const std::vector<std::string>& comment = {});
+/// written as given, relative to the manifest); `ground_truth_keys` go into
+/// its [ground_truth] table after the sigmas.
+std::string FormatManifest(const Manifest& manifest, const std::vector<std::string>& comment = {},
+                           const std::vector<ManifestKey>& ground_truth_keys = {});
 
 /// Endpoint CSV text (run,direction,ex_m,ey_m,etheta_rad).
 std::string FormatEndpointCsv(const EndpointData& data, const std::vector<std::string>& comment = {});
@@ -39,6 +50,6 @@ struct ExtraFile {
 /// not empty.
 std::string WriteCampaign(const Manifest& manifest, const std::vector<ExperimentData>& data, const std::string& dir,
                           const std::vector<std::string>& comment = {}, const std::vector<ExtraFile>& extra_files = {},
-                          bool replace = false);
+                          bool replace = false, const std::vector<ManifestKey>& ground_truth_keys = {});
 
 }  // namespace umbmark::io

@@ -93,6 +93,19 @@ Experiment ReadExperiment(const toml::table& t, std::size_t number, const std::f
   return e;
 }
 
+// The keys an importer adds to [ground_truth] (`import rosbag2 --scan`,
+// docs/formats.md): checked for their type, not used by the computations.
+void CheckImportedGroundTruthKeys(const toml::table& gt, const std::string& path) {
+  for (const char* key : {"source", "scan_pose_from"})
+    if (const toml::node* n = gt.get(key)) detail::StringValue(*n, key, path);
+  for (const char* key : {"scan_pose_x_m", "scan_pose_y_m", "scan_pose_yaw_rad", "gyro_bias_rad_s", "gyro_scale"}) {
+    if (const toml::node* n = gt.get(key)) {
+      const double v = detail::NumberValue(*n, key, path);
+      if (!std::isfinite(v)) FailAt(path, n->source(), fmt::format("{} = {} must be finite", key, v));
+    }
+  }
+}
+
 }  // namespace
 
 Manifest ParseManifest(std::string_view text, const std::string& path) {
@@ -124,7 +137,10 @@ Manifest ParseManifest(std::string_view text, const std::string& path) {
 
   if (root.contains("ground_truth")) {
     const toml::table& gt = RequireTable(root, "ground_truth", path);
-    detail::RejectUnknownKeys(gt, {"sigma_xy_m", "sigma_theta_rad"}, "[ground_truth]", path);
+    detail::RejectUnknownKeys(gt, {"sigma_xy_m", "sigma_theta_rad", "source", "scan_pose_x_m", "scan_pose_y_m",
+                                   "scan_pose_yaw_rad", "scan_pose_from", "gyro_bias_rad_s", "gyro_scale"},
+                              "[ground_truth]", path);
+    CheckImportedGroundTruthKeys(gt, path);
     GroundTruthNoise noise;
     const struct {
       const char* key;

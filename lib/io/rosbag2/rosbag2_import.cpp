@@ -12,6 +12,7 @@
 #include "core/angles.hpp"
 #include "core/errors.hpp"
 #include "io/rosbag2/messages.hpp"
+#include "io/rosbag2/scan_ground_truth.hpp"
 #include "io/rosbag2/tf_tree.hpp"
 #include "io/rosbag2/wheel_checks.hpp"
 
@@ -534,6 +535,11 @@ std::string Rosbag2ImportOptions::Validate() const {
   if (!(pause_s >= 0.0) || !std::isfinite(pause_s)) return fmt::format("pause_s = {}: must be >= 0", pause_s);
   if (!(max_gt_gap_s > 0.0) || !std::isfinite(max_gt_gap_s)) return fmt::format("max_gt_gap_s = {}: must be > 0", max_gt_gap_s);
   if (!ground_truth_frame.empty() && ground_truth_topic.empty()) return "--ground-truth-frame needs --ground-truth";
+  if (!scan_topic.empty() && !ground_truth_topic.empty()) return "--scan and --ground-truth are two ground truths: give one";
+  if (scan_topic.empty() && (!imu_topic.empty() || scan_pose))
+    return fmt::format("{} needs --scan", imu_topic.empty() ? "--scan-pose" : "--imu");
+  if (scan_pose && !(std::isfinite(scan_pose->x) && std::isfinite(scan_pose->y) && std::isfinite(scan_pose->theta)))
+    return "scan_pose: --scan-pose X,Y,YAW must be finite";
   return {};
 }
 
@@ -656,6 +662,56 @@ void CheckAgainstGroundTruth(const std::vector<TrajectoryRun>& runs, const std::
   }
 }
 
+// The lidar as the ground-truth source: each run's still stretches (from the
+// first sample of the pause before to the last of the pause after) and the
+// wheel travel for the odometry's predictions go to scan_ground_truth.hpp.
+ScanGroundTruth ScanSource(const Bag& bag, const std::vector<WheelSample>& s,
+                           const std::vector<std::pair<std::size_t, std::size_t>>& spans, std::size_t first_run,
+                           const RobotParams& robot, const Rosbag2ImportOptions& o, std::vector<std::string>& warnings) {
+  auto still = [&](std::size_t i) {
+    return std::abs(s[i].left - s[i - 1].left) < kStillM && std::abs(s[i].right - s[i - 1].right) < kStillM;
+  };
+  std::vector<scan::RunWindow> windows;
+  std::vector<std::string> names;
+  for (const auto& [a, b] : spans) {
+    std::size_t from = a, to = b;
+    while (from > 0 && still(from)) --from;
+    while (to + 1 < s.size() && still(to + 1)) ++to;
+    windows.push_back({s[from].t_ns, s[a].t_ns, s[b].t_ns, s[to].t_ns});
+    names.push_back(std::to_string(first_run + names.size() + 1));
+  }
+  std::vector<WheelTravel> travel;
+  travel.reserve(s.size());
+  for (const auto& w : s) travel.push_back({w.t_ns, w.left, w.right});
+  ScanSourceOptions so;
+  so.scan_topic = o.scan_topic;
+  so.imu_topic = o.imu_topic;
+  so.scan_pose = o.scan_pose;
+  so.log_time = o.GroundTruthTime() == StampSource::kLog;
+  so.origin_ns = s.front().t_ns;
+  return ReadScanGroundTruth(bag, so, windows, names, travel, robot.wheelbase_m, warnings);
+}
+
+// A run's scan poses as ground-truth samples, and the gap they need.
+std::vector<GtSample> ScanRunSamples(const scan::TrackResult& t, double& gap_s) {
+  std::vector<GtSample> out;
+  gap_s = 0.0;
+  for (const auto& p : t.poses) {
+    if (!out.empty()) gap_s = std::max(gap_s, static_cast<double>(p.t_ns - out.back().t_ns) * 1e-9);
+    out.push_back({p.t_ns, p.pose.x, p.pose.y, p.pose.theta});
+  }
+  return out;
+}
+
+// BuildRun on one run's scan poses: the lidar as the ground truth.
+TrajectoryRun BuildScanRun(const RecordingData& d, std::size_t a, std::size_t b, const scan::TrackResult& track,
+                           double max_gt_gap_s, double& turn) {
+  double gap_s = 0.0;
+  const std::vector<GtSample> samples = ScanRunSamples(track, gap_s);
+  GtInterpolator interp{samples, static_cast<std::int64_t>(std::llround(std::max(max_gt_gap_s, gap_s) * 1e9)) + 1};
+  return BuildRun(d, a, b, true, interp, turn);
+}
+
 }  // namespace
 
 // Per recording: read, split, drop runs with a gap in the wheel topic, then
@@ -684,10 +740,12 @@ Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotPar
                                          d.wheels.size()));
     const auto gaps = FindGaps(d.wheels);
     GtInterpolator interp{d.gt, static_cast<std::int64_t>(std::llround(o.max_gt_gap_s * 1e9))};
+    std::optional<ScanGroundTruth> lidar;  // --scan: each run's ground truth from the lidar
+    if (!o.scan_topic.empty()) lidar = ScanSource(bag, d.wheels, spans, out.runs.runs.size(), robot, o, out.warnings);
     std::vector<TrajectoryRun> runs;
     std::vector<double> turns;
-    for (const auto& span : spans) {
-      const std::size_t a = span.first, b = span.second;
+    for (std::size_t k = 0; k < spans.size(); ++k) {
+      const std::size_t a = spans[k].first, b = spans[k].second;
       const auto gap = std::find_if(gaps.begin(), gaps.end(), [a, b](const WheelGap& g) { return g.k > a && g.k <= b; });
       if (gap != gaps.end()) {
         ++rs.runs_dropped;
@@ -700,10 +758,11 @@ Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotPar
         continue;
       }
       double turn = NAN;
-      TrajectoryRun run = BuildRun(d, a, b, choice.gt.has_value(), interp, turn);
+      TrajectoryRun run = lidar ? BuildScanRun(d, a, b, lidar->runs[k].track, o.max_gt_gap_s, turn)
+                                : BuildRun(d, a, b, choice.gt.has_value(), interp, turn);
       run.run = std::to_string(out.runs.runs.size() + runs.size() + 1);
       CheckWheelsForward(run, o, path, d);
-      if (choice.gt && !run.HasGroundTruth(0))
+      if ((choice.gt || lidar) && !run.HasGroundTruth(0))
         out.warnings.push_back(fmt::format("{}: run {} has no ground truth within {} s of its first sample; its ground truth "
                                            "is relative to its first measured pose", path, run.run, o.max_gt_gap_s));
       if (o.kind == ExperimentKind::kSquare) {
@@ -729,8 +788,14 @@ Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotPar
     if (choice.gt) CheckAgainstGroundTruth(runs, turns, robot, o, path, d);
     rs.runs = runs.size();
     for (auto& r : runs) out.runs.runs.push_back(std::move(r));
+    if (lidar) {
+      rs.ground_truth_messages = lidar->scans;
+      for (auto& r : lidar->runs) r.track.poses = {};  // now in out.runs
+      out.scan.push_back(std::move(*lidar));
+    }
     out.recordings.push_back(rs);
   }
+  if (!out.scan.empty()) out.ground_truth = ScanGroundTruthNoise(out.scan);
   return out;
 }
 

@@ -11,10 +11,12 @@
 #include <string>
 #include <vector>
 
+#include "core/pose2.hpp"
 #include "core/robot.hpp"
 #include "core/runs.hpp"
 #include "io/rosbag2/bag.hpp"
 #include "io/rosbag2/tf_tree.hpp"
+#include "io/rosbag2/scan_ground_truth.hpp"
 #include "kinematics/diff_drive.hpp"
 
 namespace umbmark::io::rosbag2 {
@@ -35,6 +37,11 @@ struct Rosbag2ImportOptions {
   /// Optional ground truth; for a TFMessage topic the child frame to follow.
   std::string ground_truth_topic, ground_truth_frame;
   /// Time of the wheel messages, and of the ground truth (unset: the same).
+  /// Or ground truth from the robot's lidar (scan_ground_truth.hpp): a
+  /// LaserScan topic, the lidar's pose when /tf_static lacks it, and an
+  /// optional gyro (Imu topic).
+  std::string scan_topic, imu_topic;
+  std::optional<Pose2> scan_pose;
   StampSource time = StampSource::kHeader;
   std::optional<StampSource> ground_truth_time;
   StampSource GroundTruthTime() const { return ground_truth_time.value_or(time); }
@@ -58,6 +65,10 @@ struct Rosbag2Import {
   Experiment experiment;  ///< kind, side/distance, file = "runs.csv"
   TrajectoryData runs;    ///< dist_left_m/dist_right_m, ground truth relative to each run's start
   std::vector<RecordingSummary> recordings;
+  /// With --scan: per recording what the lidar and gyro gave (the runs'
+  /// poses moved into `runs`), and the registration's noise for the manifest.
+  std::vector<ScanGroundTruth> scan;
+  std::optional<GroundTruthNoise> ground_truth;
   std::vector<std::string> warnings;
 };
 
