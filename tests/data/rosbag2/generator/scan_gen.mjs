@@ -331,7 +331,8 @@ async function fixtures(outDir) {
   // Faulty inputs, short: a scan topic with no messages, a scan frame with no
   // transform, an IMU that says it has no angular velocity (covariance[0] = -1).
   const bad = recording({ robot: ROBOT_A, scene: SCENES.roomA, start: [2.6, 2.2, 0.25], seed: 2404,
-    plan: [{ kind: "still", seconds: 2.5 }, { kind: "leg", length: 0.3 }, { kind: "still", seconds: 2.5 }], lidar: LIDAR,
+    plan: [{ kind: "still", seconds: 2.5 }, { kind: "leg", length: 0.3 }, { kind: "turn", sign: 1 }, { kind: "still", seconds: 2.5 }],
+    lidar: LIDAR,
     frame: "rear_laser", tfChild: "laser", mount: [0.12, 0, 0], tfStatic: true, offsetS: 9500 });
   bad.push({ topic: "/imu_no_rate", log: bad[0].log, data: imu(bad[0].log, 0, true) });
   await writeMcap(path.join(outDir, "bad_inputs.mcap"), [...JP, ["/tf_static", "tf2_msgs/msg/TFMessage"],
