@@ -234,7 +234,9 @@ void PrintListedTopic(const io::rosbag2::TopicListing& l) {
   if (l.ground_truth) use += use.empty() ? "--ground-truth" : ", --ground-truth";
   if (!l.joints.empty()) use += fmt::format(" (joints: {})", io::rosbag2::TrimmedList(l.joints, 30));
   if (!l.tf.empty()) use += " with --ground-truth-frame FRAME:";
-  fmt::print("  {:<28} {:<44} {:>9} {:>9.1f}  {}\n", l.topic.name, l.topic.type, l.topic.count, l.topic.RateHz(), use);
+  const std::string lag = l.header_minus_receive_s ? fmt::format("{:+.3f}", *l.header_minus_receive_s) : std::string();
+  fmt::print("  {:<28} {:<44} {:>9} {:>9.1f} {:>12}  {}\n", l.topic.name, l.topic.type, l.topic.count, l.topic.RateHz(), lag,
+             use);
   for (std::size_t i = 0; i < l.tf.size() && i < kMaxFrames; ++i) {
     const auto& f = l.tf[i];
     const std::string rate = f.edge.is_static ? std::string("static") : fmt::format("{:.1f} Hz", f.edge.RateHz());
@@ -264,6 +266,7 @@ nlohmann::json ListedTopicJson(const io::rosbag2::TopicListing& l) {
           {"ground_truth", l.ground_truth},
           {"joints", l.joints},
           {"child_frames", l.frames},
+          {"header_minus_receive_s", l.header_minus_receive_s ? JsonNumber(*l.header_minus_receive_s) : nlohmann::json()},
           {"frames", frames}};
 }
 
@@ -283,7 +286,7 @@ int RunRosbag2List(const Rosbag2Options& o) {
     if (o.json.PrintText()) {
       fmt::print("{} ({} storage file{}: {})\n", path, listing.files.size(), listing.files.size() == 1 ? "" : "s",
                  io::rosbag2::TrimmedList(listing.files, 10));
-      fmt::print("  {:<28} {:<44} {:>9} {:>9}  use as\n", "topic", "type", "messages", "rate Hz");
+      fmt::print("  {:<28} {:<44} {:>9} {:>9} {:>12}  use as\n", "topic", "type", "messages", "rate Hz", "stamp-recv s");
     }
     std::size_t usable = 0, other = 0, omitted = 0;
     for (const bool want_usable : {true, false})
@@ -304,6 +307,8 @@ int RunRosbag2List(const Rosbag2Options& o) {
   }
   if (o.json.PrintText()) {
     for (const auto& w : warnings) fmt::print(stderr, "warning: {}\n", w);
+    fmt::print("stamp-recv: header stamp minus receive time of the first message; topics far apart were stamped by "
+               "different clocks (--time WHEELS,GROUND_TRUTH)\n");
     fmt::print("Next: umbmark import rosbag2 BAG --out DIR --experiment square --side S --robot R.toml "
                "--wheels TOPIC [--left-joint J --right-joint J] --ground-truth TOPIC [--ground-truth-frame FRAME]\n");
   }

@@ -199,6 +199,8 @@ TEST_CASE("/tf as a tree: odom chains refused, /tf_static offsets composed, --li
   o.ground_truth_frame = "mocap_marker";
   const auto marker = Import("clean.mcap", o);
   CHECK(GtDiff(marker.runs.runs[0], mocap.runs.runs[0], false) > 0.05);
+  // The odometry again, with motion-capture noise added: no drift beyond its noise.
+  CHECK_THAT(ImportError("odom_as_mocap.mcap"), Catch::Contains("follows the wheel odometry"));
   // Ground truth that is the odometry itself.
   CHECK_THAT(ImportError("clean.mcap", Options("/odom")), Catch::Contains("follows the wheel odometry") &&
                                                             Catch::Contains("--ground-truth /odom"));
@@ -226,6 +228,12 @@ TEST_CASE("Clocks: a 37 s offset named, --time per stream, repeated stamps taken
   const auto clean = Import("clean.mcap");
   const std::string off = ImportError("clock_offset.mcap");
   CHECK_THAT(off, Catch::Contains("clocks 37.0 s apart") && Catch::Contains("--time header,log"));
+  // --list shows it too: header stamp minus receive time per topic.
+  const auto listed = RunCli("import rosbag2 " + Q(kDir / "clock_offset.mcap") + " --list --json -");
+  REQUIRE(listed.status == 0);
+  const auto lj = nlohmann::json::parse(listed.out);
+  CHECK_THAT(lj["bags"][0]["topics"][0]["header_minus_receive_s"].get<double>(), Catch::WithinAbs(-0.002, 1e-9));
+  CHECK_THAT(lj["bags"][0]["topics"][1]["header_minus_receive_s"].get<double>(), Catch::WithinAbs(36.997, 1e-9));
   auto o = Options();
   o.ground_truth_time = StampSource::kLog;  // --time header,log
   const auto fixed = Import("clock_offset.mcap", o);

@@ -87,6 +87,10 @@ struct TopicListing {
   bool ground_truth = false;  ///< a pose type
   std::vector<std::string> joints;  ///< JointState: joint names of its first message
   std::vector<std::string> frames;  ///< TFMessage: every child frame of the topic
+  /// Header stamp minus receive time of the topic's first message [s]: a
+  /// clock that is off (a motion-capture PC 37 s ahead, simulation time)
+  /// shows here, for choosing --time.
+  std::optional<double> header_minus_receive_s;
   /// TFMessage: every transform (parent -> child, rate) of the topic, with
   /// the odometry frame its chain runs through ("" when none: a candidate
   /// for --ground-truth-frame).

@@ -155,6 +155,10 @@ async function main(outDir) {
     odomReset.push({ topic: "/odom", log: ns(s.t) + 1000000n, data: odometry(ns(s.t), p) });
   });
   await write("odom_reset.mcap", [MOCAP, ["/odom", "nav_msgs/msg/Odometry"]], sorted(odomReset));
+  // The robot's odometry with motion-capture noise, published as /mocap/pose.
+  const noise = rng(2323);
+  await write("odom_as_mocap.mcap", [JS, MOCAP], sorted(basic(sim.map((s) => ({ ...s, mocap: { x: s.odo.x + 2e-4 * noise(),
+    y: s.odo.y + 2e-4 * noise(), th: s.odo.th + 5e-4 * noise() } })))));
   await write("clock_offset.mcap", [JS, MOCAP], sorted(basic(sim, { poseOffsetNs: 37000000000n })));
   // Simulation time from 0 in the header stamps; the first joint state sent twice.
   const simTime = basic(sim, { simTime: true });
