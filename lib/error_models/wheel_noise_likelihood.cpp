@@ -315,6 +315,32 @@ Optimum Minimise(const LikelihoodModel& m, Eigen::Vector3d start, const std::arr
   return o;
 }
 
+namespace {
+
+/// How the other entries of theta move along the profile of entry j, per
+/// unit of theta_j: -I_oo^-1 I_oj (the conditional mean of a quadratic
+/// NLL with information I); each profile starts there, a pass or two from
+/// its minimum. Zero where I is singular.
+Eigen::Vector3d RidgeSlope(const Eigen::MatrixXd& I, int j) {
+  Eigen::Vector3d ridge = Eigen::Vector3d::Zero();
+  std::vector<int> other;
+  for (int k = 0; k < static_cast<int>(I.rows()); ++k)
+    if (k != j) other.push_back(k);
+  const auto n = static_cast<Eigen::Index>(other.size());
+  Eigen::MatrixXd Ioo(n, n);
+  Eigen::VectorXd Ioj(n);
+  for (Eigen::Index a = 0; a < n; ++a) {
+    Ioj(a) = I(other[static_cast<std::size_t>(a)], j);
+    for (Eigen::Index b = 0; b < n; ++b) Ioo(a, b) = I(other[static_cast<std::size_t>(a)], other[static_cast<std::size_t>(b)]);
+  }
+  const Eigen::VectorXd slope = -Ioo.ldlt().solve(Ioj);
+  if (slope.allFinite())
+    for (Eigen::Index a = 0; a < n; ++a) ridge(other[static_cast<std::size_t>(a)]) = slope(a);
+  return ridge;
+}
+
+}  // namespace
+
 double IntervalEnd(const LikelihoodModel& m, const Optimum& best, int j, int side, double delta, int max_iterations) {
   const double target = std::sqrt(2.0 * delta);
   const int P = m.Dimension();
@@ -328,25 +354,7 @@ double IntervalEnd(const LikelihoodModel& m, const Optimum& best, int j, int sid
   if (!std::isfinite(se) || se <= 0.0) se = 1.0;
   se = std::min(se, 5.0);
   Eigen::Vector3d warm = best.theta;
-  // Along the profile the other entries move by about -I_oo^-1 I_oj per unit
-  // of theta_j (the conditional mean of a quadratic NLL): each profile
-  // starts there, a pass or two from its minimum.
-  Eigen::Vector3d ridge = Eigen::Vector3d::Zero();
-  {
-    std::vector<int> other;
-    for (int k = 0; k < P; ++k)
-      if (k != j) other.push_back(k);
-    const auto n = static_cast<Eigen::Index>(other.size());
-    Eigen::MatrixXd Ioo(n, n);
-    Eigen::VectorXd Ioj(n);
-    for (Eigen::Index a = 0; a < n; ++a) {
-      Ioj(a) = I(other[static_cast<std::size_t>(a)], j);
-      for (Eigen::Index b = 0; b < n; ++b) Ioo(a, b) = I(other[static_cast<std::size_t>(a)], other[static_cast<std::size_t>(b)]);
-    }
-    const Eigen::VectorXd slope = -Ioo.ldlt().solve(Ioj);
-    if (slope.allFinite())
-      for (Eigen::Index a = 0; a < n; ++a) ridge(other[static_cast<std::size_t>(a)]) = slope(a);
-  }
+  const Eigen::Vector3d ridge = RidgeSlope(I, j);
   // Signed root r and dr/ds at s = side (log k - log k_hat) >= 0.
   struct Point {
     double r = kInf, drds = std::numeric_limits<double>::quiet_NaN();
