@@ -406,9 +406,33 @@ std::string Ros2Parameters(const CalibrateJobResult& r, const Chosen& chosen, co
        "Load with: ros2 param load /" + controller + " FILE (or add to the controller's --param-file list)"});
 }
 
+/// The report's held-out section, from the result JSON: each method's
+/// error on the held-out runs or paths, the recommendation and its expected
+/// error on paths it has not seen.
+void HeldoutSection(io::HtmlReport& rep, const nlohmann::json& j) {
+  if (!j.contains("heldout_error") || !j["heldout_error"].is_object()) return;
+  const nlohmann::json& h = j["heldout"];
+  rep.Heading("Which calibration to trust: error on runs it did not see");
+  std::vector<std::vector<std::string>> rows;
+  const std::string recommended = j["recommended"].is_string() ? j["recommended"].get<std::string>() : "";
+  for (const auto& [method, m] : j["heldout_error"].items()) {
+    auto mm = [](const nlohmann::json& v) { return v.is_number() ? fmt::format("{:.2f}", v.get<double>() * 1e3) : "-"; };
+    rows.push_back({method, mm(m["mean_m"]), mm(m["sem_m"]), std::to_string(m["folds"].get<int>()),
+                    method == recommended ? "recommended" : ""});
+  }
+  rep.Table({"method", "mean [mm]", "SE [mm]", "folds", ""}, rows);
+  const auto num = [](const nlohmann::json& v) { return v.is_number() ? v.get<double>() * 1e3 : 0.0; };
+  rep.Paragraph(fmt::format("Held out: {} ({}). Recommended: {} ({}). Expected error on paths it has not seen: "
+                            "{:.2f} mm +- {:.2f} (SE).",
+                            h["scheme"].get<std::string>(), h["measure"].get<std::string>(), recommended,
+                            h["why"].get<std::string>(), num(h["expected_error_m"]), num(h["expected_error_sem_m"])));
+}
+
 // The --report page of one calibration: headline, what to do next, the
 // numbers (parameters with intervals when refined, centres of gravity,
-// E_d/E_b, evaluation before/after), then the plots.
+// E_d/E_b, evaluation before/after, the held-out comparison), then the
+// plots. About 100 lines: one page laid out top to bottom, each table a few
+// lines; the held-out section is its own helper.
 std::string CalibrationReportHtml(const nlohmann::json& j, const CalibrateJobResult& r, const std::string& plot_svg,
                                   const std::string& which, const RobotParams& chosen) {
   const UmbmarkSummary& s = r.umbmark;
@@ -502,6 +526,7 @@ std::string CalibrationReportHtml(const nlohmann::json& j, const CalibrateJobRes
                "final heading error, mean [deg]", "max heading error [deg]"},
               rows);
   }
+  HeldoutSection(rep, j);
   rep.Heading("Plots");
   rep.Figure(plot_svg, fmt::format("Return errors before and after correction with the {} parameters, on one scale; "
                                    "then every run's path (up to 48; the largest final errors after correction marked).",

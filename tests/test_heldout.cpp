@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 
@@ -310,6 +311,13 @@ TEST_CASE("calibrate recommends a method and --ros2 follows --use", "[heldout][c
   CHECK(js["refined"]["E_b"].get<double>() == j["refined"]["E_b"].get<double>());
   CHECK_FALSE(js["refined"].contains("heldout_error"));
   CHECK_THAT(multiplier(dir / "skip.yaml"), WithinAbs(j["E_b"].get<double>(), 1e-12));
+  // The report shows the comparison and the expected error.
+  const auto rep = testing::RunCli(base + " --report " + (dir / "cal.html").string());
+  REQUIRE(rep.status == 0);
+  std::ifstream html(dir / "cal.html");
+  const std::string page((std::istreambuf_iterator<char>(html)), std::istreambuf_iterator<char>());
+  CHECK(page.find("Expected error on paths it has not seen: " +
+                  fmt::format("{:.2f}", j["heldout"]["expected_error_m"].get<double>() * 1e3)) != std::string::npos);
   const auto skip_text = testing::RunCli(base + " --no-heldout");
   CHECK(skip_text.out.find("not compared (--no-heldout)") != std::string::npos);
   fs::remove_all(dir);
