@@ -3,10 +3,14 @@
 // exactly the runs (and line numbers) of one sequential read; the whole
 // command gives the same JSON as the sequential path (taken with --plot);
 // a run split across the two parts is still refused with the sequential
-// read's message; a quote near the middle means no cut.
+// read's message; a quote near the middle means no cut. EvaluateRun's single
+// pass equals the TrackRun computation bit for bit.
 #include <catch2/catch.hpp>
 
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -14,6 +18,9 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "core/angles.hpp"
+#include "evaluation/run_track.hpp"
+#include "evaluation/trajectory_eval.hpp"
 #include "io/trajectory_csv.hpp"
 #include "support/run_cli.hpp"
 
@@ -124,4 +131,66 @@ TEST_CASE("evaluate on a large file: the parallel parts give the sequential resu
   CHECK(bad.status == 1);
   CHECK_THAT(bad.err, Catch::Contains("run 'r3' appears again after run 'r140'"));
   CHECK(bad.err == bad_sequential.err);
+}
+
+// EvaluateRun's one pass against the per-sample track (TrackRun) it replaces
+// in the hot path: bit for bit the same numbers, for ticks and wheel travel,
+// both integrators, samples without ground truth, heading wrapped to
+// (-pi, pi] in the file, and a start pose far from the origin.
+TEST_CASE("EvaluateRun equals the TrackRun computation bit for bit", "[evaluation][parts]") {
+  using namespace umbmark;
+  RobotParams recorded;
+  recorded.wheelbase_m = 0.34;
+  recorded.wheel_diameter_left_m = 0.1524;
+  recorded.wheel_diameter_right_m = 0.1524;
+  recorded.ticks_per_rev = 2048;
+  RobotParams params = recorded;
+  params.wheelbase_m = 0.3412;
+  params.wheel_diameter_left_m = 0.1519;
+  for (const bool ticks : {true, false}) {
+    for (const Integrator integ : {Integrator::kArc, Integrator::kMidpoint}) {
+      TrajectoryRun run;
+      run.run = "7";
+      run.direction = "ccw";
+      double x = 3.0, y = -2.0, theta = 2.9;
+      for (int i = 0; i < 900; ++i) {
+        const double dl = 0.004 + 0.002 * std::sin(0.01 * i), dr = 0.004 + 0.002 * std::cos(0.013 * i);
+        theta += (dr - dl) / 0.34;
+        x += 0.5 * (dl + dr) * std::cos(theta);
+        y += 0.5 * (dl + dr) * std::sin(theta);
+        run.t_s.push_back(0.01 * i);
+        if (ticks) {
+          run.ticks_left.push_back(1000 + static_cast<std::int64_t>(i * 3.1));
+          run.ticks_right.push_back(-50 + static_cast<std::int64_t>(i * 3.3));
+        } else {
+          run.dist_left_m.push_back(0.004 * i);
+          run.dist_right_m.push_back(0.0043 * i);
+        }
+        const bool gt = i % 5 != 3 || i == 899;
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        run.gt_x_m.push_back(gt ? x : nan);
+        run.gt_y_m.push_back(gt ? y : nan);
+        run.gt_theta_rad.push_back(gt ? WrapAngle(theta) : nan);
+        run.lines.push_back(static_cast<std::size_t>(i + 2));
+      }
+      INFO("ticks " << ticks << ", integrator " << IntegratorToString(integ));
+      const RunEvaluation ev = EvaluateRun(run, "f.csv", "e", params, recorded, integ);
+      const RunTrack t = TrackRun(run, "f.csv", params, recorded, integ);
+      double max_pos = 0.0, max_head = 0.0;
+      for (std::size_t i = 0; i < run.size(); ++i) {
+        if (!t.has_ground_truth[i]) continue;
+        max_pos = std::max(max_pos, std::hypot(t.ground_truth[i].x - t.odometry[i].x, t.ground_truth[i].y - t.odometry[i].y));
+        max_head = std::max(max_head, std::abs(WrapAngle(t.ground_truth[i].theta - t.odometry[i].theta)));
+      }
+      const Pose2 g = t.ground_truth[t.last_gt], o = t.odometry[t.last_gt];
+      CHECK(ev.max_position_error_m == max_pos);
+      CHECK(ev.max_heading_error_rad == max_head);
+      CHECK(ev.final_position_error_m == std::hypot(g.x - o.x, g.y - o.y));
+      CHECK(ev.final_heading_error_rad == std::abs(WrapAngle(g.theta - o.theta)));
+      CHECK(ev.return_error.x == g.x - o.x);
+      CHECK(ev.return_error.y == g.y - o.y);
+      CHECK(ev.return_error.theta == WrapAngle(g.theta - o.theta));
+      CHECK(ev.max_position_error_m > 1e-3);  // the parameters differ: a real error, not 0 == 0
+    }
+  }
 }
