@@ -154,10 +154,12 @@ Command SetupSimulate(CLI::App& parent) {
                   "Effect NAME:k=v,... (repeatable), e.g. turn_scrub:k=0.05 or gt_offset:dx=0.02,dy=0");
   app->add_option("--seed", opts->seed, "Seed of every random process (default 1)")->check(SeedValidator());
   auto& s = opts->sim;
-  app->add_option("--E-d", s.truth.E_d, "True wheel diameter ratio error E_d (default 1)")->check(Positive());
-  app->add_option("--E-b", s.truth.E_b, "True wheelbase error E_b (default 1)")->check(Positive());
-  app->add_option("--kl", s.truth.k_L, "True left wheel noise k_L [m^1/2] (default 0.001)")->check(NonNegative());
-  app->add_option("--kr", s.truth.k_R, "True right wheel noise k_R [m^1/2] (default 0.001)")->check(NonNegative());
+  // Ranges as calibrate's plausibility gates: no robot is off by a factor of
+  // two, and wheel noise beyond 0.1 m^1/2 (3 cm after 1 m) is no odometry.
+  app->add_option("--E-d", s.truth.E_d, "True wheel diameter ratio error E_d (default 1)")->check(NumberIn(0.5, 2.0));
+  app->add_option("--E-b", s.truth.E_b, "True wheelbase error E_b (default 1)")->check(NumberIn(0.5, 2.0));
+  app->add_option("--kl", s.truth.k_L, "True left wheel noise k_L [m^1/2] (default 0.001)")->check(NumberIn(0.0, 0.1));
+  app->add_option("--kr", s.truth.k_R, "True right wheel noise k_R [m^1/2] (default 0.001)")->check(NumberIn(0.0, 0.1));
   app->add_option("--square-runs", s.square_runs_per_direction, "Square runs per direction (default 10)")
       ->check(NumberIn(1, 1000000));
   app->add_option("--back-and-forth-runs", s.back_and_forth_runs, "Back-and-forth runs (default 20)")
@@ -171,10 +173,10 @@ Command SetupSimulate(CLI::App& parent) {
   app->add_option("--free-radius", s.free_radius_m, "Radius of the figure-eight circles [m] (default 1)")
       ->check(Positive());
   app->add_option("--gt-sigma-xy", opts->gt_sigma_xy, "Ground-truth position noise [m] (default: the manifest's, else 0.0003)")
-      ->check(NonNegative());
+      ->check(NumberIn(0.0, 1.0));
   app->add_option("--gt-sigma-theta", opts->gt_sigma_theta,
                   "Ground-truth heading noise [rad] (default: the manifest's, else 0.0017)")
-      ->check(NonNegative());
+      ->check(NumberIn(0.0, 1.0));
   app->add_flag("--hide-gt-sigma", opts->hide_gt_sigma,
                 "Do not state [ground_truth] in the written manifest (diagnose then estimates it)");
   app->add_flag("--endpoint-squares", s.endpoint_squares, "Write squares as endpoint CSV (return errors only)");

@@ -251,6 +251,14 @@ std::vector<Case> Issue23Cases() {
                                       "' evaluate imp/campaign.toml >/dev/null 2>&1").c_str()) == 0);
                  }});
   }
+  // simulate: options far out of range would write inf into the campaign.
+  for (const char* bad : {"--E-b 1e308", "--E-d 0", "--kl 1e308", "--gt-sigma-xy 1e308", "--gt-sigma-theta 7"})
+    c.push_back({fmt::format("simulate {}", bad), [](const fs::path& d) { Put(d / "m.toml", kManifest); },
+                 fmt::format("simulate m.toml --out o {}", bad), 2, "must be a number from"});
+  c.push_back({"a manifest's [ground_truth] sigma_xy_m = 1e308", [](const fs::path& d) {
+                 Put(d / "m.toml", kManifest + "\n[ground_truth]\nsigma_xy_m = 1e308\nsigma_theta_rad = 0.001\n");
+               },
+               "simulate m.toml --out o", 1, "m.toml:13:14: sigma_xy_m = 1e+308 is more than 1"});
   // Empty and NUL paths.
   for (const std::string& args : {cal + "--json ''", cal + "--report ''", cal + "--plot ''", std::string("calibrate '' --robot robot.toml --side 4"),
                                   std::string("summarize ep.csv --json ''"), std::string("evaluate ep.csv --robot '' ")})

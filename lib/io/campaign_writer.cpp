@@ -71,6 +71,17 @@ std::string FormatTrajectoryCsv(const TrajectoryData& data, const std::vector<st
   for (const auto& run : data.runs) {
     const std::string id = CsvField(run.run), dir = CsvField(run.direction);
     for (std::size_t i = 0; i < run.size(); ++i) {
+      // "inf" or "nan" in a cell would make the file unreadable (readers
+      // refuse them): refuse to write it instead.
+      const bool finite = std::isfinite(run.t_s[i]) &&
+                          (ticks || (std::isfinite(run.dist_left_m[i]) && std::isfinite(run.dist_right_m[i]))) &&
+                          (!run.HasGroundTruth(i) || (std::isfinite(run.gt_x_m[i]) && std::isfinite(run.gt_y_m[i]) &&
+                                                      std::isfinite(run.gt_theta_rad[i])));
+      if (!finite) {
+        throw InputError(data.path, fmt::format("run {} sample {}: a value is not finite (inf or NaN); nothing is "
+                                                "written (an input or option far out of range?)",
+                                                run.run, i + 1));
+      }
       fmt::format_to(std::back_inserter(buf), "{},{},{},", id, dir, run.t_s[i]);
       if (ticks)
         fmt::format_to(std::back_inserter(buf), "{},{},", run.ticks_left[i], run.ticks_right[i]);

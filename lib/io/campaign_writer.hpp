@@ -13,7 +13,9 @@ namespace umbmark::io {
 
 /// Trajectory CSV text: run,direction,t_s,ticks_left,ticks_right (or
 /// dist_left_m,dist_right_m),x_gt_m,y_gt_m,theta_gt_rad; NaN ground truth is
-/// written as empty cells. `comment` lines are written first, prefixed "# ".
+/// written as empty cells. `comment` lines are written first, prefixed "# "
+/// (invalid UTF-8 and control characters escaped as \xNN). Throws InputError
+/// (naming data.path) for any other non-finite value: no reader takes it.
 std::string FormatTrajectoryCsv(const TrajectoryData& data, const std::vector<std::string>& comment = {});
 
 /// A key of the manifest's [ground_truth] beyond the two sigmas that an

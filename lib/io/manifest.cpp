@@ -153,6 +153,12 @@ Manifest ParseManifest(std::string_view text, const std::string& path) {
       if (node == nullptr) FailAt(path, gt.source(), fmt::format("[ground_truth]: missing key '{}'", s.key));
       *s.target = detail::NumberValue(*node, s.key, path);
       if (*s.target < 0.0) FailAt(path, node->source(), fmt::format("{} = {} must be >= 0", s.key, *s.target));
+      // Ground truth off by more than a metre or a radian is no ground truth
+      // (1e308 would make every simulated pose infinite).
+      if (*s.target > 1.0)
+        FailAt(path, node->source(), fmt::format("{} = {:g} is more than 1 (metre or radian): no ground truth is that "
+                                                 "noisy; give it in metres and radians",
+                                                 s.key, *s.target));
     }
     m.ground_truth = noise;
   }
