@@ -220,7 +220,7 @@ Command SetupDiagnose(CLI::App& parent) {
   app->add_option("--threads", d.threads, "Threads (default 2)")->check(NumberIn(1, 256));
   app->add_option("--where", d.where_top, "Discrepancies listed under 'where' (default 12)")->check(NonNegative());
   app->add_option("--effects", opts->effects,
-                  "Effects to try, comma-separated (default: the contract's twelve; with --baseline also its "
+                  "Effects to try, comma-separated (default: the contract's fourteen; with --baseline also its "
                   "parameter errors)")
       ->delimiter(',');
   app->add_option("--plot", opts->plot,

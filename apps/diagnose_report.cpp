@@ -233,12 +233,12 @@ std::string PText(double p) {
 }
 
 /// Fitted parameters with units (and standard errors when given).
-std::string ParamsText(const nlohmann::json& params, const nlohmann::json& se) {
+std::string ParamsText(const nlohmann::json& params, const nlohmann::json& se, const std::string& effect) {
   std::string out;
   for (const auto& [k, val] : params.items()) {
     if (!val.is_number()) continue;
     const double e = se.contains(k) && se[k].is_number() ? se[k].get<double>() : NAN;
-    out += (out.empty() ? "" : ", ") + diag::FormatEffectParam(k, val.get<double>(), e);
+    out += (out.empty() ? "" : ", ") + diag::FormatEffectParam(k, val.get<double>(), e, effect);
   }
   return out;
 }
@@ -306,8 +306,8 @@ void CandidateTable(io::HtmlReport& rep, const nlohmann::json& j) {
     const std::string words = diag::EvidenceInWords(gain, ev, Number(c, "heldout_shrink"));
     const std::string unphysical = c.value("unphysical", "");
     const std::string effect = c.value("effect", "?");
-    if (!unphysical.empty()) symptoms.push_back({effect, ParamsText(c.value("params", nlohmann::json::object()), nlohmann::json::object()), unphysical});
-    rows.push_back({effect, ParamsText(c.value("params", nlohmann::json::object()), c.value("params_se", nlohmann::json::object())),
+    if (!unphysical.empty()) symptoms.push_back({effect, ParamsText(c.value("params", nlohmann::json::object()), nlohmann::json::object(), effect), unphysical});
+    rows.push_back({effect, ParamsText(c.value("params", nlohmann::json::object()), c.value("params_se", nlohmann::json::object()), effect),
                     Percent(Number(c, "heldout_shrink")), Percent(Number(c, "shrink")),
                     words.substr(0, words.find(':')) + (std::isfinite(ev) ? fmt::format(" ({:+.1f} nats)", ev) : ""),
                     c.contains("lr_p_value") && c["lr_p_value"].is_number() ? diag::FormatPValue(c["lr_p_value"].get<double>())
@@ -336,7 +336,7 @@ void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
                              : e.value("negligible", false) ? " (negligible)"
                                                             : "";
     rows.push_back({fmt::format("{}", ++k), e.value("effect", "?"),
-                    ParamsText(e.value("params", nlohmann::json::object()), nlohmann::json::object()),
+                    ParamsText(e.value("params", nlohmann::json::object()), nlohmann::json::object(), e.value("effect", "")),
                     Percent(Number(e, "cumulative_heldout_shrink")), Percent(Number(e, "cumulative_shrink")),
                     fmt::format("{:.2f} mm / {:.2f} mrad", Number(e, "size_mm"), Number(e, "size_mrad")),
                     // A noise effect's size: the growth of one piece type's spread.

@@ -34,7 +34,9 @@
 //              random direction; time_offset tau +-0.02-0.1 s;
 //              standstill_motion sigma_xy, sigma_theta 2-10 mm / mrad;
 //              motion_noise_floor sigma 2-10 mm; run_time_offset tau_sd
-//              0.02-0.1 s;
+//              0.02-0.1 s; stop_slide d 0.03-0.12 s^2/m, a 0.005-0.02
+//              s^2/rad; castor_swivel kappa +-0.003-0.02 rad (these two
+//              classes last, so that the others keep their campaigns);
 //   outside    gt_yaw_misalignment delta +-0.005-0.02 rad; floor_slope g
 //              0.002-0.01 m/m towards a random direction
 //
@@ -319,6 +321,11 @@ Case MakeCase(const std::string& truth, std::uint64_t seed, double arc_fraction,
         break;
       case sim::EffectKind::kMotionNoiseFloor: fx.floor_sigma = U(g, 0.002, 0.01); break;
       case sim::EffectKind::kRunTimeOffset: fx.run_tau_sd = U(g, 0.02, 0.1); break;
+      case sim::EffectKind::kStopSlide:
+        fx.slide_d = U(g, 0.03, 0.12);
+        fx.slide_a = U(g, 0.005, 0.02);
+        break;
+      case sim::EffectKind::kCastorSwivel: fx.swivel_kappa = Sign(g) * U(g, 0.003, 0.02); break;
       case sim::EffectKind::kGtYawMisalignment: fx.yaw_delta = Sign(g) * U(g, 0.005, 0.02); break;
       case sim::EffectKind::kFloorSlope:
         fx.slope_g = U(g, 0.002, 0.01);
@@ -352,11 +359,18 @@ int main(int argc, char** argv) {
   std::vector<std::string> classes = args.classes;
   if (classes.empty()) {
     classes.push_back("none");
+    // Issue 21's effects come last, so that every other class keeps its
+    // campaigns (a case's seed follows its class index).
+    const auto late = [](sim::EffectKind k) {
+      return k == sim::EffectKind::kStopSlide || k == sim::EffectKind::kCastorSwivel;
+    };
     for (const auto& d : sim::EffectCatalogue())
-      if (d.simulated) classes.emplace_back(d.name);
+      if (d.simulated && !late(d.kind)) classes.emplace_back(d.name);
     for (const char* b : {"base_ok", "base_wheelbase", "base_ratio", "base_noise", "base_noise_left",
                           "base_noise_right", "base_wheelbase_castor", "base_ratio_gt_offset"})
       classes.emplace_back(b);
+    for (const auto& d : sim::EffectCatalogue())
+      if (late(d.kind)) classes.emplace_back(d.name);
   }
   std::vector<Case> cases;
   for (std::size_t ci = 0; ci < classes.size(); ++ci) {

@@ -33,7 +33,8 @@
 // Effects (contract names, same parameters; --effect may be repeated to
 // combine them): scale_error:s, direction_asymmetry:a, castor_kick:kappa,
 // gt_offset:dx,dy, time_offset:tau, bump_outliers:rate,sigma,
-// standstill_motion:sigma_xy,sigma_theta, run_time_offset:tau_sd, and
+// standstill_motion:sigma_xy,sigma_theta, run_time_offset:tau_sd,
+// stop_slide:d,a, castor_swivel:kappa, and
 // outside the contract gt_yaw_misalignment:delta, floor_slope:g,dir.
 // The last three contract effects draw from a second random stream (seed
 // S xor a constant), so that adding them leaves every other draw, and a
@@ -50,6 +51,18 @@
 //     the encoders, stand.
 //   run_time_offset: per run tau_i ~ N(0, tau_sd^2), ground truth stamped t
 //     shows the true pose at t - tau - tau_i.
+//   stop_slide (d, a): at a standstill after a leg or stretch that ended at
+//     true speed v (the last physics step's), the chassis coasts on along
+//     its heading, decelerating uniformly at 1/(2 d) m/s^2 until it has
+//     covered d v^2 (it takes 2 d |v| s); after a spot turn that ended at
+//     true rate w it turns on at 1/(2 a) rad/s^2 by a w^2. The wheels, and
+//     so the encoders, stand meanwhile. (Written from the contract's
+//     definition; `umbmark simulate` moves the pose at once instead.)
+//   castor_swivel (kappa): a leg or stretch right after a spot turn starts
+//     with a heading jump of kappa times the turn's sign (ccw +1, cw -1);
+//     one that reverses the drive direction of the leg or stretch before it
+//     (no turn between) jumps by +kappa or -kappa, equally likely, drawn
+//     from a third stream (seed S xor another constant).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -97,7 +110,8 @@ struct Sample {
 /// geometry) and a 1 kHz clock.
 class Robot {
  public:
-  Robot(const Options& o, std::mt19937_64& g, std::mt19937_64& gx) : o_(o), g_(g), gx_(gx) {
+  Robot(const Options& o, std::mt19937_64& g, std::mt19937_64& gx, std::mt19937_64& gs)
+      : o_(o), g_(g), gx_(gx), gs_(gs) {
     // Contract (formats.md): D_R / D_L = E_d, D_L + D_R = 2 D (eqs. 4.31-4.32).
     const double s = 1.0 + Effect(o, "scale_error", "s");
     dl_true_ = 2.0 / (o.E_d + 1.0) * o.diameter * s;
@@ -124,6 +138,7 @@ class Robot {
       // castor_kick: every start from standstill, + forward, - backward.
       th_ += (distance > 0 ? 1.0 : -1.0) * Effect(o_, "castor_kick", "kappa");
     }
+    Swivel(distance > 0 ? 1 : -1);
     const double x0 = ox_, y0 = oy_, th_ref = oth_, dir = distance > 0 ? 1.0 : -1.0;
     double v = 0.0;
     for (int guard = 0; guard < 10'000'000; ++guard) {
@@ -137,6 +152,7 @@ class Robot {
   }
   void Turn(double angle) {
     const double th0 = oth_, dir = angle > 0 ? 1.0 : -1.0;
+    turn_sign_ = angle > 0 ? 1 : -1;
     double w = 0.0;
     for (int guard = 0; guard < 10'000'000; ++guard) {
       const double left = std::abs(angle) - dir * (oth_ - th0);
@@ -153,6 +169,7 @@ class Robot {
     // castor_kick: a start from standstill, + forward, - backward (an arc
     // drives forward or backward like a leg: the sign of the axle speed).
     th_ += dir * Effect(o_, "castor_kick", "kappa");
+    Swivel(dir > 0 ? 1 : -1);
     double total = 0.0;
     for (const auto& a : arcs) total += a[0];
     double v = 0.0, done_before = 0.0;
@@ -180,12 +197,30 @@ class Robot {
       settle = {(along * std::cos(th_) - across * std::sin(th_)) / settle_steps,
                 (along * std::sin(th_) + across * std::cos(th_)) / settle_steps, turn / settle_steps};
     }
+    // stop_slide: the coast's deceleration (0: none) from the speed the
+    // motion ended with.
+    const double d = Effect(o_, "stop_slide", "d"), a = Effect(o_, "stop_slide", "a");
+    double v = moved_ && steps > 0 && d > 0.0 ? last_v_ : 0.0, w = moved_ && steps > 0 && a > 0.0 ? last_w_ : 0.0;
     if (steps > 0) moved_ = false;
     for (int i = 0; i < steps; ++i) {
       if (i < settle_steps) {
         x_ += settle[0];
         y_ += settle[1];
         th_ += settle[2];
+      }
+      // Uniform deceleration, exact over the step: distance v dt - dec dt^2 / 2
+      // (or what is left of the coast when it ends within the step).
+      if (v != 0.0) {
+        const double dec = 1.0 / (2.0 * d), t_left = std::min(kDt, std::abs(v) / dec);
+        const double ds = (std::abs(v) * t_left - 0.5 * dec * t_left * t_left) * (v > 0 ? 1.0 : -1.0);
+        x_ += ds * std::cos(th_);
+        y_ += ds * std::sin(th_);
+        v = std::abs(v) <= dec * kDt ? 0.0 : v - (v > 0 ? 1.0 : -1.0) * dec * kDt;
+      }
+      if (w != 0.0) {
+        const double dec = 1.0 / (2.0 * a), t_left = std::min(kDt, std::abs(w) / dec);
+        th_ += (std::abs(w) * t_left - 0.5 * dec * t_left * t_left) * (w > 0 ? 1.0 : -1.0);
+        w = std::abs(w) <= dec * kDt ? 0.0 : w - (w > 0 ? 1.0 : -1.0) * dec * kDt;
       }
       Step(0.0, 0.0);
     }
@@ -200,6 +235,20 @@ class Robot {
 
  private:
   static constexpr double kDt = 1e-3;
+
+  /// castor_swivel at the start of a leg or stretch driving in direction
+  /// `dir` (+1 forward, -1 backward).
+  void Swivel(int dir) {
+    const double kappa = Effect(o_, "castor_swivel", "kappa");
+    if (kappa != 0.0) {
+      if (turn_sign_ != 0)
+        th_ += turn_sign_ * kappa;
+      else if (drive_dir_ != 0 && dir != drive_dir_)
+        th_ += (std::uniform_real_distribution<double>(0.0, 1.0)(gs_) < 0.5 ? -1.0 : 1.0) * kappa;
+    }
+    turn_sign_ = 0;
+    drive_dir_ = dir;
+  }
 
   /// Next speed: accelerate at most `accel` (none when 0), and brake so
   /// that the remaining distance is covered; at least `creep` to finish.
@@ -229,6 +278,10 @@ class Robot {
     Bump(1, sR);
     if (v != 0.0 || w != 0.0) moved_ = true;
     const double ds = 0.5 * (sL + sR), dth = (sR - sL) / b_true_;
+    if (v != 0.0 || w != 0.0) {
+      last_v_ = ds / kDt;
+      last_w_ = dth / kDt;
+    }
     x_ += ds * std::cos(th_ + 0.5 * dth);
     y_ += ds * std::sin(th_ + 0.5 * dth);
     th_ += dth;
@@ -289,7 +342,10 @@ class Robot {
   const Options& o_;
   std::mt19937_64& g_;
   std::mt19937_64& gx_;  ///< second stream: bump_outliers, standstill_motion, run_time_offset
+  std::mt19937_64& gs_;  ///< third stream: castor_swivel's signs after reversals
   bool moved_ = false;   ///< a motion since the last standstill (standstill_motion)
+  double last_v_ = 0.0, last_w_ = 0.0;  ///< true speed and turn rate of the last moving step (stop_slide)
+  int turn_sign_ = 0, drive_dir_ = 0;   ///< castor_swivel: the last spot turn since a leg; the last leg's direction
   double tau_run_ = 0.0;
   std::array<double, 2> next_bump_{0.0, 0.0};
   double dl_true_, dr_true_, b_true_, phase_L_ = 0.0, phase_R_ = 0.0;
@@ -362,13 +418,14 @@ int main(int argc, char** argv) {
   const Options o = Parse(argc, argv);
   std::mt19937_64 g(o.seed);
   std::mt19937_64 gx(o.seed ^ 0x9E3779B97F4A7C15ULL);
+  std::mt19937_64 gs(o.seed ^ 0xC2B2AE3D27D4EB4FULL);
   std::filesystem::create_directories(o.out);
   // Squares: 10 cw + 10 ccw alternating; each: pause, 4 x (leg, pause, turn, pause).
   std::vector<std::pair<std::string, std::vector<Sample>>> squares, fwd_back;
   const double inner_pause = o.pause_s, end_pause = std::max(o.pause_s, 1.0);
   for (int r = 0; r < 20; ++r) {
     const bool cw = r % 2 == 0;
-    Robot robot(o, g, gx);
+    Robot robot(o, g, gx, gs);
     robot.Pause(end_pause);
     for (int leg = 0; leg < 4; ++leg) {
       robot.Leg(o.side_m, leg == 0 || inner_pause > 0.0);
@@ -380,7 +437,7 @@ int main(int argc, char** argv) {
   }
   // Back and forth: pause, forward, pause, back, pause.
   for (int r = 0; r < 20; ++r) {
-    Robot robot(o, g, gx);
+    Robot robot(o, g, gx, gs);
     robot.Pause(end_pause);
     robot.Leg(o.distance_m, true);
     robot.Pause(inner_pause);
@@ -394,7 +451,7 @@ int main(int argc, char** argv) {
   const double stop_pause = std::max(o.pause_s, 0.5);
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   for (int r = 0; r < static_cast<int>(o.free_runs); ++r) {
-    Robot robot(o, g, gx);
+    Robot robot(o, g, gx, gs);
     robot.Pause(end_pause);
     for (int s = 0; s < 3; ++s) {
       std::vector<std::array<double, 2>> arcs(u01(g) < 0.5 ? 2 : 3);

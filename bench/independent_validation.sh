@@ -37,7 +37,10 @@
 #            sigma_xy_gt, sigma_theta = f sqrt(2) sigma_theta_gt, the ground
 #            truth's noise across a standstill; run_time_offset tau_sd =
 #            f2 sqrt(2) sigma_xy_gt / v). The pair classes are drawn after
-#            all others, so the other classes keep their campaigns.
+#            all others, so the other classes keep their campaigns;
+#            stop_slide (d v^2 = f sd_along of a <= 1 m piece, a w^2 = f2
+#            sd_heading of one, no acceleration limit: hard braking) and
+#            castor_swivel (kappa as castor_kick) after the pairs.
 #
 # Usage: bench/independent_validation.sh [BUILD_DIR] [N] [SEED] [PROFILE]
 #   N campaigns per single/outside/pair class, 2N clean and 2N negligible.
@@ -73,7 +76,7 @@ function S() { return rand() < 0.5 ? -1 : 1 }
 function LU(a, b) { return exp(U(log(a), log(b))) }
 BEGIN {
   srand(seed); pi = 3.141592653589793
-  nc = split("none negligible scale_error castor_kick gt_offset time_offset direction_asymmetry gt_yaw_misalignment floor_slope pair_castor_bumps pair_time_gt pair_scale_castor pair_settle_clock", cls, " ")
+  nc = split("none negligible scale_error castor_kick gt_offset time_offset direction_asymmetry gt_yaw_misalignment floor_slope pair_castor_bumps pair_time_gt pair_scale_castor pair_settle_clock stop_slide castor_swivel", cls, " ")
   id = 0
   for (c = 1; c <= nc; ++c) {
     count = (cls[c] == "none" || cls[c] == "negligible") ? 2 * n : n
@@ -125,6 +128,17 @@ BEGIN {
       if (cls[c] == "pair_settle_clock")
         eff = sprintf("standstill_motion:sigma_xy=%.6g,sigma_theta=%.6g --effect run_time_offset:tau_sd=%.6g", \
                       f * sqrt(2) * gxy, f * sqrt(2) * gth, f2 * sqrt(2) * gxy / v)
+      # Issue 21's physics effects, drawn after everything else: a slide of
+      # f times one piece's along-track noise after a leg at full speed and
+      # of f2 times a piece's heading noise after a spot turn (hard braking:
+      # no acceleration limit, else the robot stops at creep speed and
+      # barely slides); a swivel castor sized like castor_kick.
+      if (cls[c] == "stop_slide") {
+        f2 = U(3, 5); accel = 0
+        eff = sprintf("stop_slide:d=%.6g,a=%.6g", f * sqrt(k2 * (side < 1 ? side : 1)) / (v * v), \
+                      f2 * sqrt(2 * k2 * (side < 1 ? side : 1)) / b / (w * w))
+      }
+      if (cls[c] == "castor_swivel") eff = sprintf("castor_swivel:kappa=%.6g", S() * f * sqrt(2 * k2 * (side < 1 ? side : 1)) / b)
       design = sprintf("%dHz/%dticks/%s/%s/%s/%s", rate, ticks, pause ? "pauses" : "no-pauses", accel > 0 ? "accel" : "no-accel", hold > 0 ? "hold" : "no-hold", free ? "free" : "no-free")
       printf "%03d %s %s --seed %d --wheelbase %.6g --diameter %.6g --kl %.6g --kr %.6g --gt-sigma-xy %.6g --gt-sigma-theta %.6g --side %.6g --distance %.6g --speed %.6g --turn-rate %.6g --rate %d --ticks %d --pause %d --accel %.6g --heading-hold %.6g --free %d --E-d %.8g --E-b %.8g%s\n", \
         id, cls[c], design, seed * 1000 + id, b, d, kl, kr, gxy, gth, side, dist, v, w, rate, ticks, pause, accel, hold, free, ed, eb, eff == "" ? "" : " --effect " eff
@@ -201,7 +215,7 @@ end=$(date +%s.%N)
 
 echo
 echo "per class (right = verdict none / the effect / unexplained for outside effects)${BEFORE:+; before = $BEFORE}:"
-for c in none negligible scale_error castor_kick gt_offset time_offset direction_asymmetry gt_yaw_misalignment floor_slope; do
+for c in none negligible scale_error castor_kick gt_offset time_offset direction_asymmetry gt_yaw_misalignment floor_slope stop_slide castor_swivel; do
   [[ -n "${total[$c]:-}" ]] && printf '  %-20s %d/%d%s\n' "$c" "${right[$c]}" "${total[$c]}" "${BEFORE:+   before ${bright[$c]}/${total[$c]}}"
 done
 pairs=0; pairs_right=0

@@ -470,7 +470,7 @@ TEST_CASE("umbmark diagnose: contract JSON, report, plot", "[diagnose][cli]") {
   CHECK(j["gap"]["where"].is_array());
   REQUIRE_FALSE(j["gap"]["where"].empty());
   for (const char* k : {"experiment", "subset", "statistic", "size_se"}) CHECK(j["gap"]["where"][0].contains(k));
-  REQUIRE(j["candidates"].size() == 12);  // every contract effect
+  REQUIRE(j["candidates"].size() == 14);  // every contract effect
   for (const auto& cd : j["candidates"]) {
     CHECK(cd["effect"].is_string());
     CHECK(cd["params"].is_object());

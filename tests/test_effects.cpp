@@ -105,7 +105,7 @@ TEST_CASE("effects: spec parsing round-trips and rejects bad specs", "[effects]"
   Effects bad;
   bad.noise_rho = 1.5;
   CHECK_THAT(bad.Check(), Catch::Contains("correlated_noise.rho"));
-  CHECK(ContractEffects().size() == 12);  // the contract's nine plus standstill_motion, motion_noise_floor, run_time_offset
+  CHECK(ContractEffects().size() == 14);  // the nine, standstill_motion, motion_noise_floor, run_time_offset, stop_slide, castor_swivel
 }
 
 TEST_CASE("simulate: nominal robot, no noise: ground truth follows the commanded path", "[effects]") {

@@ -13,7 +13,9 @@ namespace umbmark::diag {
 
 namespace {
 /// Scale and unit an engineer reads a parameter in.
-std::pair<double, const char*> ParamUnit(const std::string& name) {
+std::pair<double, const char*> ParamUnit(const std::string& name, const std::string& effect) {
+  // stop_slide: d [s^2/m] and a [s^2/rad] in their own units.
+  if (effect == "stop_slide" || name == "d") return {1.0, name == "a" ? " s^2/rad" : " s^2/m"};
   if (name == "dx" || name == "dy" || name == "sigma" || name == "sigma_xy") return {1e3, " mm"};
   if (name == "kappa" || name == "sigma_theta") return {1e3, " mrad"};
   if (name == "tau" || name == "tau_sd") return {1e3, " ms"};
@@ -29,14 +31,14 @@ std::pair<double, const char*> ParamUnit(const std::string& name) {
 }
 }  // namespace
 
-std::string FormatEffectParam(const std::string& name, double v, double se) {
+std::string FormatEffectParam(const std::string& name, double v, double se, const std::string& effect) {
   // A given model's lengths (wheelbase_m, wheel_diameter_left_m, ...): to
   // 10 micrometres, so that a millimetre's correction shows.
   if (name.size() > 2 && name.ends_with("_m")) {
     if (std::isfinite(se)) return fmt::format("{} = {:.5f} m (se {:.2g} mm)", name, v, 1e3 * se);
     return fmt::format("{} = {:.5f} m", name, v);
   }
-  const auto [scale, unit] = ParamUnit(name);
+  const auto [scale, unit] = ParamUnit(name, effect);
   if (std::isfinite(se)) return fmt::format("{} = {:.3g}{} (se {:.2g})", name, scale * v, unit, scale * se);
   return fmt::format("{} = {:.3g}{}", name, scale * v, unit);
 }
@@ -158,11 +160,16 @@ std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSu
     out.push_back("These effects fitted impossible values, so the gap is something else that they try to imitate: " +
                   fmt::format("{}", fmt::join(symptoms, "; ")) + ".");
   for (auto& m : MissingDesign(c)) out.push_back(std::move(m));
+  // The verdict is `unexplained`: what the listed effects close is part of
+  // the answer, not the answer (the verdict's reason says why: a
+  // significant gap is left, or too little is closed held out).
   if (!s.verdict_effects.empty())
-    out.push_back(fmt::format("{} close{} part of the gap ({:.0f}% stays unexplained on held-out runs): model {} "
-                              "and diagnose again; what is left is what to look for.",
-                              fmt::join(s.verdict_effects, " + "), s.verdict_effects.size() > 1 ? "" : "s",
-                              100.0 * s.unexplained_fraction, s.verdict_effects.size() > 1 ? "them" : "it"));
+    out.push_back(fmt::format("No listed effect explains this gap (the verdict). The candidates {} close {:.0f}% of "
+                              "it on held-out runs, and what they leave is still significant or too large: check "
+                              "them one at a time (model {}, diagnose again) and look at what is left; it is "
+                              "something the list does not name.",
+                              fmt::join(s.verdict_effects, " + "), 100.0 * (1.0 - s.unexplained_fraction),
+                              s.verdict_effects.size() > 1 ? "them" : "it"));
   out.push_back("Check the recording itself: one clock for encoders and ground truth, the marker rigidly on the "
                 "robot, the same floor and load for every run. docs/diagnosis.md lists what each effect looks like.");
   return out;

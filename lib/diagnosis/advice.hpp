@@ -22,8 +22,11 @@ struct DiagnoseSummary;
 /// "name = value unit": mm (dx, dy, sigma, sigma_xy), mrad (kappa,
 /// sigma_theta), ms (tau, tau_sd), per metre (rate), per run (r);
 /// percent (s, a); dimensionless factors (k, rho) as they are. `se`: its
-/// standard error in the same unit, when finite.
-std::string FormatEffectParam(const std::string& name, double value, double se = NAN);
+/// standard error in the same unit, when finite. `effect`: the effect the
+/// parameter belongs to, where a name means two things (stop_slide's d in
+/// s^2/m and a in s^2/rad; direction_asymmetry's a in percent).
+std::string FormatEffectParam(const std::string& name, double value, double se = NAN,
+                              const std::string& effect = "");
 
 /// "< 1e-12" below 1e-12 (beyond what the chi^2 and bootstrap
 /// approximations can vouch for), else three significant digits.

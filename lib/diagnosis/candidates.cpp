@@ -26,10 +26,36 @@ std::vector<int> EffectParams(sim::EffectKind k) {
     case sim::EffectKind::kParameterDrift: return {kParamDrift};
     case sim::EffectKind::kGtOffset: return {kParamDx, kParamDy};
     case sim::EffectKind::kTimeOffset: return {kParamTau};
+    case sim::EffectKind::kStopSlide: return {kParamSlideD, kParamSlideA};
+    case sim::EffectKind::kCastorSwivel: return {kParamSwivel};
     case sim::EffectKind::kWheelbaseError: return {kParamEb};
     case sim::EffectKind::kDiameterRatioError: return {kParamEd};
     default: return {};
   }
+}
+
+std::vector<int> EffectParams(sim::EffectKind k, const CampaignData& c) {
+  if (k != sim::EffectKind::kStopSlide) return EffectParams(k);
+  bool line_stop = false;
+  double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+  for (const DiagRun& r : c.runs)
+    for (const DiagRun::Stop& st : r.stops) {
+      if (st.cls != static_cast<signed char>(sim::MotionClass::kTurn)) {
+        line_stop = true;
+        continue;
+      }
+      if (!(st.turn_m > 0.0)) continue;
+      const double w = st.rate_right - st.rate_left, ratio = w * w / st.turn_m;
+      lo = std::min(lo, ratio);
+      hi = std::max(hi, ratio);
+    }
+  // The turn part needs slides that differ from E_b's constant share of
+  // the angle by more than 20 % between turns.
+  const bool turn_part = hi > 0.0 && hi > 1.2 * lo;
+  std::vector<int> out;
+  if (line_stop || !turn_part) out.push_back(kParamSlideD);
+  if (turn_part) out.push_back(kParamSlideA);
+  return out;
 }
 
 /// A typical size of each effect parameter (the realistic ranges of the
@@ -45,6 +71,12 @@ double TypicalMagnitude(int param) {
     case kParamDx:
     case kParamDy: return 0.01;
     case kParamTau: return 0.02;
+    // castor_swivel: as castor_kick; stop_slide: 8 mm after a leg at 0.35
+    // m/s (d = 0.065 s^2/m, a friction coefficient of 0.8), 10 mrad after a
+    // spot turn at 1 rad/s.
+    case kParamSwivel: return 0.005;
+    case kParamSlideD: return 0.065;
+    case kParamSlideA: return 0.01;
     default: return 1.0;
   }
 }
@@ -136,8 +168,13 @@ bool Identify(const Shared& x, const std::vector<int>& eparams, Candidate& cd, E
   bool identifiable = true;
   int mimics = kParamEd;
   double weakest = std::numeric_limits<double>::infinity();  // typical size / se
+  // A parameter these data do not show at all (stop_slide's turn part on
+  // straight runs only) stays at 0; the others decide.
+  Eigen::Index shown = 0;
+  for (Eigen::Index k = 0; k < Jw_e.cols(); ++k) shown += Jw_e.col(k).norm() > 0.0 ? 1 : 0;
   for (Eigen::Index k = 0; k < Jw_e.cols(); ++k) {
     const double raw = Jw_e.col(k).norm(), perp = proj.col(k).norm();
+    if (!(raw > 0.0) && shown > 0) continue;
     const double se = perp > 0.0 ? 1.0 / perp : std::numeric_limits<double>::infinity();
     const double typical = TypicalMagnitude(eparams[static_cast<std::size_t>(k)]);
     weakest = std::min(weakest, typical / se);
@@ -182,6 +219,88 @@ bool Identify(const Shared& x, const std::vector<int>& eparams, Candidate& cd, E
   return true;
 }
 
+/// The pieces that end at a moving sample: neither a standstill piece nor
+/// one that ends at a stop (nor an endpoint run's return error). Their
+/// ground truth shows a clock offset (the samples while the robot moves lag
+/// or lead by tau) but never a slide at a stop, which acts only on the
+/// pieces that end there.
+std::vector<char> MovingSamplePieces(const CampaignData& c) {
+  std::vector<char> use(c.pieces.size(), 0);
+  for (std::size_t j = 0; j < c.pieces.size(); ++j) {
+    const Piece& p = c.pieces[j];
+    use[j] = p.type != PieceType::kStand && p.type != PieceType::kReturn && !p.ends_at_standstill ? 1 : 0;
+  }
+  return use;
+}
+
+int Count(const std::vector<char>& use) { return static_cast<int>(std::count(use.begin(), use.end(), 1)); }
+
+/// time_offset refitted (with E_d, E_b) on the moving samples alone, with
+/// the noise and weights of the full fit `mf`: is it there too?
+void CheckTimeOffset(const Shared& x, const std::vector<Eigen::Matrix3d>& We, const MeanFit& mf, Candidate& cd) {
+  const std::vector<char> use = MovingSamplePieces(x.c);
+  std::vector<Eigen::Matrix3d> Wm = We;
+  for (std::size_t j = 0; j < Wm.size(); ++j)
+    if (!use[j]) Wm[j].setZero();
+  std::vector<int> joint = x.b.free;
+  joint.push_back(kParamTau);
+  const MeanFit mm = FitMean(x.model, x.b.p, joint, Wm, MeanFitOptions{12});
+  Eigen::VectorXd r;
+  Eigen::MatrixXd J;
+  Whiten(Wm, mm.eps, mm.D, r, J);
+  const Eigen::MatrixXd info = J.transpose() * J;
+  const Eigen::Index t = info.cols() - 1;
+  const Eigen::MatrixXd cov = info.ldlt().solve(Eigen::MatrixXd::Identity(info.rows(), info.cols()));
+  Candidate::ClockCheck& k = cd.clock;
+  k.checked = true;
+  k.pieces = Count(use);
+  k.value = mm.p[kParamTau];
+  k.se = info(t, t) > 0.0 ? std::sqrt(std::max(0.0, cov(t, t))) : std::numeric_limits<double>::infinity();
+  const double full = mf.p[kParamTau];
+  k.supported = std::isfinite(k.se) && std::abs(k.value) >= 3.0 * k.se && k.value * full > 0.0;
+  k.text = fmt::format(
+      "the clock offset on the moving samples alone (the ends of {} pieces that do not end at a stop: a slide "
+      "cannot act there) is tau = {:.1f} ms (se {:.1f}), on all pieces {:.1f} ms: {}",
+      k.pieces, 1e3 * k.value, 1e3 * k.se, 1e3 * full,
+      k.supported ? "the moving samples carry the evidence"
+                  : "the moving samples do not support it, so the evidence lies at the stops (a slide or settling "
+                    "there, not a clock); never named");
+}
+
+/// run_time_offset refitted on the moving samples alone (see
+/// CheckTimeOffset): supported when it keeps half the full fit's tau_sd or
+/// is significant there.
+void CheckRunTimeOffset(const Shared& x, const std::vector<PieceBases>& bases, const NoiseParams& ne,
+                        const PieceNoiseFitOptions& cf, Candidate& cd) {
+  const std::vector<char> use = MovingSamplePieces(x.c);
+  const NoiseParams nm = FitPieceNoise(x.b.eps, bases, x.c.pieces, use, ne, cf);
+  // The same pieces without run_time_offset: its likelihood-ratio test there
+  // (pieces taken one by one, the run blocks' correlation left out).
+  PieceNoiseFitOptions cf0 = cf;
+  cf0.run_time = false;
+  const NoiseParams n0 = FitPieceNoise(x.b.eps, bases, x.c.pieces, use, ne, cf0);
+  double gain = 0.0;
+  for (std::size_t j = 0; j < use.size(); ++j)
+    if (use[j])
+      gain += PieceLogLik(&x.b.eps[3 * j], x.c.pieces[j].components, bases[j], nm) -
+              PieceLogLik(&x.b.eps[3 * j], x.c.pieces[j].components, bases[j], n0);
+  Candidate::ClockCheck& k = cd.clock;
+  k.checked = true;
+  k.pieces = Count(use);
+  k.value = std::sqrt(nm.run_tau2);
+  const double full = std::sqrt(ne.run_tau2);
+  // Half the full fit's spread, or significant there on its own (chi^2_1 at
+  // 0.1 %: 2 x 5.4 nats).
+  k.supported = k.pieces > 0 && (k.value >= 0.5 * full || gain > 5.4);
+  k.text = fmt::format(
+      "the per-run clock offsets on the moving samples alone (the ends of {} pieces that do not end at a stop) "
+      "have tau_sd = {:.1f} ms ({:+.1f} nats there), on all pieces {:.1f} ms: {}",
+      k.pieces, 1e3 * k.value, gain, 1e3 * full,
+      k.supported ? "the moving samples carry the evidence"
+                  : "the moving samples do not support them, so the evidence lies at the stops (a slide or "
+                    "settling there, not a clock); never named");
+}
+
 /// A mean effect fitted jointly with E_d, E_b.
 MeanFit FitMeanEffect(const Shared& x, sim::EffectKind kind, const std::vector<int>& eparams, Candidate& cd) {
   const CampaignData& c = x.c;
@@ -193,18 +312,34 @@ MeanFit FitMeanEffect(const Shared& x, sim::EffectKind kind, const std::vector<i
   std::vector<PieceBases> scrub_bases;
   if (kind == sim::EffectKind::kTurnScrub) scrub_bases = ComputeBases(c, x.model, mf.p);
   const std::vector<PieceBases>& bases = kind == sim::EffectKind::kTurnScrub ? scrub_bases : x.b.bases;
-  NoiseParams ne = FitPieceNoise(mf.eps, bases, c.pieces, {}, x.b.noise, x.b.noise_fit);
+  // castor_swivel's random kicks after reversals: kappa^2 of heading
+  // variance there, from the fitted kappa.
+  NoiseParams start = x.b.noise;
+  start.swivel_rev2 = mf.p[kParamSwivel] * mf.p[kParamSwivel];
+  NoiseParams ne = FitPieceNoise(mf.eps, bases, c.pieces, {}, start, x.b.noise_fit);
   const std::vector<Eigen::Matrix3d> We = Whiteners(bases, c.pieces, ne);
   // Parameter standard errors with the refitted noise.
   Eigen::VectorXd r2;
   Eigen::MatrixXd J2;
   Whiten(We, mf.eps, mf.D, r2, J2);
-  const Eigen::MatrixXd cov = (J2.transpose() * J2).ldlt().solve(Eigen::MatrixXd::Identity(J2.cols(), J2.cols()));
-  for (std::size_t k = 0; k < eparams.size(); ++k) {
-    const auto at = static_cast<Eigen::Index>(x.b.free.size() + k);
-    cd.params[ParamName(eparams[k])] = mf.p[eparams[k]];
-    cd.param_se[ParamName(eparams[k])] = std::sqrt(std::max(0.0, cov(at, at)));
+  // Columns the data do not show (Identify) stay out of the covariance.
+  Eigen::MatrixXd J2s(J2.rows(), 0);
+  std::vector<Eigen::Index> at(static_cast<std::size_t>(J2.cols()), -1);
+  for (Eigen::Index k = 0; k < J2.cols(); ++k) {
+    if (!(J2.col(k).norm() > 0.0)) continue;
+    J2s.conservativeResize(Eigen::NoChange, J2s.cols() + 1);
+    J2s.col(J2s.cols() - 1) = J2.col(k);
+    at[static_cast<std::size_t>(k)] = J2s.cols() - 1;
   }
+  const Eigen::MatrixXd cov = (J2s.transpose() * J2s).ldlt().solve(Eigen::MatrixXd::Identity(J2s.cols(), J2s.cols()));
+  int shown = 0;
+  for (std::size_t k = 0; k < eparams.size(); ++k) {
+    const Eigen::Index a = at[x.b.free.size() + k];
+    cd.params[ParamName(eparams[k])] = mf.p[eparams[k]];
+    cd.param_se[ParamName(eparams[k])] = a >= 0 ? std::sqrt(std::max(0.0, cov(a, a))) : 0.0;
+    shown += a >= 0 ? 1 : 0;
+  }
+  cd.parameters = std::max(1, shown);
   cd.E_d = mf.p[kParamEd];
   cd.E_b = mf.p[kParamEb];
   LikelihoodRatioTest(cd, TotalLogLik(c, bases, mf.eps, ne), x.ll_base);
@@ -218,6 +353,7 @@ MeanFit FitMeanEffect(const Shared& x, sim::EffectKind kind, const std::vector<i
   cd.heldout_loglik_gain = cv.loglik - x.cv_ll_base;
   const double gcv = ComputeGap(c, cv.scores, x.options.gap).score;
   cd.heldout_shrink = Shrink(Gap(gcv, x.null_median), x.gap_cv_before);
+  if (kind == sim::EffectKind::kTimeOffset) CheckTimeOffset(x, We, mf, cd);
   return mf;
 }
 
@@ -260,6 +396,7 @@ void FitNoiseEffect(const Shared& x, sim::EffectKind kind, Candidate& cd) {
   cd.heldout_loglik_gain = cv.loglik - x.cv_ll_base;
   const double gcv = ComputeGap(c, cv.scores, x.options.gap).score;
   cd.heldout_shrink = Shrink(Gap(gcv, x.null_median), x.gap_cv_before);
+  if (kind == sim::EffectKind::kRunTimeOffset) CheckRunTimeOffset(x, bases, ne, cf, cd);
   // With the wheel noise given (diagnose --baseline --kl --kr), bumps at
   // their rate bound are their Gaussian limit: many small travel errors,
   // rate x sigma_b^2 of variance per metre, i.e. wheel noise growing with
@@ -310,13 +447,19 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
     const sim::EffectKind kind = effects[ei];
     Candidate& cd = out.candidates[ei];
     cd.effect = kind;
-    const std::vector<int> eparams = EffectParams(kind);
+    const std::vector<int> eparams = EffectParams(kind, c);
     if (!eparams.empty()) {
       cd.parameters = static_cast<int>(eparams.size());
       // A parameter error frees a baseline parameter itself: nothing to
       // tell it apart from.
       if (!sim::IsParameterError(kind) && !Identify(x, eparams, cd, out.projected[ei])) return;
       mean_fits[ei] = FitMeanEffect(x, kind, eparams, cd);
+      if (kind == sim::EffectKind::kStopSlide && eparams.size() < EffectParams(kind).size())
+        cd.note = std::string(cd.note.empty() ? "" : cd.note + "; ") +
+                  (std::find(eparams.begin(), eparams.end(), kParamSlideA) == eparams.end()
+                       ? "its turn part a is not fitted: every spot turn here has the same angle and rate, so a "
+                         "slide after it is a constant extra turn, which the baseline's E_b absorbs"
+                       : "its straight part d is not fitted: no stop after a straight or arc motion");
     } else if (IsNoiseEffect(kind)) {
       FitNoiseEffect(x, kind, cd);
     } else {
@@ -336,7 +479,7 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
   for (std::size_t i = 0; i < effects.size(); ++i) {
     if (mean_fits[i].eps.empty()) continue;
     std::vector<int> key = b.free;
-    for (int k : EffectParams(effects[i])) key.push_back(k);
+    for (int k : EffectParams(effects[i], c)) key.push_back(k);
     out.mean_fits.emplace(std::move(key), std::move(mean_fits[i]));
   }
   return out;

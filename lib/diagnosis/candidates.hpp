@@ -55,10 +55,33 @@ struct Candidate {
   bool impossible = false;
   std::array<double, kNumStatKinds> gap_by_kind{};
   std::string note;
+  /// time_offset, run_time_offset: the clock refitted on the moving
+  /// samples alone (ClockCheck). A clock offset moves every ground-truth
+  /// sample taken while the robot moves (by about v tau along track); a
+  /// slide at a stop (stop_slide) moves only the samples after the stop.
+  struct ClockCheck {
+    bool checked = false;
+    /// The moving samples show the clock offset too: the refit stands 3
+    /// standard errors out with the full fit's sign (time_offset), or keeps
+    /// at least half the full fit's tau_sd or gains more than 5.4 nats there
+    /// (run_time_offset).
+    bool supported = true;
+    int pieces = 0;            ///< pieces that end at a moving sample (not at a stop)
+    double value = 0.0;        ///< tau [s] or tau_sd [s] refitted on them
+    double se = 0.0;           ///< its standard error (time_offset; 0 otherwise)
+    std::string text;          ///< which samples carry the evidence, in words
+  };
+  ClockCheck clock;
 };
 
 /// Mean-model parameters of an effect (empty for the noise effects).
 std::vector<int> EffectParams(sim::EffectKind k);
+/// The mean-model parameters of an effect these runs can show: stop_slide's
+/// d only with a stop after a straight or arc motion, its a only when the
+/// spot turns' slides a w^2 are not proportional to their angles (turns of
+/// one angle at one rate: a constant extra turn, E_b's footprint), else
+/// EffectParams(k). Never empty for a mean effect.
+std::vector<int> EffectParams(sim::EffectKind k, const CampaignData& c);
 
 /// The effects the piece noise model carries (piece_noise.hpp):
 /// correlated_noise, bump_outliers, standstill_motion, motion_noise_floor,

@@ -195,6 +195,17 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, Diagnose
             fmt::join(named, " + "), 100.0 * heldout, negligible_text);
       }
     } else {
+      // Still unexplained: say how far the explanation got and why that is
+      // not enough, so that the next steps (advice.cpp) and the verdict
+      // tell the same story.
+      if (!named.empty())
+        out.verdict_reason += fmt::format(
+            "; {} together close {:.0f}% of the gap on held-out runs but {}, so no combination of the listed "
+            "effects explains it",
+            fmt::join(named, " + "), 100.0 * heldout,
+            ex.gap_left ? fmt::format("leave a significant gap (G = {:.1f} > {:.1f})", ex.steps.back().gap_after,
+                                      out.null_quantile_alpha)
+                        : fmt::format("close less than {:.0f}% of it", 100.0 * options.min_heldout_shrink));
       out.verdict_reason += negligible_text;
     }
   } else if (!ex.steps.empty()) {

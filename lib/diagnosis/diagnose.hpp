@@ -103,7 +103,7 @@ struct DiagnoseOptions {
   double negligible = 0.25;
   /// Most effects in the stepwise explanation (>= 1). Default 4.
   int max_explanation_effects = 4;
-  /// Effects to try (empty: the contract's twelve; with `given`, also its
+  /// Effects to try (empty: the contract's fourteen; with `given`, also its
   /// parameter errors).
   std::vector<sim::EffectKind> effects;
   /// The user's simulation model as the baseline (`--baseline CAL.json

@@ -33,10 +33,11 @@ struct SetFit {
 /// The mean parameters a set of effects fits: the baseline's free ones
 /// (E_d, E_b; none against a given model), then each mean effect's
 /// parameters in the set's order.
-std::vector<int> MeanParamsOf(const std::vector<int>& free, const std::vector<sim::EffectKind>& set) {
+std::vector<int> MeanParamsOf(const CampaignData& c, const std::vector<int>& free,
+                              const std::vector<sim::EffectKind>& set) {
   std::vector<int> params = free;
   for (sim::EffectKind e : set)
-    for (int k : EffectParams(e)) params.push_back(k);
+    for (int k : EffectParams(e, c)) params.push_back(k);
   return params;
 }
 
@@ -79,9 +80,16 @@ SetFit FitSet(const CampaignData& c, const MeanModel& model, const BaselineFit& 
   SetFit out;
   out.p = mf.p;
   // Bumps and rho together: the bump mixture (its fit has no rho).
-  out.noise = bumps ? (warm ? FitBumps(mf.eps, mean_bases, c.pieces, {}, *warm, /*start_only=*/true, nf.fit_wheel_noise)
-                             : FitBumps(mf.eps, mean_bases, c.pieces, {}, b.noise, /*start_only=*/false, nf.fit_wheel_noise))
-                    : FitPieceNoise(mf.eps, mean_bases, c.pieces, {}, b.noise, nf);
+  // castor_swivel's random kicks after reversals (kappa^2 of heading
+  // variance there) follow the set's fitted kappa.
+  const double swivel_rev2 = mf.p[kParamSwivel] * mf.p[kParamSwivel];
+  NoiseParams start = b.noise, warm_start = warm ? *warm : b.noise;
+  start.swivel_rev2 = warm_start.swivel_rev2 = swivel_rev2;
+  if (bumps)
+    out.noise = FitBumps(mf.eps, mean_bases, c.pieces, {}, warm ? warm_start : start, /*start_only=*/warm != nullptr,
+                         nf.fit_wheel_noise);
+  else
+    out.noise = FitPieceNoise(mf.eps, mean_bases, c.pieces, {}, start, nf);
   if (!bumps && Contains(set, sim::EffectKind::kRunTimeOffset))
     out.rescaled = RescaleTimeLevers(model, mf.p, mean_bases, out.noise,
                                      [&](const std::vector<PieceBases>& bs, const NoiseParams& s) {
@@ -114,7 +122,7 @@ class MeanPartCache {
   void Prepare(const std::vector<std::vector<sim::EffectKind>>& sets) {
     std::vector<std::vector<int>> missing;
     for (const auto& set : sets) {
-      std::vector<int> key = MeanParamsOf(b_.free, set);
+      std::vector<int> key = MeanParamsOf(c_, b_.free, set);
       if (parts_.count(key) || std::find(missing.begin(), missing.end(), key) != missing.end()) continue;
       if (const auto it = known_.find(key); it != known_.end()) {
         parts_.emplace(key, MeanPartFrom(c_, model_, it->second, key));
@@ -129,7 +137,7 @@ class MeanPartCache {
     for (std::size_t i = 0; i < missing.size(); ++i) parts_.emplace(std::move(missing[i]), std::move(fitted[i]));
   }
   /// The mean part of `set` (Prepare'd before).
-  const MeanPart& Get(const std::vector<sim::EffectKind>& set) const { return parts_.at(MeanParamsOf(b_.free, set)); }
+  const MeanPart& Get(const std::vector<sim::EffectKind>& set) const { return parts_.at(MeanParamsOf(c_, b_.free, set)); }
 
  private:
   const CampaignData& c_;
@@ -143,7 +151,7 @@ class MeanPartCache {
 std::map<std::string, double> ParamsOf(sim::EffectKind e, const SetFit& f) {
   if (IsNoiseEffect(e)) return NoiseEffectParams(e, f.noise);
   std::map<std::string, double> out;
-  for (int k : EffectParams(e)) out[ParamName(k)] = f.p[k];
+  for (int k : EffectParams(e)) out[ParamName(k)] = f.p[k];  // a parameter not fitted stays 0
   return out;
 }
 
@@ -195,10 +203,12 @@ void MedianSdChange(std::size_t pieces, const With& with, const Without& without
   s.size_mrad = 1e3 * Median(head);
 }
 
-/// Practical size of effect e within the joint fit f (see explanation.hpp).
-void Size(const CampaignData& c, const MeanModel& model, const BaselineFit& base,
-          const std::vector<PieceBases>& bases, const PieceScatter& noise, const SetFit& f, sim::EffectKind e,
-          ExplanationStep& s) {
+/// Size of an effect that acts like wheel noise (correlated_noise,
+/// bump_outliers, wheel_noise_error): the relative change of the wheel
+/// noise's sd, with the change of one piece's scatter in mm / mrad beside
+/// it. False for the other effects.
+bool SizeWheelNoiseLike(const BaselineFit& base, const std::vector<PieceBases>& bases, const SetFit& f,
+                        sim::EffectKind e, ExplanationStep& s) {
   const double kL2 = f.noise.kL2, kR2 = f.noise.kR2, kbar2 = 0.5 * (kL2 + kR2);
   // correlated_noise and bump_outliers act like wheel noise: sized by the
   // relative change of its sd, with the change of one piece's scatter in
@@ -212,7 +222,7 @@ void Size(const CampaignData& c, const MeanModel& model, const BaselineFit& base
     MedianSdChange(
         bases.size(), [&](std::size_t j) -> Eigen::Matrix3d { return PieceCovariance(bases[j], f.noise); },
         [&](std::size_t j) -> Eigen::Matrix3d { return PieceCovariance(bases[j], without); }, s);
-    return;
+    return true;
   }
   if (e == sim::EffectKind::kBumpOutliers) {
     const double b2 = f.noise.bump_rate * f.noise.bump_s2;
@@ -221,7 +231,7 @@ void Size(const CampaignData& c, const MeanModel& model, const BaselineFit& base
         bases.size(),
         [&](std::size_t j) -> Eigen::Matrix3d { return PieceCovariance(bases[j], f.noise) + b2 * (bases[j].A_L + bases[j].A_R); },
         [&](std::size_t j) -> Eigen::Matrix3d { return PieceCovariance(bases[j], f.noise); }, s);
-    return;
+    return true;
   }
   if (e == sim::EffectKind::kWheelNoiseError) {
     // A given model's wheel noise (baseline_given.hpp): how far the fitted
@@ -236,55 +246,65 @@ void Size(const CampaignData& c, const MeanModel& model, const BaselineFit& base
         bases.size(), [&](std::size_t j) -> Eigen::Matrix3d { return kL2 * bases[j].A_L + kR2 * bases[j].A_R; },
         [&](std::size_t j) -> Eigen::Matrix3d { return base.noise.kL2 * bases[j].A_L + base.noise.kR2 * bases[j].A_R; },
         s);
-    return;
+    return true;
   }
-  if (IsNoiseEffect(e) && e != sim::EffectKind::kRunTimeOffset) {
-    // Variance components act on some pieces only (a noise floor at the
-    // starts and stops of motions, settling at standstills) and matter
-    // most where the wheel noise is small: on short pieces. So the size is
-    // taken per piece type: for each type, the median over its pieces the
-    // effect acts on of the relative growth of the predicted position and
-    // heading sd (the larger counts), and its own sd there [mm, mrad]; the
-    // type where that median is largest counts (types with fewer than
-    // kMinPiecesPerType such pieces only when no type has that many).
-    NoiseParams without = f.noise;
-    if (e == sim::EffectKind::kStandstillMotion) without.stand_xy2 = without.stand_th2 = 0.0;
-    if (e == sim::EffectKind::kMotionNoiseFloor) without.floor_s2 = 0.0;
-    struct Spread {
-      std::vector<double> rel, pos, head;
-    };
-    std::map<PieceType, Spread> by_type;
-    for (std::size_t j = 0; j < bases.size(); ++j) {
-      const Eigen::Matrix3d A = PieceCovariance(bases[j], f.noise), B0 = PieceCovariance(bases[j], without);
-      // Sums first: A == B0 on a piece the effect does not act on must give
-      // exactly 0 (A00 + A11 - B00 - B11 leaves a rounding residue of
-      // ~1e-22 m^2, which counted every such piece as acted on, with a
-      // growth of 0, and made a standstill_motion acting on the last piece
-      // of each run only "negligible").
-      const double dp = (A(0, 0) + A(1, 1)) - (B0(0, 0) + B0(1, 1)), dh = A(2, 2) - B0(2, 2);
-      if (!(dp > 0.0 || dh > 0.0)) continue;
-      const double rp = std::sqrt((A(0, 0) + A(1, 1)) / std::max(B0(0, 0) + B0(1, 1), 1e-300)) - 1.0;
-      const double rh = std::sqrt(A(2, 2) / std::max(B0(2, 2), 1e-300)) - 1.0;
-      Spread& t = by_type[c.pieces[j].type];
-      t.rel.push_back(std::max(rp, rh));
-      t.pos.push_back(std::sqrt(std::max(dp, 0.0)));
-      t.head.push_back(std::sqrt(std::max(dh, 0.0)));
-    }
-    std::size_t most = 0;
-    for (const auto& [type, t] : by_type) most = std::max(most, t.rel.size());
-    s.relative_size = -1.0;
-    for (const auto& [type, t] : by_type) {
-      if (t.rel.size() < std::min(most, kMinPiecesPerType)) continue;
-      const double r = Median(t.rel);
-      if (r <= s.relative_size) continue;
-      s.relative_size = r;
-      s.size_mm = 1e3 * Median(t.pos);
-      s.size_mrad = 1e3 * Median(t.head);
-      s.size_pieces = PieceTypeToString(type);
-    }
-    s.relative_size = std::max(s.relative_size, 0.0);
-    return;
+  return false;
+}
+
+/// Size of a variance component that acts on some pieces only
+/// (standstill_motion, motion_noise_floor), per piece type.
+void SizeVarianceComponent(const CampaignData& c, const std::vector<PieceBases>& bases, const SetFit& f,
+                           sim::EffectKind e, ExplanationStep& s) {
+  // Variance components act on some pieces only (a noise floor at the
+  // starts and stops of motions, settling at standstills) and matter
+  // most where the wheel noise is small: on short pieces. So the size is
+  // taken per piece type: for each type, the median over its pieces the
+  // effect acts on of the relative growth of the predicted position and
+  // heading sd (the larger counts), and its own sd there [mm, mrad]; the
+  // type where that median is largest counts (types with fewer than
+  // kMinPiecesPerType such pieces only when no type has that many).
+  NoiseParams without = f.noise;
+  if (e == sim::EffectKind::kStandstillMotion) without.stand_xy2 = without.stand_th2 = 0.0;
+  if (e == sim::EffectKind::kMotionNoiseFloor) without.floor_s2 = 0.0;
+  struct Spread {
+    std::vector<double> rel, pos, head;
+  };
+  std::map<PieceType, Spread> by_type;
+  for (std::size_t j = 0; j < bases.size(); ++j) {
+    const Eigen::Matrix3d A = PieceCovariance(bases[j], f.noise), B0 = PieceCovariance(bases[j], without);
+    // Sums first: A == B0 on a piece the effect does not act on must give
+    // exactly 0 (A00 + A11 - B00 - B11 leaves a rounding residue of
+    // ~1e-22 m^2, which counted every such piece as acted on, with a
+    // growth of 0, and made a standstill_motion acting on the last piece
+    // of each run only "negligible").
+    const double dp = (A(0, 0) + A(1, 1)) - (B0(0, 0) + B0(1, 1)), dh = A(2, 2) - B0(2, 2);
+    if (!(dp > 0.0 || dh > 0.0)) continue;
+    const double rp = std::sqrt((A(0, 0) + A(1, 1)) / std::max(B0(0, 0) + B0(1, 1), 1e-300)) - 1.0;
+    const double rh = std::sqrt(A(2, 2) / std::max(B0(2, 2), 1e-300)) - 1.0;
+    Spread& t = by_type[c.pieces[j].type];
+    t.rel.push_back(std::max(rp, rh));
+    t.pos.push_back(std::sqrt(std::max(dp, 0.0)));
+    t.head.push_back(std::sqrt(std::max(dh, 0.0)));
   }
+  std::size_t most = 0;
+  for (const auto& [type, t] : by_type) most = std::max(most, t.rel.size());
+  s.relative_size = -1.0;
+  for (const auto& [type, t] : by_type) {
+    if (t.rel.size() < std::min(most, kMinPiecesPerType)) continue;
+    const double r = Median(t.rel);
+    if (r <= s.relative_size) continue;
+    s.relative_size = r;
+    s.size_mm = 1e3 * Median(t.pos);
+    s.size_mrad = 1e3 * Median(t.head);
+    s.size_pieces = PieceTypeToString(type);
+  }
+  s.relative_size = std::max(s.relative_size, 0.0);
+}
+
+/// Size of a mean effect (and run_time_offset): how far it moves the
+/// predicted ground truth of a typical run, against one piece's noise.
+void SizeMeanEffect(const CampaignData& c, const MeanModel& model, const BaselineFit& base,
+                    const PieceScatter& noise, const SetFit& f, sim::EffectKind e, ExplanationStep& s) {
   // Removing an effect sets its parameters back to the baseline's (0 for
   // the effects; the given model's E_d, E_b for a parameter error).
   // run_time_offset: a run whose offset is the typical tau_i = tau_sd is
@@ -330,8 +350,90 @@ void Size(const CampaignData& c, const MeanModel& model, const BaselineFit& base
   s.relative_size = std::max(np > 0.0 ? dp / np : 0.0, nh > 0.0 ? dh / nh : 0.0);
 }
 
+/// Practical size of effect e within the joint fit f (see explanation.hpp).
+void Size(const CampaignData& c, const MeanModel& model, const BaselineFit& base,
+          const std::vector<PieceBases>& bases, const PieceScatter& noise, const SetFit& f, sim::EffectKind e,
+          ExplanationStep& s) {
+  if (SizeWheelNoiseLike(base, bases, f, e, s)) return;
+  if (IsNoiseEffect(e) && e != sim::EffectKind::kRunTimeOffset) {
+    SizeVarianceComponent(c, bases, f, e, s);
+    return;
+  }
+  SizeMeanEffect(c, model, base, noise, f, e, s);
+}
+
 }  // namespace
 
+std::string PracticalFloor(sim::EffectKind effect, const std::map<std::string, double>& params, double negligible) {
+  const double scale = negligible / 0.25;
+  auto get = [&](const char* k) {
+    const auto it = params.find(k);
+    return it == params.end() ? 0.0 : std::abs(it->second);
+  };
+  if (!(scale > 0.0)) return {};
+  switch (effect) {
+    case sim::EffectKind::kTimeOffset:
+      if (get("tau") < 1.5e-3 * scale)
+        return fmt::format("a clock offset of {:.2f} ms (below {:.2g} ms: under half a millimetre at walking "
+                           "speed)", 1e3 * get("tau"), 1.5 * scale);
+      break;
+    case sim::EffectKind::kRunTimeOffset:
+      if (get("tau_sd") < 1.5e-3 * scale)
+        return fmt::format("per-run clock offsets of {:.2f} ms (below {:.2g} ms)", 1e3 * get("tau_sd"), 1.5 * scale);
+      break;
+    case sim::EffectKind::kScaleError:
+      if (get("s") < 3e-4 * scale)
+        return fmt::format("a common diameter error of {:.3f} % (below {:.2g} %: under 0.3 mm per metre)",
+                           100.0 * get("s"), 0.03 * scale);
+      break;
+    case sim::EffectKind::kGtOffset:
+      if (std::hypot(get("dx"), get("dy")) < 3e-4 * scale)
+        return fmt::format("a marker {:.2f} mm off the axle midpoint (below {:.2g} mm)",
+                           1e3 * std::hypot(get("dx"), get("dy")), 0.3 * scale);
+      break;
+    case sim::EffectKind::kCastorKick:
+    case sim::EffectKind::kCastorSwivel:
+      if (get("kappa") < 3e-4 * scale)
+        return fmt::format("heading kicks of {:.2f} mrad (below {:.2g} mrad)", 1e3 * get("kappa"), 0.3 * scale);
+      break;
+    default: break;
+  }
+  return {};
+}
+
+namespace {
+
+/// The baseline with its weights from the wheel noise refitted to its
+/// residuals (against a given model's wheel noise; see Explain).
+BaselineFit RefittedWeights(const CampaignData& c, const BaselineFit& b) {
+  BaselineFit weighted = b;
+  PieceNoiseFitOptions nf = b.noise_fit;
+  nf.fit_wheel_noise = true;
+  weighted.W = Whiteners(b.bases, c.pieces, FitPieceNoise(b.eps, b.bases, c.pieces, {}, b.noise, nf));
+  return weighted;
+}
+
+/// Every step's practical size at the last step's joint fit `current`
+/// (mean part `last`), and whether it is negligible.
+void SizeSteps(const CampaignData& c, const MeanModel& model, const BaselineFit& b, const MeanPart& last,
+               const SetFit& current, double negligible, Explanation& ex) {
+  const std::vector<PieceBases>& last_bases = !current.rescaled.empty() ? current.rescaled
+                                              : last.scrub              ? last.scrub_bases
+                                                                        : b.bases;
+  const PieceScatter scatter = Scatter(c, last_bases, current.noise);
+  for (ExplanationStep& s : ex.steps) {
+    Size(c, model, b, last_bases, scatter, current, s.effect, s);
+    s.practical_floor = PracticalFloor(s.effect, s.params, negligible);
+    s.negligible = s.relative_size < negligible || !s.practical_floor.empty();
+  }
+}
+
+}  // namespace
+
+// Longer than 80 lines on purpose: one greedy forward selection whose steps
+// share the chosen set, the current fit and the cache of mean parts; its
+// pieces with state of their own (set fits, sizing, weights) are the
+// helpers above.
 Explanation Explain(const CampaignData& c, const MeanModel& model, const BaselineFit& b, const Folds& folds,
                     const std::vector<Candidate>& candidates, const std::map<std::vector<int>, MeanFit>& known,
                     const std::vector<sim::EffectKind>& first, double gap_score, double null_median,
@@ -345,14 +447,8 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
   // baseline's residuals, and the candidates' mean fits (weighted the
   // given way) are not reused.
   const bool given_noise = !b.noise_fit.fit_wheel_noise;
-  BaselineFit weighted;
+  const BaselineFit weighted = given_noise ? RefittedWeights(c, b) : BaselineFit{};
   const std::map<std::vector<int>, MeanFit> not_known;
-  if (given_noise) {
-    weighted = b;
-    PieceNoiseFitOptions nf = b.noise_fit;
-    nf.fit_wheel_noise = true;
-    weighted.W = Whiteners(b.bases, c.pieces, FitPieceNoise(b.eps, b.bases, c.pieces, {}, b.noise, nf));
-  }
   MeanPartCache means(c, model, given_noise ? weighted : b, options.threads, given_noise ? not_known : known);
   means.Prepare({{}});
   const SetFit base = FitSet(c, model, b, folds, {}, means.Get({}), options.gap);
@@ -394,7 +490,8 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
   // squares).
   std::vector<sim::EffectKind> pool;
   for (const Candidate& cd : candidates)
-    if (cd.identifiable && (!cd.weak || cd.heldout_loglik_gain > 0.0) && !Contains(chosen, cd.effect))
+    if (cd.identifiable && (!cd.weak || cd.heldout_loglik_gain > 0.0) && !Contains(chosen, cd.effect) &&
+        cd.clock.supported)
       pool.push_back(cd.effect);
   ex.stop_reason = "the largest explanation considered";
   while (static_cast<int>(chosen.size()) < options.max_effects) {
@@ -436,14 +533,7 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
   }
   progress.Finish();
   ex.gap_left = current.gap_after > null_quantile;
-  const std::vector<PieceBases>& last_bases = !current.rescaled.empty()  ? current.rescaled
-                                              : means.Get(chosen).scrub ? means.Get(chosen).scrub_bases
-                                                                        : b.bases;
-  const PieceScatter scatter = Scatter(c, last_bases, current.noise);
-  for (ExplanationStep& s : ex.steps) {
-    Size(c, model, b, last_bases, scatter, current, s.effect, s);
-    s.negligible = s.relative_size < options.negligible;
-  }
+  SizeSteps(c, model, b, means.Get(chosen), current, options.negligible, ex);
   return ex;
 }
 

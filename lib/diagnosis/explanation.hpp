@@ -28,7 +28,12 @@
 // bump_outliers; and for wheel_noise_error |k_fit / k_given - 1|, the
 // wheel further off. Below `negligible` (default 0.25: a quarter of the noise) an
 // effect is negligible: reported, never named in the verdict, however
-// significant.
+// significant. Beside that relative rule, mismatches every robot has are
+// negligible whatever the noise (PracticalFloor, issue 21: a 1 ms clock at
+// 0.3 m/s is 0.3 mm): a clock offset |tau| or tau_sd below 1.5 ms, a
+// common diameter error |s| below 0.03 %, a marker within 0.3 mm of the
+// axle midpoint, a castor kick or swivel below 0.3 mrad; the floors scale
+// with `negligible` / 0.25 (0 switches them off with the relative rule).
 #pragma once
 
 #include <map>
@@ -71,11 +76,19 @@ struct ExplanationStep {
   /// relative_size are measured; empty for the others.
   std::string size_pieces;
   bool negligible = false;
+  /// Negligible by PracticalFloor (what every robot has), in words; empty
+  /// otherwise.
+  std::string practical_floor;
   /// Why this fit is physically impossible (advice.hpp UnphysicalFit, with
   /// the single-effect candidate's standard errors), empty when it is not;
   /// filled by Diagnose. Such a step is a symptom and never named.
   std::string unphysical;
 };
+
+/// Why an effect with these fitted parameters is too small to matter
+/// whatever the noise (see the file comment), or empty. `negligible`: the
+/// option (the floors scale with negligible / 0.25).
+std::string PracticalFloor(sim::EffectKind effect, const std::map<std::string, double>& params, double negligible);
 
 struct Explanation {
   std::vector<ExplanationStep> steps;  ///< in the order added

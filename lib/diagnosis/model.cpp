@@ -18,7 +18,8 @@ ParamVector NominalParams() {
 }
 
 const char* ParamName(int index) {
-  static const char* names[kNumParams] = {"E_d", "E_b", "s", "k", "a", "kappa", "r", "dx", "dy", "tau"};
+  static const char* names[kNumParams] = {"E_d", "E_b", "s", "k", "a", "kappa", "r", "dx",
+                                                    "dy",  "tau", "kappa", "d", "a"};
   return index >= 0 && index < kNumParams ? names[index] : "?";
 }
 
@@ -55,12 +56,14 @@ inline Pose2 Relative(const Pose2& a, const Pose2& b) {
 /// diagnosis' effects on wheel travel and heading.
 struct TrueFactors {
   double c_L, c_R, scale, back, wheelbase, scrub;
+  double kappa, swivel, slide_d, slide_a;  ///< castor_kick, castor_swivel, stop_slide
 };
 
 TrueFactors Factors(const ParamVector& p, double wheelbase) {
   const double E_d = p[kParamEd];
-  return {CorrectionLeft(E_d), CorrectionRight(E_d), 1.0 + p[kParamScale], 1.0 + p[kParamAsym],
-          p[kParamEb] * wheelbase, 1.0 - p[kParamScrub]};
+  return {CorrectionLeft(E_d),    CorrectionRight(E_d),  1.0 + p[kParamScale], 1.0 + p[kParamAsym],
+          p[kParamEb] * wheelbase, 1.0 - p[kParamScrub], p[kParamKappa],      p[kParamSwivel],
+          p[kParamSlideD],         p[kParamSlideA]};
 }
 
 }  // namespace
@@ -91,12 +94,39 @@ inline double HeadingFactor(const TrueFactors& f, signed char cls) {
   return cls == static_cast<signed char>(sim::MotionClass::kTurn) ? f.scrub : 1.0;
 }
 
+/// How far a coast at initial rate `rate` (signed speed or turn rate) with
+/// coefficient k (d or a) has gone tau seconds after the wheels stopped:
+/// uniform deceleration 1 / (2 |k|) until it rests after 2 |k| |rate|,
+/// covering k rate |rate| in all (a negative k, which a fit may try, coasts
+/// backwards: the slide stays smooth in k through 0).
+double CoastProgress(double rate, double k, double tau) {
+  if (k == 0.0 || !(tau > 0.0) || rate == 0.0) return 0.0;
+  const double v = std::abs(rate), kk = std::abs(k), t = std::min(tau, 2.0 * kk * v);
+  return (k > 0.0 ? 1.0 : -1.0) * (rate > 0.0 ? 1.0 : -1.0) * (v * t - t * t / (4.0 * kk));
+}
+
+/// stop_slide at stop `st` from pose q: the coast between tau0 and tau1
+/// seconds after the wheels stopped, at the true speed the motion ended
+/// with (along the heading, or turning in the turn's sense).
+Pose2 Slide(const DiagRun::Stop& st, const TrueFactors& f, double drift, Pose2 q, double tau0, double tau1) {
+  double vl, vr;
+  TrueTravel(f, drift, st.rate_left, st.rate_right, vl, vr);
+  if (st.cls == static_cast<signed char>(sim::MotionClass::kTurn)) {
+    const double w = (vr - vl) / f.wheelbase;
+    q.theta += CoastProgress(w, f.slide_a, tau1) - CoastProgress(w, f.slide_a, tau0);
+    return q;
+  }
+  const double v = 0.5 * (vl + vr);
+  const double along = CoastProgress(v, f.slide_d, tau1) - CoastProgress(v, f.slide_d, tau0);
+  return {q.x + along * std::cos(q.theta), q.y + along * std::sin(q.theta), q.theta};
+}
+
 /// The pose after fraction `u` in [0, 1] of interval i's time from `q`
-/// (u = 1: the whole interval): a junction's two parts in turn, else the
-/// interval's one step within its active window (after the castor kick of a
-/// start from standstill).
-Pose2 AdvanceInterval(const DiagRun& r, std::size_t i, const TrueFactors& f, double drift, double kappa, Pose2 q,
-                      double u) {
+/// (u = 1: the whole interval): a junction's two parts in turn (a swivel
+/// kick between them), else the interval's one step within its active
+/// window (after the castor kicks of its start, before the slide of its
+/// stop).
+Pose2 AdvanceInterval(const DiagRun& r, std::size_t i, const TrueFactors& f, double drift, Pose2 q, double u) {
   const double dl = r.left[i + 1] - r.left[i], dr = r.right[i + 1] - r.right[i];
   double l, rr;
   if (const int jx = r.junction_of.empty() ? -1 : r.junction_of[i]; jx >= 0) {
@@ -106,15 +136,30 @@ Pose2 AdvanceInterval(const DiagRun& r, std::size_t i, const TrueFactors& f, dou
     TrueTravel(f, drift, ua * j.left_m, ua * j.right_m, l, rr);
     q = TrueStep(q, l, rr, f.wheelbase, HeadingFactor(f, j.class_a));
     if (u <= fa) return q;
+    if (!r.swivel.empty() && r.swivel[i] != 0) q.theta += f.swivel * r.swivel[i];
     const double ub = fa < 1.0 ? std::min(1.0, (u - fa) / (1.0 - fa)) : 1.0;
     TrueTravel(f, drift, ub * (dl - j.left_m), ub * (dr - j.right_m), l, rr);
     return TrueStep(q, l, rr, f.wheelbase, HeadingFactor(f, j.class_b));
   }
-  if (r.kick[i] != 0) q.theta += kappa * r.kick[i];
+  if (r.kick[i] != 0) q.theta += f.kappa * r.kick[i];
+  if (!r.swivel.empty() && r.swivel[i] != 0) q.theta += f.swivel * r.swivel[i];
   const double w0 = r.window_start[i], w1 = r.window_end[i];
   const double frac = u >= 1.0 ? 1.0 : u <= w0 || w1 <= w0 ? 0.0 : std::min(1.0, (u - w0) / (w1 - w0));
   TrueTravel(f, drift, frac * dl, frac * dr, l, rr);
-  return TrueStep(q, l, rr, f.wheelbase, HeadingFactor(f, r.interval_class[i]));
+  q = TrueStep(q, l, rr, f.wheelbase, HeadingFactor(f, r.interval_class[i]));
+  if (f.slide_d == 0.0 && f.slide_a == 0.0) return q;
+  // stop_slide: the coast from the wheels' stop (at the end of the stop
+  // interval's active window) on into the still intervals after it.
+  const double dt = r.t[i + 1] - r.t[i], t_now = r.t[i] + std::min(u, 1.0) * dt;
+  if (const int stop = r.stop_of.empty() ? -1 : r.stop_of[i]; stop >= 0 && frac >= 1.0) {
+    const DiagRun::Stop& st = r.stops[static_cast<std::size_t>(stop)];
+    q = Slide(st, f, drift, q, 0.0, t_now - st.t_stop);
+  }
+  if (const int coast = r.coast_of.empty() ? -1 : r.coast_of[i]; coast >= 0) {
+    const DiagRun::Stop& st = r.stops[static_cast<std::size_t>(coast)];
+    q = Slide(st, f, drift, q, r.t[i] - st.t_stop, t_now - st.t_stop);
+  }
+  return q;
 }
 
 }  // namespace
@@ -126,7 +171,7 @@ void MeanModel::ReplayRun(int run, const ParamVector& p, std::vector<Pose2>& pos
   const std::size_t n = r.t.size();
   poses.resize(n);
   poses[0] = Pose2{};
-  for (std::size_t i = 0; i + 1 < n; ++i) poses[i + 1] = AdvanceInterval(r, i, f, drift, p[kParamKappa], poses[i], 1.0);
+  for (std::size_t i = 0; i + 1 < n; ++i) poses[i + 1] = AdvanceInterval(r, i, f, drift, poses[i], 1.0);
 }
 
 Pose2 MeanModel::PoseAt(int run, const ParamVector& p, const std::vector<Pose2>& poses, double t) const {
@@ -143,7 +188,7 @@ Pose2 MeanModel::PoseAt(int run, const ParamVector& p, const std::vector<Pose2>&
   // the castor kick.
   const bool junction = !r.junction_of.empty() && r.junction_of[i] >= 0;
   if (!junction && (u <= r.window_start[i] || r.window_end[i] <= r.window_start[i])) return poses[i];
-  return AdvanceInterval(r, i, f, drift, p[kParamKappa], poses[i], u);
+  return AdvanceInterval(r, i, f, drift, poses[i], u);
 }
 
 std::vector<Pose2> MeanModel::PredictRun(int run, const ParamVector& p) const {
@@ -194,7 +239,8 @@ void MeanModel::Residuals(const ParamVector& p, std::vector<double>& eps) const 
 
 Eigen::MatrixXd MeanModel::Jacobian(const ParamVector& p, const std::vector<int>& params,
                                     const std::vector<double>& eps0) const {
-  static const double kStep[kNumParams] = {1e-6, 1e-6, 1e-6, 1e-6, 1e-6, 1e-7, 1e-8, 1e-6, 1e-6, 1e-5};
+  static const double kStep[kNumParams] = {1e-6, 1e-6, 1e-6, 1e-6, 1e-6, 1e-7, 1e-8,
+                                                 1e-6, 1e-6, 1e-5, 1e-7, 1e-5, 1e-5};
   Eigen::MatrixXd J(eps0.size(), params.size());
   std::vector<double> eps;
   for (std::size_t k = 0; k < params.size(); ++k) {
@@ -401,6 +447,12 @@ std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanMod
     }
     tau.Set(j, B);
     GroundTruthBases(pc, motion[j], B);
+    for (std::size_t i = pc.a; i < pc.b && i < r.reversal.size(); ++i)
+      if (r.reversal[i]) {
+        const Eigen::Vector3d v(-motion[j].y, motion[j].x, 1.0);
+        B.K = v * v.transpose();
+        break;
+      }
   }
   return out;
 }

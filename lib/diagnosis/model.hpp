@@ -9,6 +9,13 @@
 //                r = dR c_R (1 + s) (1 + r_drift i) [(1 + a) if dR < 0]
 //   heading      (r - l) / (E_b b), times (1 - k) inside spot turns
 //   castor kick  +-kappa at the first interval of every non-turn motion
+//                that starts from standstill
+//   swivel       kappa_s x the preceding spot turn's sign at the first
+//                interval of a straight or arc motion after a turn
+//   stop slide   at the end of a motion's last interval when a stop follows:
+//                d v|v| along the heading (straight, arc; v the true speed
+//                of the axle midpoint at the end) or a w|w| in heading
+//                (spot turn; w the true rate)
 //   predicted ground truth  the pose at t - tau, reported at (dx, dy)
 // with c_L = 2/(E_d + 1), c_R = 2/(1/E_d + 1). A piece's residual is
 //   eps = Rel(GT_a, GT_b) - Rel(P_a, P_b)        ([x, y, theta], start frame of the piece)
@@ -48,6 +55,9 @@ enum ParamIndex : int {
   kParamDx,       ///< gt_offset.dx [m]
   kParamDy,       ///< gt_offset.dy [m]
   kParamTau,      ///< time_offset.tau [s]
+  kParamSwivel,   ///< castor_swivel.kappa [rad]
+  kParamSlideD,   ///< stop_slide.d [s^2/m]
+  kParamSlideA,   ///< stop_slide.a [s^2/rad]
   kNumParams
 };
 using ParamVector = std::array<double, kNumParams>;
@@ -111,6 +121,11 @@ struct PieceBases {
   /// piece's second moment. The pieces of a run share tau_i: their
   /// correlation is the run block of run_block.hpp.
   Eigen::Matrix3d T = Eigen::Matrix3d::Zero();
+  /// castor_swivel after a reversal: swivel_rev2 K, K = v v^T with v =
+  /// (-y, x, 1) the lever of a heading kick at the piece's start on its
+  /// end pose (x, y: the predicted motion), on a piece in which a straight
+  /// or arc motion starts that reverses the one before (DiagRun::reversal).
+  Eigen::Matrix3d K = Eigen::Matrix3d::Zero();
   Eigen::Vector3d tau_lever_pos = Eigen::Vector3d::Zero(), tau_lever_neg = Eigen::Vector3d::Zero();
 };
 

@@ -22,7 +22,8 @@ double NoiseParams::rho() const {
 
 Eigen::Matrix3d PieceCovariance(const PieceBases& B, const NoiseParams& n) {
   return n.kL2 * B.A_L + n.kR2 * B.A_R + n.c_LR * B.A_LR + n.sxy2 * B.G_xy + n.sth2 * B.G_theta + B.Q +
-         n.floor_s2 * B.F + n.stand_xy2 * B.S_xy + n.stand_th2 * B.S_theta + n.run_tau2 * B.T;
+         n.floor_s2 * B.F + n.stand_xy2 * B.S_xy + n.stand_th2 * B.S_theta + n.run_tau2 * B.T +
+         n.swivel_rev2 * B.K;
 }
 
 BumpMixture PieceMixture(const PieceBases& B, const NoiseParams& n) {

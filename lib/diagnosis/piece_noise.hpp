@@ -41,6 +41,10 @@ struct NoiseParams {
   double stand_xy2 = 0.0;         ///< standstill_motion sigma_xy^2 [m^2]
   double stand_th2 = 0.0;         ///< standstill_motion sigma_theta^2 [rad^2]
   double run_tau2 = 0.0;          ///< run_time_offset tau_sd^2 [s^2]
+  /// castor_swivel's kicks after reversals, +-kappa with equal probability:
+  /// a heading variance kappa^2 at those starts [rad^2]. Never estimated
+  /// here: the mean fit's kappa sets it (candidates.cpp, explanation.cpp).
+  double swivel_rev2 = 0.0;
 
   double rho() const;
 };

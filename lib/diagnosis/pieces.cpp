@@ -115,11 +115,39 @@ void QuantisationPhase(const std::vector<std::int64_t>& ticks, const std::vector
   }
 }
 
+/// Records motion m's end as a stop (DiagRun::Stop): its nominal wheel
+/// speeds over up to three full intervals before its last one (or over the
+/// whole motion when it is that short).
+void AddStop(DiagRun& r, const sim::MotionSegment& m) {
+  DiagRun::Stop st;
+  st.interval = m.last_interval;
+  st.cls = static_cast<signed char>(m.cls);
+  st.turn_m = std::abs(m.right_m - m.left_m);
+  const std::size_t i = m.last_interval;
+  st.t_stop = r.t[i] + static_cast<double>(r.window_end[i]) * (r.t[i + 1] - r.t[i]);
+  const std::size_t hi = m.last_interval, lo = hi > m.first_interval + 3 ? hi - 3 : m.first_interval;
+  if (hi > lo && r.t[hi] > r.t[lo]) {
+    st.rate_left = (r.left[hi] - r.left[lo]) / (r.t[hi] - r.t[lo]);
+    st.rate_right = (r.right[hi] - r.right[lo]) / (r.t[hi] - r.t[lo]);
+  } else if (r.t[m.EndSample()] > r.t[m.FirstSample()]) {
+    const double dt = r.t[m.EndSample()] - r.t[m.FirstSample()];
+    st.rate_left = m.left_m / dt;
+    st.rate_right = m.right_m / dt;
+  }
+  r.stop_of[m.last_interval] = static_cast<int>(r.stops.size());
+  r.stops.push_back(st);
+}
+
 /// Interval classes, castor kicks and active windows from the motions.
 void AnnotateIntervals(DiagRun& r, int min_stand_intervals) {
   const std::size_t intervals = r.t.empty() ? 0 : r.t.size() - 1;
   r.interval_class.assign(intervals, -1);
   r.kick.assign(intervals, 0);
+  r.swivel.assign(intervals, 0);
+  r.reversal.assign(intervals, 0);
+  r.stop_of.assign(intervals, -1);
+  r.coast_of.assign(intervals, -1);
+  r.stops.clear();
   r.window_start.assign(intervals, 0.0f);
   r.window_end.assign(intervals, 1.0f);
   for (std::size_t k = 0; k < r.motions.size(); ++k) {
@@ -137,11 +165,27 @@ void AnnotateIntervals(DiagRun& r, int min_stand_intervals) {
                    !m.after_brief_stop);
     if (from_standstill && m.cls != sim::MotionClass::kTurn)
       r.kick[m.first_interval] = static_cast<signed char>(m.sign);
+    // castor_swivel: a straight or arc start right after a spot turn.
+    if (k > 0 && m.cls != sim::MotionClass::kTurn && r.motions[k - 1].cls == sim::MotionClass::kTurn)
+      r.swivel[m.first_interval] = static_cast<signed char>(r.motions[k - 1].sign);
+    if (k > 0 && m.cls != sim::MotionClass::kTurn && r.motions[k - 1].cls != sim::MotionClass::kTurn &&
+        r.motions[k - 1].sign != m.sign)
+      r.reversal[m.first_interval] = 1;
     if (m.last_interval > m.first_interval) {
       const double t0 = IntervalTravel(r, m.first_interval), t1 = IntervalTravel(r, m.first_interval + 1);
       if (t1 > 0.0) r.window_start[m.first_interval] = static_cast<float>(1.0 - std::min(1.0, t0 / t1));
       const double tl = IntervalTravel(r, m.last_interval), tp = IntervalTravel(r, m.last_interval - 1);
       if (tp > 0.0) r.window_end[m.last_interval] = static_cast<float>(std::min(1.0, tl / tp));
+    }
+    // stop_slide: the motion ends at a stop (after its active window).
+    const bool stops_here =
+        k + 1 == r.motions.size() ||
+        (r.motions[k + 1].first_interval - m.last_interval > static_cast<std::size_t>(min_stand_intervals) &&
+         !r.motions[k + 1].after_brief_stop);
+    if (stops_here && !r.endpoint) {
+      AddStop(r, m);
+      const std::size_t end = k + 1 < r.motions.size() ? r.motions[k + 1].first_interval : intervals;
+      for (std::size_t i = m.last_interval + 1; i < end; ++i) r.coast_of[i] = static_cast<int>(r.stops.size()) - 1;
     }
   }
 }
@@ -309,22 +353,46 @@ bool StopAmbiguous(const DiagRun& r, std::size_t mi, double tick_left_m, double 
   return falling && std::sqrt(n) - 1.0 < 1.0 / lead_fraction;
 }
 
-void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, const PieceOptions& o,
-                         SubsetTable& subsets, double tick_left_m, double tick_right_m) {
-  const DiagRun& r = c.runs[run_index];
-  const std::size_t n = r.t.size();
-  std::size_t g0 = n, g1 = 0;
-  for (std::size_t i = 0; i < n; ++i)
-    if (r.has_gt[i]) {
-      g0 = std::min(g0, i);
-      g1 = i;
-    }
-  if (g0 >= g1) return;
-  const std::size_t first_piece = c.pieces.size();
-  auto add = [&](std::size_t a, std::size_t b, PieceType type, int sign, bool first) {
+/// Builds the pieces of one logged run (AddTrajectoryPieces): the
+/// standstills between motions and each motion cut into pieces, then which
+/// pieces start or end at a standstill, then the standstill averaging.
+class TrajectoryPieces {
+ public:
+  TrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, const PieceOptions& o, SubsetTable& subsets,
+                   double tick_left_m, double tick_right_m)
+      : c_(c),
+        r_(c.runs[static_cast<std::size_t>(run_index)]),
+        run_index_(run_index),
+        kind_(kind),
+        o_(o),
+        subsets_(subsets),
+        tick_left_m_(tick_left_m),
+        tick_right_m_(tick_right_m) {}
+
+  void Build() {
+    const std::size_t n = r_.t.size();
+    g0_ = n;
+    g1_ = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (r_.has_gt[i]) {
+        g0_ = std::min(g0_, i);
+        g1_ = i;
+      }
+    if (g0_ >= g1_) return;
+    first_piece_ = c_.pieces.size();
+    cur_ = g0_;
+    for (std::size_t mi = 0; mi < r_.motions.size(); ++mi) AddMotion(mi);
+    if (g1_ > cur_) Add(cur_, g1_, PieceType::kStand, 0, false);
+    MarkStandstillNeighbours();
+    if (o_.average_standstills) AverageStandstills();
+  }
+
+ private:
+  /// One piece from sample a to b (none when b <= a).
+  void Add(std::size_t a, std::size_t b, PieceType type, int sign, bool first) {
     if (b <= a) return;
     Piece p;
-    p.run = run_index;
+    p.run = run_index_;
     p.a = p.a_lo = p.a_hi = a;
     p.b = p.b_lo = p.b_hi = b;
     p.type = type;
@@ -332,33 +400,34 @@ void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, co
     p.motion_first = first;
     double travel = 0.0;
     for (std::size_t i = a; i < b; ++i)
-      travel += 0.5 * (std::abs(r.left[i + 1] - r.left[i]) + std::abs(r.right[i + 1] - r.right[i]));
+      travel += 0.5 * (std::abs(r_.left[i + 1] - r_.left[i]) + std::abs(r_.right[i + 1] - r_.right[i]));
     p.travel_m = travel;
     if (type == PieceType::kStand && travel > 0.0) {
       // Ground truth missing where a motion starts or ends: the stretch
       // that was meant as standstill holds motion; type it by its travel.
-      const double L = r.left[b] - r.left[a], R = r.right[b] - r.right[a];
-      const sim::MotionClass cls = sim::ClassifyMotion(L, R, c.robot.wheelbase_m, o.motion);
+      const double L = r_.left[b] - r_.left[a], R = r_.right[b] - r_.right[a];
+      const sim::MotionClass cls = sim::ClassifyMotion(L, R, c_.robot.wheelbase_m, o_.motion);
       p.type = type = cls == sim::MotionClass::kStraight ? PieceType::kStraight
                       : cls == sim::MotionClass::kTurn   ? PieceType::kTurn
                                                          : PieceType::kArc;
       p.sign = sign = cls == sim::MotionClass::kTurn ? (R - L >= 0.0 ? 1 : -1) : (R + L >= 0.0 ? 1 : -1);
       p.motion_first = first = false;
-    }
-    p.subset = subsets.Get(r.experiment, SubsetName(kind, r, type, sign, first));
-    p.pooled_subset = subsets.Get(r.experiment, std::string("all runs, ") + PieceTypeToString(type));
-    p.campaign_subset = subsets.Get(-1, std::string("all experiments, ") + PieceTypeToString(type));
-    c.pieces.push_back(p);
-  };
-  std::size_t cur = g0;
-  for (std::size_t mi = 0; mi < r.motions.size(); ++mi) {
-    const sim::MotionSegment& m = r.motions[mi];
+  }
+  p.subset = subsets_.Get(r_.experiment, SubsetName(kind_, r_, type, sign, first));
+  p.pooled_subset = subsets_.Get(r_.experiment, std::string("all runs, ") + PieceTypeToString(type));
+  p.campaign_subset = subsets_.Get(-1, std::string("all experiments, ") + PieceTypeToString(type));
+  c_.pieces.push_back(p);
+  }
+
+  /// Motion mi's pieces, and the standstill before it.
+  void AddMotion(std::size_t mi) {
+    const sim::MotionSegment& m = r_.motions[mi];
     // Back to back with a neighbouring motion (no pause between): the
     // interval in which one ends and the next begins holds parts of both, no
     // single constant-curvature step; the two intervals at the junction stay
     // out of the pieces.
-    const bool joined_before = mi > 0 && r.motions[mi - 1].last_interval + 1 == m.first_interval;
-    const bool joined_after = mi + 1 < r.motions.size() && m.last_interval + 1 == r.motions[mi + 1].first_interval;
+    const bool joined_before = mi > 0 && r_.motions[mi - 1].last_interval + 1 == m.first_interval;
+    const bool joined_after = mi + 1 < r_.motions.size() && m.last_interval + 1 == r_.motions[mi + 1].first_interval;
     // The castor kick happens at the motion's start (contract), and the
     // robot starts before its first count (tens of ms with acceleration
     // limits and coarse encoders): when the encoders do not locate the
@@ -366,105 +435,130 @@ void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, co
     // already show the kick, so the motion's first piece starts one sample
     // earlier and that sample leaves the standstill
     // (PieceOptions::start_before_first_count).
-    const bool early = !joined_before && o.start_before_first_count &&
-                       StartAmbiguous(r, mi, tick_left_m, tick_right_m, o.start_lead_fraction);
+    const bool early = !joined_before && o_.start_before_first_count &&
+                       StartAmbiguous(r_, mi, tick_left_m_, tick_right_m_, o_.start_lead_fraction);
     // After a brief stop (effects_motion.hpp) the motion's first piece
     // starts where the one before ended: the still samples between hold
     // the braking and the start, not a standstill.
-    const bool brief = m.after_brief_stop && mi > 0 && cur <= m.FirstSample();
+    const bool brief = m.after_brief_stop && mi > 0 && cur_ <= m.FirstSample();
     const std::size_t s0 = joined_before ? m.FirstSample() + 1
-                           : brief       ? cur
+                           : brief       ? cur_
                            : early       ? m.FirstSample() - 1
                                          : m.FirstSample();
-    const bool late = !joined_after && o.start_before_first_count &&
-                      StopAmbiguous(r, mi, tick_left_m, tick_right_m, o.start_lead_fraction);
+    const bool late = !joined_after && o_.start_before_first_count &&
+                      StopAmbiguous(r_, mi, tick_left_m_, tick_right_m_, o_.start_lead_fraction);
     const std::size_t s1 = m.EndSample() - (joined_after ? 1 : 0) + (late ? 1 : 0);
-    if (s1 <= s0 || s1 <= cur || s0 >= g1) {
-      if (joined_after) cur = std::max(cur, std::min(m.EndSample() + 1, g1));
-      continue;
-    }
-    if (joined_before) cur = std::max(cur, std::min(s0, g1));
-    const auto start = s0 <= cur ? std::optional<std::size_t>(cur) : NearestWithGt(r, s0, cur, s1 - 1);
-    if (!start) continue;
-    if (*start > cur) add(cur, *start, PieceType::kStand, 0, false);
-    const PieceType type = m.cls == sim::MotionClass::kStraight ? PieceType::kStraight
-                           : m.cls == sim::MotionClass::kTurn   ? PieceType::kTurn
-                                                                : PieceType::kArc;
-    // Split points by travelled distance (or heading for turns).
+    if (s1 <= s0 || s1 <= cur_ || s0 >= g1_) {
+      if (joined_after) cur_ = std::max(cur_, std::min(m.EndSample() + 1, g1_));
+      return;
+  }
+  if (joined_before) cur_ = std::max(cur_, std::min(s0, g1_));
+  const auto start = s0 <= cur_ ? std::optional<std::size_t>(cur_) : NearestWithGt(r_, s0, cur_, s1 - 1);
+  if (!start) return;
+  if (*start > cur_) Add(cur_, *start, PieceType::kStand, 0, false);
+  const PieceType type = m.cls == sim::MotionClass::kStraight ? PieceType::kStraight
+                         : m.cls == sim::MotionClass::kTurn   ? PieceType::kTurn
+                                                              : PieceType::kArc;
+  const std::vector<std::size_t> cuts = Cuts(m, type, s0, s1);
+  std::size_t prev = *start;
+  bool first = true;
+  for (std::size_t cut : cuts) {
+    const auto at = NearestWithGt(r_, cut, prev + 1, std::min(s1, g1_) - 1);
+    if (!at) continue;
+    Add(prev, *at, type, m.sign, first);
+    first = false;
+    prev = *at;
+  }
+  // End of the motion: its first still sample, or the sample before the
+  // junction with the next motion (or the nearest with ground truth).
+  const auto end = NearestWithGt(r_, std::min(s1, g1_), prev + 1, joined_after ? std::min(s1, g1_) : g1_);
+  if (!end) {
+    cur_ = joined_after ? std::min(s1 + 2, g1_) : prev;
+    return;
+  }
+  Add(prev, *end, type, m.sign, first);
+  cur_ = joined_after ? std::max(*end, std::min(s1 + 2, g1_)) : *end;
+  }
+
+  /// Split points of a motion from s0 to s1, by travelled distance (or
+  /// heading for turns).
+  std::vector<std::size_t> Cuts(const sim::MotionSegment& m, PieceType type, std::size_t s0, std::size_t s1) const {
     int parts = 1;
     if (type == PieceType::kTurn) {
-      const double angle = std::abs(m.right_m - m.left_m) / c.robot.wheelbase_m;
-      parts = std::max(1, static_cast<int>(std::ceil(angle / o.max_piece_angle_rad)));
+      const double angle = std::abs(m.right_m - m.left_m) / c_.robot.wheelbase_m;
+      parts = std::max(1, static_cast<int>(std::ceil(angle / o_.max_piece_angle_rad)));
     } else {
       const double len = 0.5 * (std::abs(m.left_m) + std::abs(m.right_m));
-      parts = std::max(1, static_cast<int>(std::ceil(len / o.max_piece_length_m)));
+      parts = std::max(1, static_cast<int>(std::ceil(len / o_.max_piece_length_m)));
+  }
+  std::vector<std::size_t> cuts;
+  if (parts > 1) {
+    double total = 0.0;
+    std::vector<double> cum(s1 - s0 + 1, 0.0);
+    for (std::size_t i = s0; i < s1; ++i) {
+      total += IntervalTravel(r_, i);
+      cum[i - s0 + 1] = total;
     }
-    std::vector<std::size_t> cuts;
-    if (parts > 1) {
-      double total = 0.0;
-      std::vector<double> cum(s1 - s0 + 1, 0.0);
-      for (std::size_t i = s0; i < s1; ++i) {
-        total += IntervalTravel(r, i);
-        cum[i - s0 + 1] = total;
+    for (int k = 1; k < parts; ++k) {
+      const double want = total * k / parts;
+      std::size_t j = s0;
+      while (j < s1 && cum[j - s0] < want) ++j;
+      cuts.push_back(j);
+    }
+  }
+  return cuts;
+  }
+
+  void MarkStandstillNeighbours() {
+    for (std::size_t j = first_piece_; j < c_.pieces.size(); ++j) {
+      Piece& p = c_.pieces[j];
+      if (p.type == PieceType::kStand) continue;
+      const bool stand_before =
+          j == first_piece_ || (c_.pieces[j - 1].type == PieceType::kStand && c_.pieces[j - 1].b == p.a);
+      p.starts_from_standstill = p.motion_first && stand_before;
+      p.ends_at_standstill =
+          j + 1 < c_.pieces.size() && c_.pieces[j + 1].type == PieceType::kStand && c_.pieces[j + 1].a == p.b;
+  }
+  }
+
+  /// Motions next to a true standstill (no wheel travel) are measured from
+  /// / to its mean ground-truth pose.
+  void AverageStandstills() {
+    for (std::size_t j = first_piece_; j < c_.pieces.size(); ++j) {
+      const Piece& st = c_.pieces[j];
+      if (st.type != PieceType::kStand || st.travel_m > 0.0) continue;
+      int samples = 0;
+      for (std::size_t i = st.a; i <= st.b; ++i) samples += r_.has_gt[i] ? 1 : 0;
+      if (samples < 2) continue;
+      const double w = 1.0 / samples;
+      if (j > first_piece_ && c_.pieces[j - 1].b == st.a && c_.pieces[j - 1].type != PieceType::kStand) {
+        Piece& before = c_.pieces[j - 1];
+        before.b_lo = st.a;
+        before.b_hi = st.b;
+        before.b_weight = w;
       }
-      for (int k = 1; k < parts; ++k) {
-        const double want = total * k / parts;
-        std::size_t j = s0;
-        while (j < s1 && cum[j - s0] < want) ++j;
-        cuts.push_back(j);
+      if (j + 1 < c_.pieces.size() && c_.pieces[j + 1].a == st.b && c_.pieces[j + 1].type != PieceType::kStand) {
+        Piece& after = c_.pieces[j + 1];
+        after.a_lo = st.a;
+        after.a_hi = st.b;
+        after.a_weight = w;
       }
-    }
-    std::size_t prev = *start;
-    bool first = true;
-    for (std::size_t cut : cuts) {
-      const auto at = NearestWithGt(r, cut, prev + 1, std::min(s1, g1) - 1);
-      if (!at) continue;
-      add(prev, *at, type, m.sign, first);
-      first = false;
-      prev = *at;
-    }
-    // End of the motion: its first still sample, or the sample before the
-    // junction with the next motion (or the nearest with ground truth).
-    const auto end = NearestWithGt(r, std::min(s1, g1), prev + 1, joined_after ? std::min(s1, g1) : g1);
-    if (!end) {
-      cur = joined_after ? std::min(s1 + 2, g1) : prev;
-      continue;
-    }
-    add(prev, *end, type, m.sign, first);
-    cur = joined_after ? std::max(*end, std::min(s1 + 2, g1)) : *end;
   }
-  if (g1 > cur) add(cur, g1, PieceType::kStand, 0, false);
-  for (std::size_t j = first_piece; j < c.pieces.size(); ++j) {
-    Piece& p = c.pieces[j];
-    if (p.type == PieceType::kStand) continue;
-    const bool stand_before = j == first_piece || (c.pieces[j - 1].type == PieceType::kStand && c.pieces[j - 1].b == p.a);
-    p.starts_from_standstill = p.motion_first && stand_before;
-    p.ends_at_standstill =
-        j + 1 < c.pieces.size() && c.pieces[j + 1].type == PieceType::kStand && c.pieces[j + 1].a == p.b;
   }
-  if (!o.average_standstills) return;
-  // Motions next to a true standstill (no wheel travel) are measured from /
-  // to its mean ground-truth pose.
-  for (std::size_t j = first_piece; j < c.pieces.size(); ++j) {
-    const Piece& st = c.pieces[j];
-    if (st.type != PieceType::kStand || st.travel_m > 0.0) continue;
-    int samples = 0;
-    for (std::size_t i = st.a; i <= st.b; ++i) samples += r.has_gt[i] ? 1 : 0;
-    if (samples < 2) continue;
-    const double w = 1.0 / samples;
-    if (j > first_piece && c.pieces[j - 1].b == st.a && c.pieces[j - 1].type != PieceType::kStand) {
-      Piece& before = c.pieces[j - 1];
-      before.b_lo = st.a;
-      before.b_hi = st.b;
-      before.b_weight = w;
-    }
-    if (j + 1 < c.pieces.size() && c.pieces[j + 1].a == st.b && c.pieces[j + 1].type != PieceType::kStand) {
-      Piece& after = c.pieces[j + 1];
-      after.a_lo = st.a;
-      after.a_hi = st.b;
-      after.a_weight = w;
-    }
-  }
+
+  CampaignData& c_;
+  const DiagRun& r_;
+  int run_index_;
+  ExperimentKind kind_;
+  const PieceOptions& o_;
+  SubsetTable& subsets_;
+  double tick_left_m_, tick_right_m_;
+  std::size_t g0_ = 0, g1_ = 0, cur_ = 0, first_piece_ = 0;
+};
+
+void AddTrajectoryPieces(CampaignData& c, int run_index, ExperimentKind kind, const PieceOptions& o,
+                         SubsetTable& subsets, double tick_left_m, double tick_right_m) {
+  TrajectoryPieces(c, run_index, kind, o, subsets, tick_left_m, tick_right_m).Build();
 }
 
 /// Synthetic commanded square for an endpoint run: still, motion, still, ...

@@ -93,6 +93,35 @@ struct DiagRun {
   /// the neighbouring interval (constant-speed motion, as commanded).
   std::vector<signed char> interval_class;
   std::vector<signed char> kick;
+  /// castor_swivel per interval: the sign of the spot turn before the
+  /// straight or arc motion that begins in it (+1 ccw, -1 cw), else 0. A
+  /// start after a reversal kicks with a random sign: no mean, so it is not
+  /// marked (the fit sees those kicks as heading noise).
+  std::vector<signed char> swivel;
+  /// castor_swivel: 1 at the first interval of a straight or arc motion
+  /// that reverses the drive direction of the one before (no spot turn
+  /// between), where the swivel kicks with a random sign.
+  std::vector<char> reversal;
+  /// stop_slide: a motion that ends at a stop (the next motion starts from
+  /// standstill, or none follows) with its nominal wheel speeds at the end
+  /// [m/s] (over up to three full intervals before its last one) and its
+  /// class; stop_of[i] indexes `stops` for the motion's last interval i
+  /// (-1 elsewhere). Endpoint runs have none (no timing). The chassis
+  /// coasts from the moment the wheels stop, decelerating uniformly (Coulomb
+  /// friction) at 1/(2 d): the slide d v^2 takes 2 d |v| seconds and goes on
+  /// into the still intervals after the stop (coast_of).
+  struct Stop {
+    std::size_t interval = 0;
+    double rate_left = 0.0, rate_right = 0.0;
+    double turn_m = 0.0;  ///< the motion's |R - L| (nominal wheel travel): its heading change x b
+    double t_stop = 0.0;  ///< when the wheels stopped (within the stop interval, its active window's end)
+    signed char cls = 0;
+  };
+  std::vector<Stop> stops;
+  std::vector<int> stop_of;
+  /// The stop whose coast may still go on in still interval i (the last
+  /// stop before it, until the next motion starts), else -1.
+  std::vector<int> coast_of;
   std::vector<float> window_start, window_end;
   /// Junctions of motions back to back (no pause): the interval in which
   /// motion A ends and B begins is two steps, A's direction then B's. For

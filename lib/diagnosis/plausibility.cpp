@@ -31,6 +31,19 @@ std::string UnphysicalFit(const std::string& effect, const std::map<std::string,
   if (effect == "castor_kick" && std::abs(get("kappa")) > 0.05)
     return fmt::format("a castor kick of {:.0f} mrad ({:.1f} deg) at every start: far beyond what a castor swings the "
                        "robot", 1e3 * get("kappa"), get("kappa") * 180.0 / 3.14159265358979);
+  if (effect == "castor_swivel" && std::abs(get("kappa")) > 0.05)
+    return fmt::format("a swivel kick of {:.0f} mrad ({:.1f} deg) after every spot turn: far beyond what a castor "
+                       "swings the robot",
+                       1e3 * get("kappa"), get("kappa") * 180.0 / 3.14159265358979);
+  // stop_slide: a chassis coasts on, never back; d = 1/(2 mu g) > 1 s^2/m
+  // is a friction coefficient under 0.05 (wet ice).
+  if (effect == "stop_slide" && (get("d") < -0.01 || get("a") < -0.01))
+    return fmt::format("a negative slide (d = {:.3g} s^2/m, a = {:.3g} s^2/rad): a coasting chassis moves on, never "
+                       "back",
+                       get("d"), get("a"));
+  if (effect == "stop_slide" && (get("d") > 1.0 || get("a") > 1.0))
+    return fmt::format("a slide of d = {:.3g} s^2/m, a = {:.3g} s^2/rad: a friction coefficient below 0.05",
+                       get("d"), get("a"));
   if (effect == "gt_offset" && std::hypot(get("dx"), get("dy")) > 0.3)
     return fmt::format("a ground-truth marker {:.0f} mm from the axle midpoint: off the robot",
                        1e3 * std::hypot(get("dx"), get("dy")));

@@ -35,7 +35,9 @@ nlohmann::json ByKind(const std::array<double, kNumStatKinds>& a) {
   return j;
 }
 
-std::string FormatParam(const std::string& name, double v) { return FormatEffectParam(name, v); }
+std::string FormatParam(const std::string& name, double v, const std::string& effect) {
+  return FormatEffectParam(name, v, NAN, effect);
+}
 std::string FormatP(double p) { return FormatPValue(p); }
 
 const Candidate* Winner(const DiagnoseSummary& s) {
@@ -60,6 +62,7 @@ nlohmann::json ExplanationJson(const DiagnoseSummary& s) {
                      {"relative_size", Num(e.relative_size)},
                      {"negligible", e.negligible}});
     if (!e.size_pieces.empty()) steps.back()["size_pieces"] = e.size_pieces;
+    if (!e.practical_floor.empty()) steps.back()["practical_floor"] = e.practical_floor;
     // An impossible fit is a symptom, never named (diagnose.cpp NameEffects).
     if (!e.unphysical.empty()) steps.back()["unphysical"] = e.unphysical;
   }
@@ -86,7 +89,14 @@ nlohmann::json CandidatesJson(const DiagnoseSummary& s) {
     nlohmann::json params = nlohmann::json::object(), se = nlohmann::json::object();
     for (const auto& [k, v] : c.params) params[k] = Num(v);
     for (const auto& [k, v] : c.param_se) se[k] = Num(v);
-    cands.push_back({{"effect", sim::EffectToString(c.effect)},
+    nlohmann::json& added = cands.emplace_back(nlohmann::json::object());
+    if (c.clock.checked)
+      added["clock_check"] = {{"supported", c.clock.supported},
+                              {"moving_pieces", c.clock.pieces},
+                              {"moving_value_s", Num(c.clock.value)},
+                              {"moving_se_s", Num(c.clock.se)},
+                              {"evidence", c.clock.text}};
+    added.update({{"effect", sim::EffectToString(c.effect)},
                      {"params", params},
                      {"shrink", Num(c.shrink)},
                      {"heldout_shrink", Num(c.heldout_shrink)},
@@ -220,9 +230,10 @@ void CandidatesSection(TextReport& o, const DiagnoseSummary& s) {
     std::string params;
     for (const auto& [k, v] : c.params) {
       const auto se = c.param_se.find(k);
-      params += FormatEffectParam(k, v, se != c.param_se.end() ? se->second : NAN) + "  ";
+      params += FormatEffectParam(k, v, se != c.param_se.end() ? se->second : NAN, sim::EffectToString(c.effect)) + "  ";
     }
     if (!c.note.empty()) params += "(" + c.note + ")";
+    if (c.clock.checked) params += " [" + c.clock.text + "]";
     if (const auto why = UnphysicalFit(sim::EffectToString(c.effect), c.params, b.runs, c.param_se); !why.empty())
       params += " IMPOSSIBLE VALUE, a symptom (the gap is something else): " + why;
     o.line(fmt::format("    {:<20} {:>8.3f} {:>9.3f} {:>9.1f} n {:>10}  {}", sim::EffectToString(c.effect), c.shrink,
@@ -241,7 +252,7 @@ void ExplanationSection(TextReport& o, const DiagnoseSummary& s) {
     int k = 0;
     for (const auto& e : s.explanation) {
       std::string params;
-      for (const auto& [n, v] : e.params) params += FormatParam(n, v) + "  ";
+      for (const auto& [n, v] : e.params) params += FormatParam(n, v, sim::EffectToString(e.effect)) + "  ";
       // A noise effect's size is the growth of the spread of one piece type
       // (explanation.hpp), printed as such.
       const std::string rel = e.size_pieces.empty()
@@ -250,9 +261,10 @@ void ExplanationSection(TextReport& o, const DiagnoseSummary& s) {
       o.line(fmt::format("    {:>4} {:<22} {:>17.0f}% {:>8.0f}%   {:>7.2f} / {:>6.2f}, {}{}  {}", ++k,
                          sim::EffectToString(e.effect), 100.0 * e.cumulative_shrink, 100.0 * e.cumulative_heldout_shrink,
                          e.size_mm, e.size_mrad, rel,
-                         !e.unphysical.empty() ? " (impossible value: a symptom)"
-                         : e.negligible ? " (negligible)"
-                                        : "",
+                         !e.unphysical.empty() ? std::string(" (impossible value: a symptom)")
+                         : !e.practical_floor.empty() ? " (negligible: " + e.practical_floor + ")"
+                         : e.negligible                 ? std::string(" (negligible)")
+                                                        : std::string(),
                          params));
     }
     o.line(fmt::format("    unexplained on held-out runs: {:.0f}%; negligible = size below {:.2g} x the noise of one "

@@ -41,6 +41,33 @@ void Significance(const CandidateFits& fits, double score_p_value, const Verdict
   }
 }
 
+/// Why the verdict is `unexplained` (best: the top candidate, if
+/// identifiable), naming a clock offset the moving samples do not support
+/// when it was the candidate with the most evidence.
+std::string UnexplainedReason(const Verdict& out, const Candidate* best, const std::string& p_text,
+                              double null_quantile_alpha, const VerdictOptions& options) {
+  // The candidate with the most evidence, when it is a clock offset the
+  // moving samples do not support: say so (the verdict's footprint rule).
+  const Candidate* clock = nullptr;
+  for (const Candidate& cd : out.candidates)
+    if (cd.identifiable && (!clock || cd.evidence > clock->evidence)) clock = &cd;
+  if (clock && clock->clock.supported) clock = nullptr;
+  std::string reason =
+      !best ? fmt::format("significant gap ({}) and no identifiable candidate", p_text)
+      : best->heldout_shrink < options.min_heldout_shrink || best->evidence <= 0.0
+          ? fmt::format("significant gap ({}); the best candidate, {}, closes only {:.0f}% of it on "
+                        "held-out runs",
+                        p_text, sim::EffectToString(best->effect), 100.0 * best->heldout_shrink)
+          : fmt::format("significant gap ({}); the best candidate, {}, closes {:.0f}% of it on held-out "
+                        "runs but leaves a significant gap (G = {:.1f} > {:.1f})",
+                        p_text, sim::EffectToString(best->effect), 100.0 * best->heldout_shrink,
+                        best->gap_after, null_quantile_alpha);
+  if (clock)
+    reason += fmt::format("; {} would close {:.0f}% held out, but {}", sim::EffectToString(clock->effect),
+                              100.0 * clock->heldout_shrink, clock->clock.text);
+  return reason;
+}
+
 /// Ranks the candidates and names the verdict with its reason.
 void Decide(const CandidateFits& fits, double score_p_value, double null_quantile_alpha, const VerdictOptions& options,
             Verdict& out) {
@@ -53,15 +80,19 @@ void Decide(const CandidateFits& fits, double score_p_value, double null_quantil
   // evidence, by evidence; then the others by evidence; unidentifiable last.
   // A winner must also leave no significant gap behind, unless it closes
   // nearly all of it (a tiny misfit of a huge effect still scores high).
+  // A clock offset whose moving samples do not show it (Candidate::clock)
+  // is a footprint of something at the stops: never named.
   auto qualifies = [&](const Candidate& cd) {
-    return cd.identifiable && cd.evidence > 0.0 && cd.heldout_shrink >= options.min_heldout_shrink &&
+    return cd.identifiable && cd.clock.supported && cd.evidence > 0.0 &&
+           cd.heldout_shrink >= options.min_heldout_shrink &&
            (cd.gap_after <= null_quantile_alpha || cd.heldout_shrink >= options.full_shrink);
   };
   // Found by its own likelihood-ratio test (the gap G may be too diffuse to
   // see it): significant after Bonferroni, gains held out, and leaves no
   // significant G.
   auto found_alone = [&](const Candidate& cd) {
-    return found_by_tests && cd.identifiable && cd.tested && !cd.impossible && out.tests * cd.lr_p_value < route_alpha &&
+    return found_by_tests && cd.identifiable && cd.clock.supported && cd.tested && !cd.impossible &&
+           out.tests * cd.lr_p_value < route_alpha &&
            cd.evidence > 0.0 && cd.gap_after <= null_quantile_alpha;
   };
   std::stable_sort(rank.begin(), rank.end(), [&](std::size_t a, std::size_t b) {
@@ -104,16 +135,7 @@ void Decide(const CandidateFits& fits, double score_p_value, double null_quantil
           best->gap_after, null_quantile_alpha);
     } else {
       out.verdict = "unexplained";
-      out.reason =
-          !best ? fmt::format("significant gap ({}) and no identifiable candidate", p_text)
-          : best->heldout_shrink < options.min_heldout_shrink || best->evidence <= 0.0
-              ? fmt::format("significant gap ({}); the best candidate, {}, closes only {:.0f}% of it on "
-                            "held-out runs",
-                            p_text, sim::EffectToString(best->effect), 100.0 * best->heldout_shrink)
-              : fmt::format("significant gap ({}); the best candidate, {}, closes {:.0f}% of it on held-out "
-                            "runs but leaves a significant gap (G = {:.1f} > {:.1f})",
-                            p_text, sim::EffectToString(best->effect), 100.0 * best->heldout_shrink,
-                            best->gap_after, null_quantile_alpha);
+      out.reason = UnexplainedReason(out, best, p_text, null_quantile_alpha, options);
     }
   }
 }

@@ -184,188 +184,337 @@ void WriteLog(const std::vector<double>& ts, const std::vector<Pose2>& sample_po
   }
 }
 
-}  // namespace
+/// Where the plan's motions meet standstills: a motion starts from one (the
+/// run's first move, or after a pause that lasts) and stops before one (a
+/// pause that lasts, or the run's end); standstill_follows: a lasting pause
+/// comes after it (the run's end does not count; standstill_motion).
+struct MotionBoundaries {
+  std::vector<char> starts, stops, standstill_follows;
+};
 
-// Longer than 80 lines on purpose: one loop over the motions and their steps
-// that shares the wheel positions, the pose and the sample cursor; the
-// pieces with state of their own (sample times, wheel disturbance, logger,
-// pose at any time) are the helpers above.
-SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::uint64_t seed, std::uint64_t run_index,
-                               const std::string& run_id, const std::string& direction) {
-  const Effects& fx = truth.effects;
-  if (!(truth.true_wheelbase_m > 0.0)) throw InvalidOptions("SimulateLoggedRun: true wheelbase must be > 0");
-  const std::vector<double> ts = SampleTimes(plan);
-
-  NormalSource gt_rng(StreamSeed(seed, run_index, kCampaignStreamGroundTruth));
-  NormalSource phase_rng(StreamSeed(seed, run_index, kCampaignStreamPhase));
-  NormalSource stand_rng(StreamSeed(seed, run_index, kCampaignStreamStandstill));
-  NormalSource floor_rng(StreamSeed(seed, run_index, kCampaignStreamMotionFloor));
-  NormalSource run_time_rng(StreamSeed(seed, run_index, kCampaignStreamRunTime));
-  // run_time_offset: this run's tau_i.
-  const double run_tau = fx.run_tau_sd > 0.0 ? fx.run_tau_sd * run_time_rng.Next() : 0.0;
-  // A motion between two standstills: starts at the run's first move or
-  // after a pause that lasts; stops before such a pause (or the run's end).
-  std::vector<char> motion_starts(plan.motions.size(), 0), motion_stops(plan.motions.size(), 0);
-  {
-    bool still = true;
-    for (std::size_t k = 0; k < plan.motions.size(); ++k) {
-      const PlannedMotion& m = plan.motions[k];
-      if (m.pause) {
-        if (m.duration_s > 0.0) still = true;
-        continue;
-      }
-      motion_starts[k] = still;
-      still = false;
-      std::size_t q = k + 1;
-      while (q < plan.motions.size() && plan.motions[q].pause && !(plan.motions[q].duration_s > 0.0)) ++q;
-      motion_stops[k] = q == plan.motions.size() || plan.motions[q].pause;
-    }
-  }
-  // standstill_motion applies only when a standstill follows.
-  auto standstill_follows = [&](std::size_t k) {
-    for (std::size_t q = k + 1; q < plan.motions.size(); ++q) {
-      if (!plan.motions[q].pause) return false;
-      if (plan.motions[q].duration_s > 0.0) return true;
-    }
-    return false;
-  };
-
-  SimulatedRun out;
-  TrajectoryRun& run = out.run;
-  run.run = run_id;
-  run.direction = direction;
-
-  // Wheel state: continuous position p (ticks, or nominal metres) and the
-  // cumulative commanded nominal travel.
-  double p[2] = {0.0, 0.0};
-  if (truth.ticks) {
-    p[0] = phase_rng.Uniform();
-    p[1] = phase_rng.Uniform();
-  }
-  out.phase_left = p[0];
-  out.phase_right = p[1];
-  const double nominal_per_tick[2] = {truth.nominal_per_tick_left, truth.nominal_per_tick_right};
-  const double true_per_tick[2] = {truth.true_per_tick_left, truth.true_per_tick_right};
-  WheelDisturbance disturbance(truth, seed, run_index);
-  const double slide_cos = std::cos(fx.slope_dir), slide_sin = std::sin(fx.slope_dir);
-
-  double commanded[2] = {0.0, 0.0};
-  Pose2 pose;
-  std::vector<StepRecord> steps;
-  steps.reserve(ts.size() + 2 * plan.motions.size());
-  std::vector<Pose2> sample_pose;
-  sample_pose.reserve(ts.size());
-  std::vector<double> sample_p[2];
-  sample_p[0].reserve(ts.size());
-  sample_p[1].reserve(ts.size());
-
-  std::size_t next_sample = 0;
-  auto record_samples_upto = [&](double t) {
-    while (next_sample < ts.size() && ts[next_sample] <= t + 1e-9) {
-      sample_pose.push_back(pose);
-      sample_p[0].push_back(p[0]);
-      sample_p[1].push_back(p[1]);
-      ++next_sample;
-    }
-  };
-  record_samples_upto(0.0);
-
-  double t = 0.0;
-  for (std::size_t mk = 0; mk < plan.motions.size(); ++mk) {
-    const PlannedMotion& m = plan.motions[mk];
-    const double t0 = t, t1 = t + m.duration_s;
+MotionBoundaries FindBoundaries(const RunPlan& plan) {
+  const std::size_t n = plan.motions.size();
+  MotionBoundaries b{std::vector<char>(n, 0), std::vector<char>(n, 0), std::vector<char>(n, 0)};
+  bool still = true;
+  for (std::size_t k = 0; k < n; ++k) {
+    const PlannedMotion& m = plan.motions[k];
     if (m.pause) {
-      record_samples_upto(t1);
-      t = t1;
+      if (m.duration_s > 0.0) still = true;
       continue;
     }
-    // Targets: the controller stops each wheel when its count reaches the
-    // target count of the cumulative commanded travel.
-    commanded[0] += m.left_m;
-    commanded[1] += m.right_m;
-    double p_end[2];
-    for (int w = 0; w < 2; ++w) {
-      if (truth.ticks) {
-        const double target = std::round(commanded[w] / nominal_per_tick[w]);
-        p_end[w] = EncoderStopPosition(target, std::floor(p[w]), p[w], kStopBelowTicks);
+    b.starts[k] = still;
+    still = false;
+    std::size_t q = k + 1;
+    while (q < n && plan.motions[q].pause && !(plan.motions[q].duration_s > 0.0)) ++q;
+    b.stops[k] = q == n || plan.motions[q].pause;
+    for (q = k + 1; q < n && plan.motions[q].pause; ++q)
+      if (plan.motions[q].duration_s > 0.0) {
+        b.standstill_follows[k] = 1;
+        break;
+      }
+  }
+  return b;
+}
+
+/// A motion's sign (PlannedMotion::sign, or from its travel).
+int MotionSign(const PlannedMotion& m) {
+  if (m.sign != 0) return m.sign;
+  if (m.cls == MotionClass::kTurn) return m.right_m - m.left_m >= 0.0 ? 1 : -1;
+  return m.left_m + m.right_m >= 0.0 ? 1 : -1;
+}
+
+/// Executes a plan step by step (SimulateLoggedRun): the wheel positions,
+/// the pose, the executed steps and what each sample sees.
+class RunExecutor {
+ public:
+  RunExecutor(const RunPlan& plan, const RunTruth& truth, std::uint64_t seed, std::uint64_t run_index,
+              const std::vector<double>& ts, SimulatedRun& out)
+      : plan_(plan),
+        truth_(truth),
+        fx_(truth.effects),
+        ts_(ts),
+        out_(out),
+        bounds_(FindBoundaries(plan)),
+        phase_rng_(StreamSeed(seed, run_index, kCampaignStreamPhase)),
+        stand_rng_(StreamSeed(seed, run_index, kCampaignStreamStandstill)),
+        floor_rng_(StreamSeed(seed, run_index, kCampaignStreamMotionFloor)),
+        swivel_rng_(StreamSeed(seed, run_index, kCampaignStreamSwivel)),
+        disturbance_(truth, seed, run_index),
+        nominal_per_tick_{truth.nominal_per_tick_left, truth.nominal_per_tick_right},
+        true_per_tick_{truth.true_per_tick_left, truth.true_per_tick_right},
+        slide_cos_(std::cos(fx_.slope_dir)),
+        slide_sin_(std::sin(fx_.slope_dir)) {
+    if (truth.ticks) {
+      p_[0] = phase_rng_.Uniform();
+      p_[1] = phase_rng_.Uniform();
+    }
+    out.phase_left = p_[0];
+    out.phase_right = p_[1];
+    steps_.reserve(ts.size() + 2 * plan.motions.size());
+    sample_pose_.reserve(ts.size());
+    sample_p_[0].reserve(ts.size());
+    sample_p_[1].reserve(ts.size());
+  }
+
+  /// Runs every motion and pause of the plan.
+  void Execute() {
+    RecordSamplesUpto(0.0);
+    double t = 0.0;
+    for (std::size_t mk = 0; mk < plan_.motions.size(); ++mk) {
+      const PlannedMotion& m = plan_.motions[mk];
+      const double t1 = t + m.duration_s;
+      if (m.pause) {
+        Rest(t, t1);
       } else {
-        p_end[w] = commanded[w];
+        coast_.active = false;  // a motion ends any coast
+        double p_end[2];
+        WheelTargets(m, p_end);
+        StartKicks(mk);
+        RunSteps(mk, t, p_end);
+      }
+      t = t1;
+    }
+    RecordSamplesUpto(ts_.back());
+  }
+
+  const std::vector<Pose2>& sample_pose() const { return sample_pose_; }
+  const std::vector<double> (&sample_p() const)[2] { return sample_p_; }
+  const std::vector<StepRecord>& steps() const { return steps_; }
+
+ private:
+  void RecordSamplesUpto(double t) {
+    while (next_sample_ < ts_.size() && ts_[next_sample_] <= t + 1e-9) {
+      sample_pose_.push_back(pose_);
+      sample_p_[0].push_back(p_[0]);
+      sample_p_[1].push_back(p_[1]);
+      ++next_sample_;
+    }
+  }
+
+  /// The controller stops each wheel when its count reaches the target
+  /// count of the cumulative commanded travel.
+  void WheelTargets(const PlannedMotion& m, double (&p_end)[2]) {
+    commanded_[0] += m.left_m;
+    commanded_[1] += m.right_m;
+    for (int w = 0; w < 2; ++w) {
+      if (truth_.ticks) {
+        const double target = std::round(commanded_[w] / nominal_per_tick_[w]);
+        p_end[w] = EncoderStopPosition(target, std::floor(p_[w]), p_[w], kStopBelowTicks);
+      } else {
+        p_end[w] = commanded_[w];
       }
     }
-    const double dp_total[2] = {p_end[0] - p[0], p_end[1] - p[1]};
-    // castor_kick: a start from standstill that is not a spot turn.
-    if (m.from_standstill && m.cls != MotionClass::kTurn && fx.castor_kappa != 0.0) {
-      pose.theta += (m.left_m + m.right_m >= 0.0 ? 1.0 : -1.0) * fx.castor_kappa;
+  }
+
+  /// castor_kick (a start from standstill that is not a spot turn) and
+  /// castor_swivel (a straight or arc start after a spot turn or a
+  /// reversal) as the motion begins.
+  void StartKicks(std::size_t mk) {
+    const PlannedMotion& m = plan_.motions[mk];
+    if (m.from_standstill && m.cls != MotionClass::kTurn && fx_.castor_kappa != 0.0)
+      pose_.theta += (m.left_m + m.right_m >= 0.0 ? 1.0 : -1.0) * fx_.castor_kappa;
+    if (!m.motion_start) return;
+    const int sign = MotionSign(m);
+    if (m.cls != MotionClass::kTurn) {
+      if (fx_.swivel_kappa != 0.0) {
+        if (last_turn_sign_ != 0)
+          pose_.theta += last_turn_sign_ * fx_.swivel_kappa;
+        else if (last_drive_sign_ != 0 && sign != last_drive_sign_)
+          pose_.theta += (swivel_rng_.Uniform() < 0.5 ? -1.0 : 1.0) * fx_.swivel_kappa;
+      }
+      last_drive_sign_ = sign;
+      last_turn_sign_ = 0;
+    } else {
+      last_turn_sign_ = sign;
     }
-    const double heading_factor = m.cls == MotionClass::kTurn ? 1.0 - fx.scrub_k : 1.0;
+  }
+
+  /// One step's true wheel travel with noise, bumps and start / stop slip.
+  void StepTravel(std::size_t mk, bool first_step, bool last, const double (&dp)[2], double (&travel)[2]) {
+    for (int w = 0; w < 2; ++w) {
+      const double asym = dp[w] < 0.0 ? 1.0 + fx_.asymmetry_a : 1.0;
+      travel[w] = dp[w] * true_per_tick_[w] * asym;
+    }
+    disturbance_.Apply(travel, out_);
+    // motion_noise_floor: half its variance in the motion's first step,
+    // half in its last (start and stop slip).
+    if (fx_.floor_sigma > 0.0) {
+      const bool start_slip = bounds_.starts[mk] && first_step, stop_slip = bounds_.stops[mk] && last;
+      for (int w = 0; w < 2; ++w) {
+        if (start_slip) travel[w] += fx_.floor_sigma * std::sqrt(0.5) * floor_rng_.Next();
+        if (stop_slip) travel[w] += fx_.floor_sigma * std::sqrt(0.5) * floor_rng_.Next();
+      }
+    }
+  }
+
+  /// The steps of one motion, from t0 to its end: one per sample interval.
+  void RunSteps(std::size_t mk, double t0, const double (&p_end)[2]) {
+    const PlannedMotion& m = plan_.motions[mk];
+    const double t1 = t0 + m.duration_s;
+    const double dp_total[2] = {p_end[0] - p_[0], p_end[1] - p_[1]};
+    const double heading_factor = m.cls == MotionClass::kTurn ? 1.0 - fx_.scrub_k : 1.0;
     double ta = t0;
     double done = 0.0;  // fraction of the motion executed
     while (true) {
       double tb = t1;
-      if (next_sample < ts.size() && ts[next_sample] < t1 - 1e-12 && ts[next_sample] > ta) tb = ts[next_sample];
+      if (next_sample_ < ts_.size() && ts_[next_sample_] < t1 - 1e-12 && ts_[next_sample_] > ta) tb = ts_[next_sample_];
       const double f_end = m.duration_s > 0.0 ? (tb - t0) / m.duration_s : 1.0;
       const bool last = tb >= t1;
-      double travel[2];
-      double dp[2];
-      for (int w = 0; w < 2; ++w) {
-        dp[w] = last ? p_end[w] - p[w] : (f_end - done) * dp_total[w];
-        const double asym = dp[w] < 0.0 ? 1.0 + fx.asymmetry_a : 1.0;
-        travel[w] = dp[w] * true_per_tick[w] * asym;
-      }
-      disturbance.Apply(travel, out);
-      // motion_noise_floor: half its variance in the motion's first step,
-      // half in its last (start and stop slip).
-      if (fx.floor_sigma > 0.0) {
-        const bool first_step = motion_starts[mk] && ta == t0, last_step = motion_stops[mk] && last;
-        for (int w = 0; w < 2; ++w) {
-          if (first_step) travel[w] += fx.floor_sigma * std::sqrt(0.5) * floor_rng.Next();
-          if (last_step) travel[w] += fx.floor_sigma * std::sqrt(0.5) * floor_rng.Next();
-        }
-      }
+      double dp[2], travel[2];
+      for (int w = 0; w < 2; ++w) dp[w] = last ? p_end[w] - p_[w] : (f_end - done) * dp_total[w];
+      StepTravel(mk, ta == t0, last, dp, travel);
       StepRecord s;
       s.ta = ta;
       s.tb = tb;
-      s.start = pose;
+      s.start = pose_;
       s.left_m = travel[0];
       s.right_m = travel[1];
       s.heading_factor = heading_factor;
-      const double slide = fx.slope_g * 0.5 * (std::abs(travel[0]) + std::abs(travel[1]));
-      s.slide_x_m = slide * slide_cos;
-      s.slide_y_m = slide * slide_sin;
-      pose = AdvancePose(pose, travel[0], travel[1], truth.true_wheelbase_m, heading_factor, s.slide_x_m,
-                         s.slide_y_m);
-      s.end = pose;
-      steps.push_back(s);
-      p[0] += dp[0];
-      p[1] += dp[1];
+      const double slope = fx_.slope_g * 0.5 * (std::abs(travel[0]) + std::abs(travel[1]));
+      s.slide_x_m = slope * slide_cos_;
+      s.slide_y_m = slope * slide_sin_;
+      pose_ = AdvancePose(pose_, travel[0], travel[1], truth_.true_wheelbase_m, heading_factor, s.slide_x_m,
+                          s.slide_y_m);
+      s.end = pose_;
+      steps_.push_back(s);
+      p_[0] += dp[0];
+      p_[1] += dp[1];
       done = f_end;
       if (last) {
-        p[0] = p_end[0];
-        p[1] = p_end[1];
-        // standstill_motion: the robot settles as the standstill begins (an
-        // instantaneous step, so every still sample shows it).
-        if ((fx.stand_sigma_xy > 0.0 || fx.stand_sigma_theta > 0.0) && motion_stops[mk] && standstill_follows(mk)) {
-          StepRecord nudge;
-          nudge.ta = nudge.tb = tb;
-          nudge.start = pose;
-          const double nx = fx.stand_sigma_xy * stand_rng.Next(), ny = fx.stand_sigma_xy * stand_rng.Next();
-          const double nt = fx.stand_sigma_theta * stand_rng.Next();
-          const double c = std::cos(pose.theta), sn = std::sin(pose.theta);
-          pose = {pose.x + c * nx - sn * ny, pose.y + sn * nx + c * ny, pose.theta + nt};
-          nudge.end = pose;
-          steps.push_back(nudge);
-        }
+        p_[0] = p_end[0];
+        p_[1] = p_end[1];
+        StopEffects(mk, tb);
       }
-      record_samples_upto(tb);
+      RecordSamplesUpto(tb);
       if (last) break;
       ta = tb;
     }
-    t = t1;
   }
-  record_samples_upto(ts.back());
 
-  out.true_pose = sample_pose;
-  WriteLog(ts, sample_pose, sample_p, steps, truth, run_tau, gt_rng, run);
+  /// An instantaneous change of the true pose at time t (a step of no
+  /// duration, so that the pose at any time sees it).
+  void Jump(const Pose2& to, double t) {
+    StepRecord s;
+    s.ta = s.tb = t;
+    s.start = pose_;
+    pose_ = to;
+    s.end = pose_;
+    steps_.push_back(s);
+  }
+
+  /// At the end of motion mk (time t): standstill_motion, then stop_slide.
+  void StopEffects(std::size_t mk, double t) {
+    const PlannedMotion& m = plan_.motions[mk];
+    // standstill_motion: the robot settles as the standstill begins.
+    if ((fx_.stand_sigma_xy > 0.0 || fx_.stand_sigma_theta > 0.0) && bounds_.stops[mk] &&
+        bounds_.standstill_follows[mk]) {
+      const double nx = fx_.stand_sigma_xy * stand_rng_.Next(), ny = fx_.stand_sigma_xy * stand_rng_.Next();
+      const double nt = fx_.stand_sigma_theta * stand_rng_.Next();
+      const double c = std::cos(pose_.theta), sn = std::sin(pose_.theta);
+      Jump({pose_.x + c * nx - sn * ny, pose_.y + sn * nx + c * ny, pose_.theta + nt}, t);
+    }
+    // stop_slide: the chassis coasts on at the speed the motion ended with,
+    // through the pause that follows (Coast).
+    if ((fx_.slide_d == 0.0 && fx_.slide_a == 0.0) || !m.motion_end || !bounds_.stops[mk]) return;
+    const double duration = m.duration_s > 0.0 ? m.duration_s : 1.0;
+    double rate[2] = {std::isfinite(m.end_rate_left) ? m.end_rate_left : m.left_m / duration,
+                      std::isfinite(m.end_rate_right) ? m.end_rate_right : m.right_m / duration};
+    for (int w = 0; w < 2; ++w)
+      rate[w] *= true_per_tick_[w] / nominal_per_tick_[w] * (rate[w] < 0.0 ? 1.0 + fx_.asymmetry_a : 1.0);
+    coast_ = {};
+    coast_.t0 = t;
+    coast_.turn = m.cls == MotionClass::kTurn;
+    coast_.rate = coast_.turn ? (rate[1] - rate[0]) / truth_.true_wheelbase_m : 0.5 * (rate[0] + rate[1]);
+    coast_.k = coast_.turn ? fx_.slide_a : fx_.slide_d;
+    coast_.active = coast_.k > 0.0 && coast_.rate != 0.0;
+  }
+
+  /// The coast of stop_slide: from t0, uniform deceleration 1 / (2 k)
+  /// (Coulomb friction) from `rate` until it rests after 2 k |rate| s,
+  /// having covered k rate |rate| (m along the heading, or rad of turn).
+  struct Coast {
+    bool active = false, turn = false;
+    double t0 = 0.0, rate = 0.0, k = 0.0;
+    double Progress(double t) const {
+      const double v = std::abs(rate), tau = std::clamp(t - t0, 0.0, 2.0 * k * v);
+      return (rate > 0.0 ? 1.0 : -1.0) * (v * tau - tau * tau / (4.0 * k));
+    }
+    double End() const { return t0 + 2.0 * k * std::abs(rate); }
+  };
+
+  /// A pause from t to t1: the samples in it, and the coast of the stop
+  /// before it while it lasts (in steps of at most 1 ms, so that the pose
+  /// at any time follows it).
+  void Rest(double t, double t1) {
+    while (coast_.active && t < t1) {
+      // Steps of at most 1 ms: the pose at any time (time_offset) is
+      // interpolated linearly within a step, the coast is quadratic.
+      double tb = std::min({t1, coast_.End(), t + 1e-3});
+      if (next_sample_ < ts_.size() && ts_[next_sample_] > t && ts_[next_sample_] < tb) tb = ts_[next_sample_];
+      const double step = coast_.Progress(tb) - coast_.Progress(t);
+      StepRecord s;
+      s.ta = t;
+      s.tb = tb;
+      s.start = pose_;
+      if (coast_.turn) {
+        s.left_m = -0.5 * step * truth_.true_wheelbase_m;
+        s.right_m = 0.5 * step * truth_.true_wheelbase_m;
+      } else {
+        s.slide_x_m = step * std::cos(pose_.theta);
+        s.slide_y_m = step * std::sin(pose_.theta);
+      }
+      pose_ = AdvancePose(pose_, s.left_m, s.right_m, truth_.true_wheelbase_m, 1.0, s.slide_x_m, s.slide_y_m);
+      s.end = pose_;
+      steps_.push_back(s);
+      RecordSamplesUpto(tb);
+      t = tb;
+      if (tb >= coast_.End()) coast_.active = false;
+    }
+    RecordSamplesUpto(t1);
+  }
+
+  const RunPlan& plan_;
+  const RunTruth& truth_;
+  const Effects& fx_;
+  const std::vector<double>& ts_;
+  SimulatedRun& out_;
+  const MotionBoundaries bounds_;
+  NormalSource phase_rng_, stand_rng_, floor_rng_, swivel_rng_;
+  WheelDisturbance disturbance_;
+  const double nominal_per_tick_[2], true_per_tick_[2];
+  const double slide_cos_, slide_sin_;
+  // Wheel state: continuous position p (ticks, or nominal metres) and the
+  // cumulative commanded nominal travel.
+  double p_[2] = {0.0, 0.0};
+  double commanded_[2] = {0.0, 0.0};
+  Pose2 pose_;
+  // castor_swivel: the last spot turn's sign since the last straight or arc
+  // motion (0: none), and that motion's drive sign (0: none yet).
+  int last_turn_sign_ = 0, last_drive_sign_ = 0;
+  Coast coast_;
+  std::vector<StepRecord> steps_;
+  std::vector<Pose2> sample_pose_;
+  std::vector<double> sample_p_[2];
+  std::size_t next_sample_ = 0;
+};
+
+}  // namespace
+
+SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::uint64_t seed, std::uint64_t run_index,
+                               const std::string& run_id, const std::string& direction) {
+  if (!(truth.true_wheelbase_m > 0.0)) throw InvalidOptions("SimulateLoggedRun: true wheelbase must be > 0");
+  const std::vector<double> ts = SampleTimes(plan);
+  NormalSource gt_rng(StreamSeed(seed, run_index, kCampaignStreamGroundTruth));
+  NormalSource run_time_rng(StreamSeed(seed, run_index, kCampaignStreamRunTime));
+  // run_time_offset: this run's tau_i.
+  const double run_tau = truth.effects.run_tau_sd > 0.0 ? truth.effects.run_tau_sd * run_time_rng.Next() : 0.0;
+  SimulatedRun out;
+  out.run.run = run_id;
+  out.run.direction = direction;
+  RunExecutor exec(plan, truth, seed, run_index, ts, out);
+  exec.Execute();
+  out.true_pose = exec.sample_pose();
+  WriteLog(ts, exec.sample_pose(), exec.sample_p(), exec.steps(), truth, run_tau, gt_rng, out.run);
   return out;
 }
 

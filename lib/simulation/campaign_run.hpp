@@ -26,7 +26,18 @@
 //    turns the heading change is (1 - k) times (r - l)/b_true [turn_scrub].
 //    At the start of every motion that is not a spot turn and starts from
 //    standstill, the heading jumps by +kappa (forward) or -kappa (backward)
-//    [castor_kick].
+//    [castor_kick]. At the start of a straight or arc motion that follows a
+//    spot turn (with or without a pause) the heading jumps by kappa_s times
+//    the turn's sign; after a reversal of the drive direction by +-kappa_s,
+//    the sign drawn with equal probability [castor_swivel].
+//  - At a stop (a motion's end followed by a lasting pause, or the run's
+//    end), first the robot settles [standstill_motion], an instantaneous
+//    step as the wheels stop; then the chassis coasts on [stop_slide]: by
+//    d v|v| metres along the heading after a straight or arc motion at true
+//    speed v (the axle midpoint's, at the motion's end), by a w|w| rad after
+//    a spot turn at true rate w, decelerating uniformly at 1/(2 d) (1/(2 a))
+//    as Coulomb friction does, so the coast takes 2 d |v| (2 a |w|) seconds
+//    of the pause that follows; a motion that starts earlier ends it.
 //  - Ground truth at sample time t is the true pose at t - tau
 //    [time_offset] (before the start: the start pose; after the end: the
 //    end pose), reported at the robot-frame point (dx, dy) [gt_offset], plus
@@ -46,6 +57,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -65,6 +77,7 @@ enum CampaignStream : std::uint64_t {
   kCampaignStreamStandstill = 105,
   kCampaignStreamMotionFloor = 106,
   kCampaignStreamRunTime = 107,
+  kCampaignStreamSwivel = 108,
 };
 
 /// One commanded motion, or a pause.
@@ -78,6 +91,17 @@ struct PlannedMotion {
   /// after a pause of non-zero duration (a motion that follows another one
   /// back to back never does). A castor kick applies unless cls is kTurn.
   bool from_standstill = true;
+  /// The step begins / ends its motion (a replayed run splits a motion
+  /// into one step per sample interval): castor_swivel kicks at a motion's
+  /// start, stop_slide acts at its end when a lasting pause follows.
+  bool motion_start = true, motion_end = true;
+  /// The motion's sign: straight / arc +1 forward, -1 backward; turn +1
+  /// ccw, -1 cw. 0: from this step's travel.
+  int sign = 0;
+  /// Nominal wheel speeds at the motion's end [m/s] (stop_slide); NaN: the
+  /// step's travel over its duration.
+  double end_rate_left = std::numeric_limits<double>::quiet_NaN();
+  double end_rate_right = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct RunPlan {

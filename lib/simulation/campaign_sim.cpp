@@ -94,6 +94,33 @@ RunPlan FigureEightPlan(double radius_m, double wheelbase_m, const CampaignSimOp
   return plan;
 }
 
+/// A replayed step's place in its motion (castor_swivel, stop_slide): the
+/// motion's start, its end when a standstill follows (the next motion
+/// starts from standstill, as the diagnosis reads it, or none follows), its
+/// sign, and the nominal wheel speeds at its end (the mean over up to three
+/// full intervals before its last, partial one).
+void MarkReplayedMotion(const WheelTravel& travel, const std::vector<double>& ts,
+                        const std::vector<MotionSegment>& motions, std::size_t k, const MotionOptions& mo,
+                        std::size_t i, PlannedMotion& step) {
+  const MotionSegment& m = motions[k];
+  step.sign = m.sign;
+  step.motion_start = i == m.first_interval;
+  step.motion_end = false;
+  if (i != m.last_interval) return;
+  step.motion_end = k + 1 == motions.size() ||
+                    (motions[k + 1].first_interval - m.last_interval > static_cast<std::size_t>(mo.min_stand_intervals) &&
+                     !motions[k + 1].after_brief_stop);
+  const std::size_t hi = m.last_interval, lo = hi > m.first_interval + 3 ? hi - 3 : m.first_interval;
+  if (hi > lo && ts[hi] > ts[lo]) {
+    step.end_rate_left = (travel.left_m[hi] - travel.left_m[lo]) / (ts[hi] - ts[lo]);
+    step.end_rate_right = (travel.right_m[hi] - travel.right_m[lo]) / (ts[hi] - ts[lo]);
+  } else if (ts[m.EndSample()] > ts[m.FirstSample()]) {
+    const double dt = ts[m.EndSample()] - ts[m.FirstSample()];
+    step.end_rate_left = m.left_m / dt;
+    step.end_rate_right = m.right_m / dt;
+  }
+}
+
 /// Replays a recorded run: one planned step per sample interval with the
 /// recorded nominal wheel travel and timing; motions and standstill as
 /// SegmentMotions finds them.
@@ -132,6 +159,7 @@ RunPlan ReplayPlan(const TrajectoryRun& run, const RobotParams& robot) {
       const double sgn = m.left_m + m.right_m >= 0.0 ? 1.0 : -1.0;
       if ((step.left_m + step.right_m) * sgn < 0.0) step.from_standstill = false;
     }
+    MarkReplayedMotion(travel, plan.sample_times, motions, next_motion, mo, i, step);
     plan.motions.push_back(step);
   }
   return plan;

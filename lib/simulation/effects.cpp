@@ -3,6 +3,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include <fmt/format.h>
@@ -49,6 +50,15 @@ const std::vector<EffectDescriptor>& EffectCatalogue() {
        "its length"},
       {EffectKind::kRunTimeOffset, "run_time_offset", {{"tau_sd", &Effects::run_tau_sd, "s"}}, true,
        "in run i the ground truth stamped t shows the true pose at t - tau_i, tau_i ~ N(0, tau_sd^2) per run"},
+      {EffectKind::kStopSlide,
+       "stop_slide",
+       {{"d", &Effects::slide_d, "s^2/m"}, {"a", &Effects::slide_a, "s^2/rad"}},
+       true,
+       "at every stop after a straight or arc motion at speed v the chassis coasts on along its last direction "
+       "of travel by d v^2 m while the encoders read still; after a spot turn at rate w it turns on by a w^2 rad"},
+      {EffectKind::kCastorSwivel, "castor_swivel", {{"kappa", &Effects::swivel_kappa, "rad"}}, true,
+       "at the start of a straight or arc motion after a spot turn the heading jumps by kappa times the turn's "
+       "sign (ccw +1, cw -1); after a reversal of the drive direction by +kappa or -kappa with equal probability"},
       {EffectKind::kGtYawMisalignment, "gt_yaw_misalignment", {{"delta", &Effects::yaw_delta, "rad"}}, false,
        "(outside the contract) ground-truth heading = true heading + delta; position right"},
       {EffectKind::kFloorSlope,
@@ -94,7 +104,26 @@ std::optional<EffectKind> EffectFromString(std::string_view name) {
   return std::nullopt;
 }
 
+namespace {
+// Ranges of the issue-21 effects: d = 1/(2 mu g) <= 1 s^2/m is a friction
+// coefficient of at least 0.05 (ice is about 0.05-0.1); a the same for the
+// turn; a swivel castor's kick of at most 0.5 rad (29 deg).
+constexpr double kMaxSlideD = 1.0;
+constexpr double kMaxSlideA = 1.0;
+constexpr double kMaxSwivelKappa = 0.5;
+}  // namespace
+
 std::string Effects::Check() const {
+  // Ranges that also catch NaN (the message gives the allowed range).
+  if (!(slide_d >= 0.0 && slide_d <= kMaxSlideD))
+    return fmt::format("stop_slide.d = {} must be in [0, {}] s^2/m (d = 1/(2 mu g): a friction coefficient mu of at "
+                       "least 0.05)",
+                       slide_d, kMaxSlideD);
+  if (!(slide_a >= 0.0 && slide_a <= kMaxSlideA))
+    return fmt::format("stop_slide.a = {} must be in [0, {}] s^2/rad", slide_a, kMaxSlideA);
+  if (!(std::abs(swivel_kappa) <= kMaxSwivelKappa))
+    return fmt::format("castor_swivel.kappa = {} must be in [-{}, {}] rad", swivel_kappa, kMaxSwivelKappa,
+                       kMaxSwivelKappa);
   auto finite = [](const char* name, double v) -> std::string {
     if (!std::isfinite(v)) return fmt::format("{} = {} must be finite", name, v);
     return {};
@@ -187,11 +216,23 @@ void ParseEffectSpec(std::string_view spec, Effects& effects) {
     if (!seen.insert(key).second) fail(fmt::format("parameter '{}' given twice", key));
     double v = 0.0;
     const auto [ptr, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
-    if (ec != std::errc() || ptr != value.data() + value.size() || !std::isfinite(v))
-      fail(fmt::format("{} = '{}' is not a finite number", key, value));
+    if (ec != std::errc() || ptr != value.data() + value.size() || !std::isfinite(v)) {
+      // The allowed range, where Check states one that NaN fails.
+      Effects probe;
+      probe.*(param->field) = std::numeric_limits<double>::quiet_NaN();
+      const std::string range = probe.Check();
+      const std::size_t must = range.find(" must be ");
+      fail(fmt::format("{} = '{}' is not a finite number{}", key, value,
+                       range.starts_with(fmt::format("{}.{} ", d.name, key)) && must != std::string::npos &&
+                               range.find("must be finite") == std::string::npos
+                           ? ";" + range.substr(must)
+                           : std::string()));
+    }
     effects.*(param->field) = v;
   }
   if (seen.empty()) fail("no parameters");
+  // The effect's own range (the rest of Check is the caller's business).
+  if (const std::string e = effects.Check(); e.starts_with(std::string(d.name) + ".")) fail(e);
 }
 
 std::string EffectSpecString(EffectKind kind, const Effects& effects) {

@@ -30,6 +30,14 @@
 //                                   motion starts, half as it stops)
 //   run_time_offset     tau_sd      run i's ground truth stamped t shows the true pose
 //                                   at t - tau_i, tau_i ~ N(0, tau_sd^2) per run
+//   stop_slide          d, a        at every stop (a standstill follows) after a straight
+//                                   or arc motion at speed v the chassis coasts on by
+//                                   d v^2 m along its last direction of travel; after a
+//                                   spot turn at rate w it turns on by a w^2 rad
+//   castor_swivel       kappa       at the start of a straight or arc motion that follows
+//                                   a spot turn the heading jumps kappa x the turn's sign
+//                                   (ccw +1, cw -1); after a reversal of the drive
+//                                   direction +-kappa with equal probability
 //
 // Two further effects are NOT in the contract; the blind validation benchmark
 // uses them as "outside" effects that no listed effect mimics, to check that
@@ -67,6 +75,8 @@ enum class EffectKind {
   kStandstillMotion,
   kMotionNoiseFloor,
   kRunTimeOffset,
+  kStopSlide,
+  kCastorSwivel,
   // Outside the contract (blind benchmark only).
   kGtYawMisalignment,
   kFloorSlope,
@@ -96,6 +106,9 @@ struct Effects {
   double stand_sigma_theta = 0.0;  ///< standstill_motion.sigma_theta [rad]
   double floor_sigma = 0.0;        ///< motion_noise_floor.sigma [m]
   double run_tau_sd = 0.0;         ///< run_time_offset.tau_sd [s]
+  double slide_d = 0.0;            ///< stop_slide.d [s^2/m]
+  double slide_a = 0.0;            ///< stop_slide.a [s^2/rad]
+  double swivel_kappa = 0.0;       ///< castor_swivel.kappa [rad]
   double yaw_delta = 0.0;      ///< gt_yaw_misalignment.delta [rad] (outside)
   double slope_g = 0.0;        ///< floor_slope.g [m/m] (outside)
   double slope_dir = 0.0;      ///< floor_slope.dir [rad] (outside)
@@ -129,7 +142,7 @@ struct EffectDescriptor {
 
 /// All effects, contract ones first (in the contract's table order).
 const std::vector<EffectDescriptor>& EffectCatalogue();
-/// The contract's twelve effects (those the simulator produces).
+/// The contract's fourteen effects (those the simulator produces).
 std::vector<EffectKind> ContractEffects();
 /// The contract's parameter errors of a given model (`diagnose --baseline`):
 /// wheelbase_error, diameter_ratio_error, wheel_noise_error.
