@@ -96,3 +96,36 @@ TEST_CASE("DART campaigns: fitted sizes match the engine's", "[diagnose][dart]")
     CHECK_THAT(Param(*c, "tau"), WithinAbs(tau, 3e-3));
   }
 }
+
+TEST_CASE("DART campaigns: sliding stops are named stop_slide, never a clock", "[diagnose][dart]") {
+  const auto& j = Diagnose("stop_slide");
+  INFO(j["verdict"].dump());
+  CHECK(j["verdict"]["effect"] == "stop_slide");
+  for (const auto& e : j["verdict"]["effects"]) {
+    CHECK(e != "time_offset");
+    CHECK(e != "run_time_offset");
+  }
+  // d within 10 % of the engine's: the mean slide after a leg over v^2.
+  const auto* c = Candidate(j, "stop_slide");
+  REQUIRE(c != nullptr);
+  const double v = TruthNumber("stop_slide", R"(; v ([0-9.]+) m/s)");
+  const double slide = TruthNumber("stop_slide", R"(slide after a leg[^:]*: \+([0-9.]+) mm)") * 1e-3;
+  CHECK_THAT(Param(*c, "d"), WithinAbs(slide / (v * v), 0.1 * slide / (v * v)));
+}
+
+TEST_CASE("DART campaigns: a swivel castor's kicks are named castor_swivel", "[diagnose][dart]") {
+  // Named among the verdict's effects, kappa within 25 % of the engine's mean
+  // kick after a turn. (The verdict's first effect is still bump_outliers:
+  // docs/diagnosis.md, Physics-engine validation.)
+  const auto& j = Diagnose("swivel_castor");
+  INFO(j["verdict"].dump());
+  bool named = false;
+  for (const auto& e : j["verdict"]["effects"]) named = named || e == "castor_swivel";
+  CHECK(named);
+  const auto* c = Candidate(j, "castor_swivel");
+  REQUIRE(c != nullptr);
+  const double ccw = TruthNumber("swivel_castor", R"(forward motion after ccw: \+([0-9.]+) mrad)");
+  const double cw = TruthNumber("swivel_castor", R"(forward motion after cw: -([0-9.]+) mrad)");
+  const double kappa = 0.5 * (ccw + cw) * 1e-3;
+  CHECK_THAT(Param(*c, "kappa"), WithinAbs(kappa, 0.25 * kappa));
+}
