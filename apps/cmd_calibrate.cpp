@@ -433,10 +433,10 @@ void HeldoutSection(io::HtmlReport& rep, const nlohmann::json& j) {
 // E_d/E_b, evaluation before/after, the held-out comparison), then the
 // plots. About 100 lines: one page laid out top to bottom, each table a few
 // lines; the held-out section is its own helper.
-std::string CalibrationReportHtml(const nlohmann::json& j, const CalibrateJobResult& r, const std::string& plot_svg,
-                                  const std::string& which, const RobotParams& chosen) {
+// The report's headline: is a correction worthwhile, and by how much the
+// classic correction shrinks E_max,syst on the same runs.
+void ReportHeadline(io::HtmlReport& rep, const CalibrateJobResult& r, const std::string& which) {
   const UmbmarkSummary& s = r.umbmark;
-  io::HtmlReport rep("umbmark calibrate", r.label);
   const double emax = s.E_max_syst_m * 1e3, three_sem = 3e3 * s.sem_m;
   if (!s.compensation_worthwhile) {
     rep.Headline(fmt::format("The systematic error E_max,syst = {:.2f} mm lies within the run-to-run scatter (3 SEM = {:.2f} "
@@ -444,16 +444,29 @@ std::string CalibrationReportHtml(const nlohmann::json& j, const CalibrateJobRes
                              emax, three_sem),
                  io::HtmlReport::Level::kInfo);
   } else if (r.evaluation) {
+    // r.evaluation is the classic UMBmark correction's (RunCalibrateJob); the
+    // recommended set can be another method, whose return errors the plot shows.
     const double after = r.evaluation->E_max_syst_m * 1e3;
-    rep.Headline(fmt::format("Correction worthwhile: E_max,syst {:.2f} mm before, {:.2f} mm after correcting with the {} "
-                             "parameters ({:.1f}x smaller; 3 SEM = {:.2f} mm).",
-                             emax, after, which, emax / std::max(after, 1e-9), three_sem),
+    const std::string shown_note =
+        which.rfind("umbmark", 0) == 0
+            ? std::string()
+            : fmt::format(" The recommended calibration is {}: its return errors are in the plot.", which);
+    rep.Headline(fmt::format("Correction worthwhile: E_max,syst {:.2f} mm before, {:.2f} mm after the classic UMBmark "
+                             "correction ({:.1f}x smaller; 3 SEM = {:.2f} mm).{}",
+                             emax, after, emax / std::max(after, 1e-9), three_sem, shown_note),
                  r.evaluation->second_pass_worthwhile ? io::HtmlReport::Level::kWarn : io::HtmlReport::Level::kGood);
   } else {
     rep.Headline(fmt::format("Correction worthwhile: E_max,syst = {:.2f} mm stands out of the scatter (3 SEM = {:.2f} mm).",
                              emax, three_sem),
                  io::HtmlReport::Level::kGood);
   }
+}
+
+std::string CalibrationReportHtml(const nlohmann::json& j, const CalibrateJobResult& r, const std::string& plot_svg,
+                                  const std::string& which, const RobotParams& chosen) {
+  const UmbmarkSummary& s = r.umbmark;
+  io::HtmlReport rep("umbmark calibrate", r.label);
+  ReportHeadline(rep, r, which);
   std::vector<std::string> steps;
   if (s.compensation_worthwhile) {
     steps.push_back(fmt::format("Set the odometry to the {} parameters: wheelbase {:.6f} m, left wheel diameter {:.6f} m, "
