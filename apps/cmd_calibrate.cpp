@@ -6,8 +6,12 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <set>
+#include <string>
+#include <utility>
 #include <variant>
+#include <vector>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -192,6 +196,41 @@ nlohmann::json JsonHeldout(const HeldoutComparison& h) {
   return methods;
 }
 
+/// Each run's return error, outlier score and flags (JSON `runs`).
+nlohmann::json JsonRuns(const CalibrateInput& in, const UmbmarkSummary& s) {
+  nlohmann::json runs = nlohmann::json::array();
+  for (std::size_t i = 0; i < s.runs.size(); ++i) {
+    const auto& f = s.runs[i];
+    nlohmann::json jr = {{"run", f.run},         {"direction", f.direction}, {"ex_m", f.ex_m},
+                         {"ey_m", f.ey_m},       {"outlier", f.outlier},     {"excluded", f.excluded},
+                         {"rejected", f.rejected}};
+    jr["etheta_rad"] = in.errors[i].etheta_rad ? nlohmann::json(*in.errors[i].etheta_rad) : nlohmann::json(nullptr);
+    jr["outlier_score"] = f.score ? nlohmann::json(*f.score) : nlohmann::json(nullptr);
+    runs.push_back(jr);
+  }
+  return runs;
+}
+
+/// JSON `heldout`: the scheme, the recommendation's expected error and the
+/// runner-up (nulls where --no-heldout skipped the comparison or there is
+/// none).
+nlohmann::json JsonHeldoutSummary(const HeldoutComparison& h) {
+  const bool skipped = h.scheme == kHeldoutSkipped;
+  return {{"scheme", h.scheme},
+          {"measure", h.measure},
+          {"left_out", h.left_out},
+          {"sessions", h.sessions},
+          {"baseline", h.baseline.empty() ? nlohmann::json(nullptr) : nlohmann::json(h.baseline)},
+          {"why", h.why},
+          {"expected_error_m", skipped ? nlohmann::json(nullptr) : JsonNumber(h.expected_error_m)},
+          {"expected_error_sem_m", skipped ? nlohmann::json(nullptr) : JsonNumber(h.expected_error_sem_m)},
+          {"runner_up", h.runner_up.empty() ? nlohmann::json(nullptr) : nlohmann::json(h.runner_up)},
+          {"runner_up_difference_m", h.runner_up.empty() ? nlohmann::json(nullptr) : JsonNumber(h.runner_up_difference_m)},
+          {"runner_up_difference_sem_m",
+           h.runner_up.empty() ? nlohmann::json(nullptr) : JsonNumber(h.runner_up_difference_sem_m)},
+          {"notes", h.notes}};
+}
+
 nlohmann::json JsonResult(const CalibrateInput& in, const CalibrateJobResult& r, const CalibrateOptions& o,
                           const HeldoutComparison& h, const ModelCheck& check, const Chosen& chosen,
                           const std::vector<std::string>& warnings) {
@@ -219,17 +258,7 @@ nlohmann::json JsonResult(const CalibrateInput& in, const CalibrateJobResult& r,
   j["sem_m"] = s.sem_m;
   j["three_sem_m"] = 3.0 * s.sem_m;
   j["compensation_worthwhile"] = s.compensation_worthwhile;
-  nlohmann::json runs = nlohmann::json::array();
-  for (std::size_t i = 0; i < s.runs.size(); ++i) {
-    const auto& f = s.runs[i];
-    nlohmann::json jr = {{"run", f.run},         {"direction", f.direction}, {"ex_m", f.ex_m},
-                         {"ey_m", f.ey_m},       {"outlier", f.outlier},     {"excluded", f.excluded},
-                         {"rejected", f.rejected}};
-    jr["etheta_rad"] = in.errors[i].etheta_rad ? nlohmann::json(*in.errors[i].etheta_rad) : nlohmann::json(nullptr);
-    jr["outlier_score"] = f.score ? nlohmann::json(*f.score) : nlohmann::json(nullptr);
-    runs.push_back(jr);
-  }
-  j["runs"] = runs;
+  j["runs"] = JsonRuns(in, s);
   j["experiments"] = in.files;
   if (r.refine_failure) j["refine_error"] = r.refine_failure->what();
   if (r.refined) {
@@ -242,20 +271,7 @@ nlohmann::json JsonResult(const CalibrateInput& in, const CalibrateJobResult& r,
   // --no-heldout: both keys say so instead of naming a method.
   const bool skipped = h.scheme == kHeldoutSkipped;
   j["heldout_error"] = skipped ? nlohmann::json(kHeldoutSkipped) : JsonHeldout(h);
-  j["heldout"] = {{"scheme", h.scheme},
-                  {"measure", h.measure},
-                  {"left_out", h.left_out},
-                  {"sessions", h.sessions},
-                  {"baseline", h.baseline.empty() ? nlohmann::json(nullptr) : nlohmann::json(h.baseline)},
-                  {"why", h.why},
-                  {"expected_error_m", skipped ? nlohmann::json(nullptr) : JsonNumber(h.expected_error_m)},
-                  {"expected_error_sem_m", skipped ? nlohmann::json(nullptr) : JsonNumber(h.expected_error_sem_m)},
-                  {"runner_up", h.runner_up.empty() ? nlohmann::json(nullptr) : nlohmann::json(h.runner_up)},
-                  {"runner_up_difference_m", h.runner_up.empty() ? nlohmann::json(nullptr)
-                                                                   : JsonNumber(h.runner_up_difference_m)},
-                  {"runner_up_difference_sem_m", h.runner_up.empty() ? nlohmann::json(nullptr)
-                                                                       : JsonNumber(h.runner_up_difference_sem_m)},
-                  {"notes", h.notes}};
+  j["heldout"] = JsonHeldoutSummary(h);
   j["recommended"] = skipped              ? nlohmann::json(kHeldoutSkipped)
                      : h.recommended.empty() ? nlohmann::json(nullptr)
                                              : nlohmann::json(h.recommended);
@@ -428,11 +444,6 @@ void HeldoutSection(io::HtmlReport& rep, const nlohmann::json& j) {
                             h["why"].get<std::string>(), num(h["expected_error_m"]), num(h["expected_error_sem_m"])));
 }
 
-// The --report page of one calibration: headline, what to do next, the
-// numbers (parameters with intervals when refined, centres of gravity,
-// E_d/E_b, evaluation before/after, the held-out comparison), then the
-// plots. About 100 lines: one page laid out top to bottom, each table a few
-// lines; the held-out section is its own helper.
 // The report's headline: is a correction worthwhile, and by how much the
 // classic correction shrinks E_max,syst on the same runs.
 void ReportHeadline(io::HtmlReport& rep, const CalibrateJobResult& r, const std::string& which) {
@@ -462,6 +473,11 @@ void ReportHeadline(io::HtmlReport& rep, const CalibrateJobResult& r, const std:
   }
 }
 
+// The --report page of one calibration: headline, what to do next, the
+// numbers (parameters with intervals when refined, centres of gravity,
+// E_d/E_b, evaluation before/after, the held-out comparison), then the
+// plots. About 85 lines: one page laid out top to bottom, each table a few
+// lines; the headline and the held-out section are their own helpers.
 std::string CalibrationReportHtml(const nlohmann::json& j, const CalibrateJobResult& r, const std::string& plot_svg,
                                   const std::string& which, const RobotParams& chosen) {
   const UmbmarkSummary& s = r.umbmark;
@@ -605,16 +621,8 @@ void CheckDataBeforeFit(const CalibrateInput& in) {
     throw InputError(in.label, problem);
 }
 
-// ~150 lines: the command's one sequence (read every input, calibrate each
-// unit, gate, print, write each requested output) shares the batch state
-// (rows, results, status, warnings, written outputs) across all of it; the
-// self-contained parts are the helpers above and the plot / report / ros2
-// writers.
-int RunCalibrate(const CalibrateOptions& o) {
-  if (o.use == "refined" && !o.refine) throw InvalidOptions("--use refined needs --refine");
-  CalibrateJobOptions jo = JobOptions(o);
-
-  // Output safety: no output may be an input or another output.
+/// Output safety: no output may be an input or another output.
+void CheckOutputs(const CalibrateOptions& o) {
   io::OutputSet& outs = CommandOutputs();
   RegisterInputs(o.inputs, &o.robot);
   outs.AddOutput("--json", o.json.path);
@@ -622,153 +630,252 @@ int RunCalibrate(const CalibrateOptions& o) {
   outs.AddOutput("--plot", o.plot);
   outs.AddOutput("--report", o.report);
   outs.Check();
+}
 
-  // Collect every calibration unit first; with one input, errors propagate
-  // (exit 1). With several, a failing input is reported and skipped, and the
-  // exit status is 1 at the end.
-  const bool batch = o.inputs.size() > 1;
-  nlohmann::json results = nlohmann::json::array();
+/// A calibration unit's result that passed the plausibility gates (their
+/// warnings kept for the output).
+struct FittedUnit {
+  CalibrateJobResult result;
+  PlausibilityReport gate;
+};
+
+/// What the command says about a fitted unit: the held-out comparison of the
+/// methods, the calibration the outputs use (--use), the check of the
+/// centres of gravity against the model, and the warnings.
+struct UnitAssessment {
+  HeldoutComparison heldout;
+  Chosen chosen;
+  ModelCheck check;
+  std::vector<std::string> warnings;
+};
+
+UnitAssessment Assess(const CalibrateInput& in, const FittedUnit& f, const CalibrateOptions& o,
+                      const CalibrateJobOptions& jo) {
+  const CalibrateJobResult& r = f.result;
+  HeldoutComparison heldout = o.no_heldout ? SkippedHeldout() : CompareMethodsHeldout(in, jo, r);
+  Chosen chosen = ChooseParameters(r, heldout, o.use);
+  const ModelCheck check = CheckCentresAgainstModel(in, r.umbmark.runs, r.refined ? r.refined->refined : r.umbmark.corrected,
+                                                    jo.refine ? jo.refine->final_turn : true);
+  std::vector<std::string> warnings = TrustWarnings(r, heldout, check);
+  warnings.insert(warnings.end(), f.gate.warnings.begin(), f.gate.warnings.end());
+  if (r.refined && in.trajectories && !HasInteriorGroundTruth(*in.trajectories)) {
+    warnings.push_back("ground truth only at the first and last sample of each run: the refined fit used the "
+                       "return errors (commanded-square model), as for endpoint data, not the path geometry");
+  }
+  return {std::move(heldout), std::move(chosen), check, std::move(warnings)};
+}
+
+// One `calibrate` command, in steps: Load each input into calibration units,
+// Fit and gate each unit, Conclude it (assess, write its outputs, print),
+// then the summary table and the JSON. With one input, errors propagate
+// (exit 1, or 3 for a quality gate); with several (a batch), a failing input
+// or unit is reported, recorded and skipped, and the exit status is the
+// worst at the end. The members are the batch state the steps share.
+class CalibrateBatch {
+ public:
+  CalibrateBatch(const CalibrateOptions& o, CalibrateJobOptions jo);
+  int Run();
+
+ private:
   struct Row {
     std::string label;
     std::optional<CalibrateJobResult> result;
     std::string error;
   };
-  std::vector<Row> rows;
-  std::vector<std::string> all_warnings;
-  std::vector<std::string> written;  // "path (what)"
-  std::set<std::string> tags_used;
-  int status = 0;
-  // A failed unit of a batch: a row, a JSON entry and the worst exit status.
-  const auto record_failure = [&](const std::string& label, const std::string& what, int code) {
-    rows.push_back({label, std::nullopt, what});
-    results.push_back({{"input", label}, {"error", what}});
-    status = std::max(status, code);
-  };
-  Progress progress(fmt::format("calibrating {} inputs", o.inputs.size()), static_cast<double>(o.inputs.size()));
-  double done = 0.0;
+  std::optional<std::vector<CalibrateInput>> Load(const std::string& path);
+  std::optional<FittedUnit> Fit(const CalibrateInput& in);
+  void Conclude(const std::string& path, const CalibrateInput& in, bool several, FittedUnit f);
+  std::string UniqueTag(const std::string& path, const CalibrateInput& in);
+  void WriteOutputs(const CalibrateInput& in, const CalibrateJobResult& r, const UnitAssessment& a,
+                    const std::string& tag, bool several);
+  void PrintSummaryTable() const;
+  void RecordFailure(const std::string& label, const std::string& what, int code);
+
+  const CalibrateOptions& o_;
+  CalibrateJobOptions jo_;
+  const bool batch_;
+  nlohmann::json results_ = nlohmann::json::array();  ///< each unit's JSON, only when --json asks for it
+  std::vector<Row> rows_;
+  std::vector<std::string> all_warnings_;
+  std::vector<std::string> written_;  ///< "path (what)"
+  std::set<std::string> tags_used_;
+  int status_ = 0;
+  Progress progress_;
+  double done_ = 0.0;
+};
+
+CalibrateBatch::CalibrateBatch(const CalibrateOptions& o, CalibrateJobOptions jo)
+    : o_(o),
+      jo_(std::move(jo)),
+      batch_(o.inputs.size() > 1),
+      progress_(fmt::format("calibrating {} inputs", o.inputs.size()), static_cast<double>(o.inputs.size())) {
   // Within an input, the held-out comparison (the long part) moves the line
   // by its folds.
-  jo.progress = [&](double folds_done, double folds) {
-    progress.Update(done - 1.0 + (folds > 0.0 ? folds_done / folds : 1.0));
+  jo_.progress = [this](double folds_done, double folds) {
+    progress_.Update(done_ - 1.0 + (folds > 0.0 ? folds_done / folds : 1.0));
   };
-  for (const auto& path : o.inputs) {
-    progress.Update(done++);
-    std::vector<CalibrateInput> inputs;
-    try {
-      inputs = LoadInputs(path, o, jo.integrator);
-    } catch (const InputError& e) {
-      if (!batch) throw;
-      fmt::print(stderr, "{}\n", e.what());
-      record_failure(path, e.what(), 1);
+}
+
+int CalibrateBatch::Run() {
+  for (const auto& path : o_.inputs) {
+    progress_.Update(done_++);
+    const std::optional<std::vector<CalibrateInput>> inputs = Load(path);
+    if (!inputs) continue;
+    const bool several = batch_ || inputs->size() > 1;
+    for (const auto& in : *inputs) {
+      if (std::optional<FittedUnit> fitted = Fit(in)) Conclude(path, in, several, std::move(*fitted));
+    }
+  }
+  if (o_.json.PrintText() && rows_.size() > 1) PrintSummaryTable();
+  // (results_ holds the JSON of each unit only when --json asks for it.)
+  const bool single = rows_.size() == 1 && rows_.front().result && !results_.empty();
+  o_.json.EmitAndListOutputs(
+      single ? results_.front()
+             : nlohmann::json{{"results", results_}, {"failed", status_ != 0}, {"warnings", all_warnings_}},
+      written_);
+  return status_;
+}
+
+/// A failed unit of a batch: a row, a JSON entry and the worst exit status.
+void CalibrateBatch::RecordFailure(const std::string& label, const std::string& what, int code) {
+  rows_.push_back({label, std::nullopt, what});
+  results_.push_back({{"input", label}, {"error", what}});
+  status_ = std::max(status_, code);
+}
+
+/// The input's calibration units; nullopt when a batch input cannot be read
+/// (reported and recorded).
+std::optional<std::vector<CalibrateInput>> CalibrateBatch::Load(const std::string& path) {
+  try {
+    return LoadInputs(path, o_, jo_.integrator);
+  } catch (const InputError& e) {
+    if (!batch_) throw;
+    fmt::print(stderr, "{}\n", e.what());
+    RecordFailure(path, e.what(), 1);
+    return std::nullopt;
+  }
+}
+
+/// Checks the data, calibrates the unit and applies the plausibility gates;
+/// nullopt when a batch unit fails (reported and recorded).
+std::optional<FittedUnit> CalibrateBatch::Fit(const CalibrateInput& in) {
+  FittedUnit f;
+  try {
+    CheckDataBeforeFit(in);
+    f.result = RunCalibrateJob(in, jo_);
+    // Plausibility gates: never print or write an impossible result.
+    f.gate = CheckUmbmarkPlausibility(f.result.umbmark);
+    if (f.result.refined) CheckRefinedPlausibility(f.result.umbmark.recorded, f.result.refined->refined, f.gate);
+    if (!f.gate.ok()) throw QualityGateError(fmt::format("{}: implausible result: {}", in.label, f.gate.Message()));
+  } catch (const RefineError& e) {
+    // Print what is known (solver report, identifiability), then fail
+    // the quality gate: exit 3, never numbers from a failed fit.
+    fmt::print(stderr, "{}: refined calibration failed: {}\n{}", in.label, e.what(), RefineReport(e.summary()));
+    if (!batch_) throw;
+    RecordFailure(in.label, e.what(), 3);
+    return std::nullopt;
+  } catch (const QualityGateError& e) {
+    if (!batch_) throw;
+    fmt::print(stderr, "umbmark: quality gate failed: {}\n", e.what());
+    RecordFailure(in.label, e.what(), 3);
+    return std::nullopt;
+  } catch (const InputError& e) {
+    if (!batch_) throw;
+    fmt::print(stderr, "{}\n", e.what());
+    RecordFailure(in.label, e.what(), 1);
+    return std::nullopt;
+  }
+  return f;
+}
+
+/// A fitted unit: assessed, its outputs written, printed (or its warnings on
+/// stderr), its JSON and summary row kept.
+void CalibrateBatch::Conclude(const std::string& path, const CalibrateInput& in, bool several, FittedUnit f) {
+  const UnitAssessment a = Assess(in, f, o_, jo_);
+  CalibrateJobResult& r = f.result;
+  WriteOutputs(in, r, a, UniqueTag(path, in), several);
+  if (o_.json.PrintText()) {
+    PrintResult(r);
+    PrintHeldout(a.heldout, a.chosen, a.warnings, o_);
+    fmt::print("\n");
+  } else {
+    for (const auto& w : a.warnings) fmt::print(stderr, "{}: warning: {}\n", in.label, w);
+  }
+  if (r.refine_failure) {
+    // The classic result stands (printed and written); the refined fit
+    // failed its quality gate: say so once, with the solver's report.
+    fmt::print(stderr, "umbmark: quality gate failed: {}: refined calibration failed: {}\n  solver: {}\n", in.label,
+               r.refine_failure->what(), r.refine_failure->summary().solver.brief_report);
+    status_ = std::max(status_, 3);
+  }
+  for (const auto& w : a.warnings) all_warnings_.push_back(batch_ ? in.label + ": " + w : w);
+  // The JSON document only when asked for: with a million runs it is
+  // the largest thing the command builds.
+  if (!o_.json.path.empty()) results_.push_back(JsonResult(in, r, o_, a.heldout, a.check, a.chosen, a.warnings));
+  rows_.push_back({in.label, std::move(r), ""});
+}
+
+/// The unit's dataset tag (DatasetTag), numbered from 2 when already used.
+std::string CalibrateBatch::UniqueTag(const std::string& path, const CalibrateInput& in) {
+  std::string tag = DatasetTag(path, in);
+  for (int k = 2; !tags_used_.insert(tag).second; ++k) tag = fmt::format("{}-{}", DatasetTag(path, in), k);
+  return tag;
+}
+
+/// --ros2, --plot and --report of one unit (tagged with the dataset when the
+/// command has several units).
+void CalibrateBatch::WriteOutputs(const CalibrateInput& in, const CalibrateJobResult& r, const UnitAssessment& a,
+                                  const std::string& tag, bool several) {
+  io::OutputSet& outs = CommandOutputs();
+  if (!o_.ros2.empty()) {
+    const std::string file = several ? TaggedPath(o_.ros2, tag) : o_.ros2;
+    outs.Write(file, Ros2Parameters(r, a.chosen, o_.controller));
+    written_.push_back(file + " (ros2_control parameters)");
+  }
+  // The plot and the report show the calibration --use selects (by
+  // default the recommended one), and say which.
+  const RobotParams& shown = a.chosen.parameters;
+  const std::string& which = a.chosen.method;
+  std::string svg;
+  if (!o_.plot.empty() || !o_.report.empty()) svg = CalibrationPlotSvg(in, r, jo_.integrator, shown, which);
+  if (!o_.plot.empty()) {
+    const std::string file = several ? TaggedPath(o_.plot, tag) : o_.plot;
+    outs.Write(file, svg);
+    written_.push_back(file + " (plot: " + which + ")");
+  }
+  if (!o_.report.empty()) {
+    const std::string file = several ? TaggedPath(o_.report, tag) : o_.report;
+    outs.Write(file, CalibrationReportHtml(JsonResult(in, r, o_, a.heldout, a.check, a.chosen, a.warnings), r, svg,
+                                           which, shown));
+    written_.push_back(file + " (HTML report)");
+  }
+}
+
+/// The batch's summary table: one line per unit (FAILED with the reason).
+void CalibrateBatch::PrintSummaryTable() const {
+  fmt::print("Summary ({} calibrations)\n", rows_.size());
+  fmt::print("  {:<40} {:>10} {:>10} {:>11} {:>11} {:>11} {:>10} {:>10}\n", "input", "E_d", "E_b", "wheelbase_m",
+             "D_left_m", "D_right_m", "Emax_mm", "after_mm");
+  for (const auto& row : rows_) {
+    if (!row.result) {
+      fmt::print("  {:<40} FAILED: {}\n", row.label, row.error);
       continue;
     }
-    for (const auto& in : inputs) {
-      CalibrateJobResult r;
-      PlausibilityReport gate;
-      try {
-        CheckDataBeforeFit(in);
-        r = RunCalibrateJob(in, jo);
-        // Plausibility gates: never print or write an impossible result.
-        gate = CheckUmbmarkPlausibility(r.umbmark);
-        if (r.refined) CheckRefinedPlausibility(r.umbmark.recorded, r.refined->refined, gate);
-        if (!gate.ok()) throw QualityGateError(fmt::format("{}: implausible result: {}", in.label, gate.Message()));
-      } catch (const RefineError& e) {
-        // Print what is known (solver report, identifiability), then fail
-        // the quality gate: exit 3, never numbers from a failed fit.
-        fmt::print(stderr, "{}: refined calibration failed: {}\n{}", in.label, e.what(), RefineReport(e.summary()));
-        if (!batch) throw;
-        record_failure(in.label, e.what(), 3);
-        continue;
-      } catch (const QualityGateError& e) {
-        if (!batch) throw;
-        fmt::print(stderr, "umbmark: quality gate failed: {}\n", e.what());
-        record_failure(in.label, e.what(), 3);
-        continue;
-      } catch (const InputError& e) {
-        if (!batch) throw;
-        fmt::print(stderr, "{}\n", e.what());
-        record_failure(in.label, e.what(), 1);
-        continue;
-      }
-      const HeldoutComparison heldout = o.no_heldout ? SkippedHeldout() : CompareMethodsHeldout(in, jo, r);
-      const Chosen chosen = ChooseParameters(r, heldout, o.use);
-      const ModelCheck check = CheckCentresAgainstModel(in, r.umbmark.runs, r.refined ? r.refined->refined : r.umbmark.corrected,
-                                                        jo.refine ? jo.refine->final_turn : true);
-      std::vector<std::string> warnings = TrustWarnings(r, heldout, check);
-      warnings.insert(warnings.end(), gate.warnings.begin(), gate.warnings.end());
-      if (r.refined && in.trajectories && !HasInteriorGroundTruth(*in.trajectories)) {
-        warnings.push_back("ground truth only at the first and last sample of each run: the refined fit used the "
-                           "return errors (commanded-square model), as for endpoint data, not the path geometry");
-      }
-      std::string tag = DatasetTag(path, in);
-      for (int k = 2; !tags_used.insert(tag).second; ++k) tag = fmt::format("{}-{}", DatasetTag(path, in), k);
-      const bool several = batch || inputs.size() > 1;
-      if (!o.ros2.empty()) {
-        const std::string file = several ? TaggedPath(o.ros2, tag) : o.ros2;
-        outs.Write(file, Ros2Parameters(r, chosen, o.controller));
-        written.push_back(file + " (ros2_control parameters)");
-      }
-      // The plot and the report show the calibration --use selects (by
-      // default the recommended one), and say which.
-      const RobotParams& shown = chosen.parameters;
-      const std::string& which = chosen.method;
-      std::string svg;
-      if (!o.plot.empty() || !o.report.empty()) svg = CalibrationPlotSvg(in, r, jo.integrator, shown, which);
-      if (!o.plot.empty()) {
-        const std::string file = several ? TaggedPath(o.plot, tag) : o.plot;
-        outs.Write(file, svg);
-        written.push_back(file + " (plot: " + which + ")");
-      }
-      if (!o.report.empty()) {
-        const std::string file = several ? TaggedPath(o.report, tag) : o.report;
-        outs.Write(file, CalibrationReportHtml(JsonResult(in, r, o, heldout, check, chosen, warnings), r, svg, which, shown));
-        written.push_back(file + " (HTML report)");
-      }
-      if (o.json.PrintText()) {
-        PrintResult(r);
-        PrintHeldout(heldout, chosen, warnings, o);
-        fmt::print("\n");
-      } else {
-        for (const auto& w : warnings) fmt::print(stderr, "{}: warning: {}\n", in.label, w);
-      }
-      if (r.refine_failure) {
-        // The classic result stands (printed and written); the refined fit
-        // failed its quality gate: say so once, with the solver's report.
-        fmt::print(stderr, "umbmark: quality gate failed: {}: refined calibration failed: {}\n  solver: {}\n", in.label,
-                   r.refine_failure->what(), r.refine_failure->summary().solver.brief_report);
-        status = std::max(status, 3);
-      }
-      for (const auto& w : warnings) all_warnings.push_back(batch ? in.label + ": " + w : w);
-      // The JSON document only when asked for: with a million runs it is
-      // the largest thing the command builds.
-      if (!o.json.path.empty()) results.push_back(JsonResult(in, r, o, heldout, check, chosen, warnings));
-      rows.push_back({in.label, std::move(r), ""});
-    }
+    const auto& s = row.result->umbmark;
+    const std::string after =
+        row.result->evaluation ? fmt::format("{:.2f}", row.result->evaluation->E_max_syst_m * 1e3) : "-";
+    fmt::print("  {:<40} {:>10.6f} {:>10.6f} {:>11.6f} {:>11.6f} {:>11.6f} {:>10.2f} {:>10}\n", row.label,
+               s.selected.E_d, s.selected.E_b, s.corrected.wheelbase_m, s.corrected.wheel_diameter_left_m,
+               s.corrected.wheel_diameter_right_m, s.E_max_syst_m * 1e3, after);
   }
-  if (o.json.PrintText() && rows.size() > 1) {
-    fmt::print("Summary ({} calibrations)\n", rows.size());
-    fmt::print("  {:<40} {:>10} {:>10} {:>11} {:>11} {:>11} {:>10} {:>10}\n", "input", "E_d", "E_b", "wheelbase_m",
-               "D_left_m", "D_right_m", "Emax_mm", "after_mm");
-    for (const auto& row : rows) {
-      if (!row.result) {
-        fmt::print("  {:<40} FAILED: {}\n", row.label, row.error);
-        continue;
-      }
-      const auto& s = row.result->umbmark;
-      const std::string after =
-          row.result->evaluation ? fmt::format("{:.2f}", row.result->evaluation->E_max_syst_m * 1e3) : "-";
-      fmt::print("  {:<40} {:>10.6f} {:>10.6f} {:>11.6f} {:>11.6f} {:>11.6f} {:>10.2f} {:>10}\n", row.label,
-                 s.selected.E_d, s.selected.E_b, s.corrected.wheelbase_m, s.corrected.wheel_diameter_left_m,
-                 s.corrected.wheel_diameter_right_m, s.E_max_syst_m * 1e3, after);
-    }
-  }
-  // (results holds the JSON of each unit only when --json asks for it.)
-  const bool single = rows.size() == 1 && rows.front().result && !results.empty();
-  o.json.EmitAndListOutputs(
-      single ? results.front()
-             : nlohmann::json{{"results", results}, {"failed", status != 0}, {"warnings", all_warnings}},
-      written);
-  return status;
+}
+
+int RunCalibrate(const CalibrateOptions& o) {
+  if (o.use == "refined" && !o.refine) throw InvalidOptions("--use refined needs --refine");
+  CalibrateJobOptions jo = JobOptions(o);
+  CheckOutputs(o);
+  CalibrateBatch command(o, std::move(jo));
+  return command.Run();
 }
 
 }  // namespace

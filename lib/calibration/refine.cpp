@@ -203,15 +203,7 @@ ceres::Solver::Summary Solve(FitProblem& fit, const RefineOptions& options, Refi
   // Gauge: without E_s free, the overall scale is held at its start value
   // (1 = the reference mean diameter factor) by a subset manifold.
   if (!fit.scale_free) problem.SetManifold(fit.theta, new ceres::SubsetManifold(kNumRefineParameters, {kIndexEs}));
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
-  so.max_num_iterations = options.max_num_iterations;
-  so.function_tolerance = options.function_tolerance;
-  so.gradient_tolerance = options.gradient_tolerance;
-  so.parameter_tolerance = options.parameter_tolerance;
-  so.num_threads = options.num_threads;
-  so.logging_type = ceres::SILENT;
-  so.minimizer_progress_to_stdout = false;
+  const ceres::Solver::Options so = SolverOptions(options);
   ceres::Solver::Summary cs;
   ceres::Solve(so, &problem, &cs);
 
@@ -520,6 +512,19 @@ void FillParameters(const FitProblem& fit, const Eigen::Matrix3d& cov, const Ref
 }
 
 }  // namespace
+
+ceres::Solver::Options SolverOptions(const RefineOptions& options) {
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = options.max_num_iterations;
+  so.function_tolerance = options.function_tolerance;
+  so.gradient_tolerance = options.gradient_tolerance;
+  so.parameter_tolerance = options.parameter_tolerance;
+  so.num_threads = options.num_threads;
+  so.logging_type = ceres::SILENT;
+  so.minimizer_progress_to_stdout = false;
+  return so;
+}
 
 void SolveAndAssess(FitProblem& fit, const RefineOptions& options, CovarianceKind kind, std::optional<double> dof,
                     RefineSummary* summary) {

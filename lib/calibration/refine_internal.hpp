@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <ceres/cost_function.h>
 #include <ceres/problem.h>
+#include <ceres/solver.h>
 
 #include "calibration/refine.hpp"
 
@@ -42,6 +43,10 @@ enum class CovarianceKind {
   kRunClustered,  ///< cluster-robust sandwich over blocks (TrajectoryCovariance)
   kSolverScaled   ///< C * 2 cost / (m - p)
 };
+
+/// The Ceres settings every refined fit solves with: dense QR, the options'
+/// iteration cap, tolerances and thread count, no logging.
+ceres::Solver::Options SolverOptions(const RefineOptions& options);
 
 /// Solves `fit`, then fills summary->{solver, identifiability, theta
 /// covariance, intervals, refined, covariance, final_cost, reduced_chi2,

@@ -128,14 +128,7 @@ void FitSessionFrames(std::vector<PreparedRun>* prepared, std::size_t sets, cons
     ++runs_of[p.set];
   }
   if (!scale_free) problem.SetManifold(theta, new ceres::SubsetManifold(kNumRefineParameters, {kIndexEs}));
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
-  so.max_num_iterations = options.max_num_iterations;
-  so.function_tolerance = options.function_tolerance;
-  so.gradient_tolerance = options.gradient_tolerance;
-  so.parameter_tolerance = options.parameter_tolerance;
-  so.num_threads = options.num_threads;
-  so.logging_type = ceres::SILENT;
+  const ceres::Solver::Options so = refine_detail::SolverOptions(options);
   ceres::Solver::Summary cs;
   ceres::Solve(so, &problem, &cs);
   if (!cs.IsSolutionUsable()) {

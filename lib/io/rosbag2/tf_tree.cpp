@@ -77,20 +77,20 @@ std::optional<std::pair<std::string, Pose2>> TfTree::StaticAnchor(std::string_vi
     return std::any_of(edges_.begin(), edges_.end(), [&](const TfEdge& e) { return !e.is_static && e.child == f; });
   };
   std::map<std::string, Pose2, std::less<>> reached{{std::string(frame), Pose2{}}};
-  std::deque<std::string> todo{std::string(frame)};
-  while (!todo.empty()) {
-    const std::string x = todo.front();
-    todo.pop_front();
+  std::deque<std::string> pending{std::string(frame)};
+  while (!pending.empty()) {
+    const std::string x = pending.front();
+    pending.pop_front();
     const Pose2 x_T_frame = reached.at(x);
     if (x != frame && moving(x)) return std::make_pair(x, x_T_frame);
     for (const auto& e : edges_) {
       if (!e.is_static) continue;
       if (e.child == x && !reached.count(e.parent)) {
         reached[e.parent] = Compose(e.last, x_T_frame);
-        todo.push_back(e.parent);
+        pending.push_back(e.parent);
       } else if (e.parent == x && !reached.count(e.child)) {
         reached[e.child] = Compose(Inverse(e.last), x_T_frame);
-        todo.push_back(e.child);
+        pending.push_back(e.child);
       }
     }
   }
