@@ -11,7 +11,9 @@
 #   half-size campaigns committed under tests/data/dart/; KEEP=DIR writes the
 #   campaigns to DIR instead of a temporary directory; BEFORE=/path/umbmark
 #   also diagnoses every campaign with that executable (a baseline); NICE=N
-#   sets the generators' niceness (default 10).
+#   sets the generators' niceness (default 10); ROBOT=B generates robot
+#   design B (bigger and heavier, front castor, 30/100 Hz motion capture;
+#   default A, the design of the committed campaigns).
 # Needs /usr/bin/python3 with dartpy and numpy (apt-get install python3-dartpy).
 set -euo pipefail
 
@@ -30,7 +32,7 @@ BEFORE=${BEFORE:-}
 CLASSES=${CLASSES:-"clean stop_slide swivel_castor offset_castor floor_strips turn_scrub marker_offset clock_fixed clock_per_run eccentric_hubs"}
 OUT=${KEEP:-$(mktemp -d "${TMPDIR:-/tmp}/umbmark-dart.XXXXXX")}
 mkdir -p "$OUT"
-echo "DART validation: $N campaigns per class from seed $SEED${QUICK:+ (quick)}; campaigns in $OUT"
+echo "DART validation: robot ${ROBOT:-A}, $N campaigns per class from seed $SEED${QUICK:+ (quick)}; campaigns in $OUT"
 
 # Generate (JOBS at a time; a full campaign takes 20-60 s of one core).
 start=$(date +%s)
@@ -41,7 +43,7 @@ done
 generate() {  # CLASS SEED
   local dir="$OUT/$1-$2"
   [[ -f "$dir/truth.md" ]] && return 0
-  nice -n "${NICE:-10}" "$PY" "$GEN" "$1" "$2" "$dir" ${QUICK:+--quick} >"$dir.log" 2>&1 ||
+  nice -n "${NICE:-10}" "$PY" "$GEN" "$1" "$2" "$dir" ${QUICK:+--quick} --robot "${ROBOT:-A}" >"$dir.log" 2>&1 ||
     { echo "generator failed: $1 $2 (see $dir.log)" >&2; return 1; }
 }
 failed=0

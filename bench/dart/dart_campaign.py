@@ -19,7 +19,11 @@ from the true wheel angles, split into start / steady / stop phases) and
 `truth.md` (its summary and the expected verdict), the measured evidence for
 the expected answer.
 
-Usage: dart_campaign.py CLASS SEED OUTDIR [--quick]
+Two robot designs (--robot): A, the default (wheelbase 0.26-0.36 m, 4-7 kg,
+rear castor); B, a bigger, heavier robot with a front castor and a different
+recording (see Config._robot_b).
+
+Usage: dart_campaign.py CLASS SEED OUTDIR [--quick] [--robot A|B]
 """
 import argparse
 import math
@@ -35,6 +39,7 @@ FREE_RATE = 50.0     # ... of the free paths (figure eights)
 FREE_SPEED = 0.2     # m/s along the figure eights
 G = 9.81
 WHEEL_MU_SWIVEL = 0.275   # castor classes: drive-wheel grip just under the slip threshold
+WHEEL_MU_SWIVEL_B = 0.25  # ... of robot B (its threshold: see _apply_class_b)
 
 # Expected verdict per class, decided from the physics (truth.md checks it).
 CLASSES = {
@@ -73,9 +78,14 @@ def box_inertia(m, x, y, z):
 class Config:
     """Everything one campaign is made of, drawn from the class and the seed."""
 
-    def __init__(self, cls, seed, quick):
+    def __init__(self, cls, seed, quick, robot="A"):
         rng = np.random.default_rng(seed)
-        self.cls, self.seed = cls, seed
+        self.cls, self.seed, self.robot = cls, seed, robot
+        self._design_a()
+        if robot == "B":
+            self._robot_b(rng, quick)
+            self._apply_class_b(rng)
+            return
         U = rng.uniform
         # Nominal robot (what the odometry uses) -- a robot unlike the bundled one.
         self.b_nom = round(U(0.26, 0.36), 3)
@@ -125,6 +135,22 @@ class Config:
         self.pause = 0.6
         self.settle = 1.0
         self._apply_class(rng)
+
+    def _design_a(self):
+        """Robot A's fixed design and recording (no random draws: A's campaigns
+        stay byte-identical to those generated before design B existed)."""
+        self.rate = RATE                  # squares and back-and-forth (Hz)
+        self.free_rate = FREE_RATE        # figure eights (Hz)
+        self.free_speed = FREE_SPEED
+        self.eight_radius = 0.6
+        self.com = (-0.04, 0.0, 0.01)     # chassis centre of mass from the axle midpoint (m)
+        self.chassis_size = (0.40, 0.12)  # length, height of the inertia box (m)
+        self.wheel_mass, self.wheel_inertia = 0.4, (8e-4, 1.5e-3, 8e-4)
+        self.castor_x, self.castor_r, self.fork_drop = -0.22, 0.02, 0.03
+        self.fork = (0.08, (-0.01, 0.0, -0.015), 2e-5)    # mass, centre, inertia of the swivel fork
+        self.castor_wheel = (0.05, 1e-5)                  # mass, inertia of the castor wheel
+        self.strip_h = (0.006, 0.010)
+        self.t_decimals = 2               # time stamps on the sample grid: 10 ms steps are exact
 
     def _apply_class(self, rng):
         U = rng.uniform
@@ -177,6 +203,108 @@ class Config:
         elif c != "clean":
             raise SystemExit(f"unknown class {c}; one of {', '.join(CLASSES)}")
 
+    def _robot_b(self, rng, quick):
+        """Design B: a bigger, heavier robot with its castor in FRONT of the axle,
+        the centre of mass ahead of the axle and higher, other encoders, and a
+        different recording: motion capture at 30 or 100 Hz for every
+        experiment, 0.3-0.5 mm / 0.8-1.5 mrad noise, a bigger square, longer
+        back-and-forth runs, bigger and faster figure eights, longer pauses."""
+        U = rng.uniform
+        self.b_nom = round(U(0.40, 0.55), 3)
+        self.d_nom = round(U(0.14, 0.20), 4)
+        self.d_nom_drawn = self.d_nom
+        self.ticks = int(rng.choice([10000, 20000]))     # 2500-line quadrature encoders (x1, x2 gear)
+        ed = 1.0 + rng.choice([-1, 1]) * U(0.002, 0.006)
+        self.eb = 1.0 + rng.choice([-1, 1]) * U(0.01, 0.03)
+        self.r_left = self.d_nom / 2.0 * 2.0 / (ed + 1.0)
+        self.r_right = self.d_nom / 2.0 * 2.0 / (1.0 / ed + 1.0)
+        self.b_true = self.b_nom * self.eb
+        self.mass = U(12.0, 30.0)
+        self.v = U(0.35, 0.5)
+        self.w = U(0.6, 1.0)
+        self.acc, self.alpha = 0.5, 1.5
+        self.hard_stop = False
+        self.abrupt_turn_start = False
+        self.mu, self.wheel_mu, self.castor_mu = 0.8, 1.2, 1.2
+        self.castor_trail = 0.045
+        self.castor = "ball"
+        self.castor_y = 0.0
+        self.swivel_friction = 0.0
+        self.strips = False
+        self.ecc = 0.0
+        self.marker = (0.0, 0.0)
+        self.tau = 0.0
+        self.tau_sd = 0.0
+        self.sig_xy = round(U(0.0003, 0.0005), 5)
+        self.sig_th = round(U(0.0008, 0.0015), 5)
+        self.rate = float(rng.choice([30.0, 100.0]))
+        self.free_rate = self.rate
+        self.free_speed, self.eight_radius = 0.3, 0.9
+        self.com = (0.06, 0.0, 0.03)
+        self.chassis_size = (0.60, 0.20)
+        self.castor_x, self.castor_r, self.fork_drop = 0.30, 0.035, 0.05
+        self.fork = (0.25, (-0.015, 0.0, -0.025), 1e-4)
+        self.castor_wheel = (0.2, 1e-4)
+        self.strip_h = (0.010, 0.016)
+        self.t_decimals = 4               # 30 Hz stamps are not on a 10 ms grid
+        self.side = round(U(1.5, 2.0), 1)
+        self.n_square = 2 if quick else 4
+        self.fb_dist = 2.0
+        self.n_fb = 3 if quick else 6
+        self.n_free = 2
+        self.pause = 1.0
+        self.settle = 1.5
+
+    def _apply_class_b(self, rng):
+        """Robot B's physical causes (tuned on B's seed 1 only)."""
+        U = rng.uniform
+        c = self.cls
+        if c == "stop_slide":
+            # hard braking on a low-friction floor (the ball castor carries ~20 %)
+            self.mu = U(0.60, 0.75)
+            self.hard_stop = True
+            self.v = U(0.38, 0.42)
+            self.w = U(0.70, 0.80)
+        elif c in ("swivel_castor", "offset_castor"):
+            # front swivel castor with bearing friction on low-grip drive wheels,
+            # grip just under this robot's slip threshold.  Measured on seed 1
+            # (one square each way): bearing 0.6 N m kicks ~1 mrad at grip 0.20
+            # and nothing at 0.25; at grip 0.25, 1.0 / 1.1 / 1.2 N m kick about
+            # 6 / 11 / 15 mrad following the turn; grip 0.20 with 1.1 N m also
+            # makes the spot turns slip (k 0.08).
+            self.b_nom, self.d_nom, self.mass, self.ticks = 0.48, 0.16, 20.0, 10000
+            self.b_true = self.b_nom * self.eb
+            self.r_left = self.r_left / self.d_nom_drawn * 0.16
+            self.r_right = self.r_right / self.d_nom_drawn * 0.16
+            self.castor = "swivel"
+            self.mu, self.castor_mu, self.wheel_mu = 1.0, 1.0, WHEEL_MU_SWIVEL_B
+            self.swivel_friction = U(1.0, 1.15)   # ~0.028 m x the castor load, as robot A
+            self.acc = 0.8
+            if c == "offset_castor":
+                self.castor_y = U(0.04, 0.06) * rng.choice([-1, 1])
+        elif c == "floor_strips":
+            self.strips = True
+        elif c == "turn_scrub":
+            self.mu = U(0.45, 0.55)
+            self.w = U(0.9, 1.0)
+            self.abrupt_turn_start = True
+            self.acc = 0.4
+        elif c == "marker_offset":
+            ang = U(0, 2 * math.pi)
+            rad = U(0.006, 0.012)
+            self.marker = (rad * math.cos(ang), rad * math.sin(ang))
+        elif c == "clock_fixed":
+            self.tau = U(0.015, 0.035) * rng.choice([-1, 1])
+        elif c == "clock_per_run":
+            self.tau_sd = U(0.025, 0.035)
+        elif c == "eccentric_hubs":
+            self.ecc = U(0.0012, 0.0018)
+        elif c != "clean":
+            raise SystemExit(f"unknown class {c}; one of {', '.join(CLASSES)}")
+        r = self.d_nom / 2
+        self.wheel_mass = 1.2
+        self.wheel_inertia = (0.25 * 1.2 * r * r, 0.5 * 1.2 * r * r, 0.25 * 1.2 * r * r)
+
 
 class Robot:
     """The DART world: floor, chassis, two driven wheels, castor."""
@@ -194,14 +322,14 @@ class Robot:
         self.skel = dart.dynamics.Skeleton("robot")
         fj, self.chassis = self.skel.createFreeJointAndBodyNodePair()
         self.chassis.setInertia(dart.dynamics.Inertia(
-            cfg.mass, [-0.04, 0.0, 0.01], box_inertia(cfg.mass, 0.40, cfg.b_true, 0.12)))
+            cfg.mass, list(cfg.com), box_inertia(cfg.mass, cfg.chassis_size[0], cfg.b_true, cfg.chassis_size[1])))
         self.wheels = []
         phase = [0.0, 2.1]
         for i, (r, y) in enumerate(((cfg.r_left, cfg.b_true / 2), (cfg.r_right, -cfg.b_true / 2))):
             wj, wb = self.skel.createRevoluteJointAndBodyNodePair(self.chassis)
             wj.setTransformFromParentBodyNode(iso((0.0, y, 0.0)))
             wj.setAxis([0.0, 1.0, 0.0])
-            wb.setInertia(dart.dynamics.Inertia(0.4, [0.0, 0.0, 0.0], np.diag([8e-4, 1.5e-3, 8e-4])))
+            wb.setInertia(dart.dynamics.Inertia(cfg.wheel_mass, [0.0, 0.0, 0.0], np.diag(list(cfg.wheel_inertia))))
             off = (cfg.ecc * math.cos(phase[i]), 0.0, cfg.ecc * math.sin(phase[i]))
             self._sphere(wb, r, off, cfg.wheel_mu)
             wj.setActuatorType(dart.dynamics.RevoluteJoint.ActuatorType.VELOCITY)
@@ -233,22 +361,22 @@ class Robot:
         sn.createDynamicsAspect().setFrictionCoeff(mu)
 
     def _castor(self):
-        cfg, rc, xc = self.cfg, 0.02, -0.22
+        cfg, rc, xc, drop = self.cfg, self.cfg.castor_r, self.cfg.castor_x, self.cfg.fork_drop
         if cfg.castor == "ball":
             # frictionless ball castor: carries load, no force in the plane
             self._sphere(self.chassis, rc, (xc, cfg.castor_y, -(self.r_mean - rc)), 0.0)
             return
         # swivel castor: vertical swivel axis, fork with trail, castor wheel on an axle
         sj, fork = self.skel.createRevoluteJointAndBodyNodePair(self.chassis)
-        sj.setTransformFromParentBodyNode(iso((xc, cfg.castor_y, -self.r_mean + rc + 0.03)))
+        sj.setTransformFromParentBodyNode(iso((xc, cfg.castor_y, -self.r_mean + rc + drop)))
         sj.setAxis([0.0, 0.0, 1.0])
         sj.setCoulombFriction(0, cfg.swivel_friction)
         sj.setDampingCoefficient(0, 0.002)
-        fork.setInertia(dart.dynamics.Inertia(0.08, [-0.01, 0.0, -0.015], np.diag([2e-5, 2e-5, 2e-5])))
+        fork.setInertia(dart.dynamics.Inertia(cfg.fork[0], list(cfg.fork[1]), np.diag([cfg.fork[2]] * 3)))
         cj, cw = self.skel.createRevoluteJointAndBodyNodePair(fork)
-        cj.setTransformFromParentBodyNode(iso((-cfg.castor_trail, 0.0, -0.03)))
+        cj.setTransformFromParentBodyNode(iso((-cfg.castor_trail, 0.0, -drop)))
         cj.setAxis([0.0, 1.0, 0.0])
-        cw.setInertia(dart.dynamics.Inertia(0.05, [0.0, 0.0, 0.0], np.diag([1e-5, 1e-5, 1e-5])))
+        cw.setInertia(dart.dynamics.Inertia(cfg.castor_wheel[0], [0.0, 0.0, 0.0], np.diag([cfg.castor_wheel[1]] * 3)))
         self._sphere(cw, rc, (0.0, 0.0, 0.0), cfg.castor_mu)
         self.swivel = sj
 
@@ -256,7 +384,7 @@ class Robot:
         """A floor strip (6-10 mm high, 2-4 cm long) across the left wheel's path."""
         sk = dart.dynamics.Skeleton(f"strip{len(self.strips)}_{self.world.getTime():.3f}")
         j, body = sk.createWeldJointAndBodyNodePair()
-        h = rng.uniform(0.006, 0.010)
+        h = rng.uniform(*self.cfg.strip_h)
         self._box(body, (rng.uniform(0.02, 0.04), 0.08, h), (0.0, 0.0, h / 2), self.cfg.mu)
         j.setTransformFromParentBodyNode(iso((x, y, 0.0), yaw))
         self.world.addSkeleton(sk)
@@ -437,12 +565,12 @@ class Driver:
 
     def figure_eight(self):
         """Two circles of radius 0.6 m, ccw then cw, without stopping between,
-        at 0.2 m/s: DART's contact gives a little under sideways load (0.3 mm
+        at 0.2 m/s (robot B: 0.9 m at 0.3 m/s): DART's contact gives a little under sideways load (0.3 mm
         towards the outside at 0.23 m/s^2 in a 0.4 m circle at 0.3 m/s, gone
         when the curve ends), which would otherwise show as a gap of its own."""
-        rad, b2 = 0.6, self.cfg.b_nom / 2
+        rad, b2 = self.cfg.eight_radius, self.cfg.b_nom / 2
         ang = 2 * math.pi
-        peak = FREE_SPEED * (rad + b2) / rad
+        peak = self.cfg.free_speed * (rad + b2) / rad
         self.motion("arc", ang * (rad - b2), ang * (rad + b2), peak, 0,
                     then=(ang * (rad + b2), ang * (rad - b2)))
 
@@ -474,15 +602,21 @@ def run_campaign(cfg):
     return drv, runs
 
 
+def design_tag(cfg):
+    return "" if cfg.robot == "A" else f", robot {cfg.robot}"
+
+
 def write_campaign(cfg, drv, runs, out):
     """Manifest + one trajectory CSV per experiment (contract format)."""
     rng = np.random.default_rng(cfg.seed + 104729)
     t = np.asarray(drv.hist_t)
     pose = np.asarray(drv.hist_pose)
     wheel = np.asarray(drv.hist_wheel)
-    # free paths (arcs) at 50 Hz (more samples where the path curves)
-    every_for = {"square": int(round(1.0 / (RATE * DT))), "back_and_forth": int(round(1.0 / (RATE * DT))),
-                 "free": int(round(1.0 / (FREE_RATE * DT)))}
+    # robot A: free paths (arcs) at 50 Hz (more samples where the path curves);
+    # samples on the engine's steps
+    every_for = {"square": int(round(1.0 / (cfg.rate * DT))), "back_and_forth": int(round(1.0 / (cfg.rate * DT))),
+                 "free": int(round(1.0 / (cfg.free_rate * DT)))}
+    rate_for = {"square": cfg.rate, "back_and_forth": cfg.rate, "free": cfg.free_rate}
     files = {"square": "square.csv", "back_and_forth": "fwd_back.csv", "free": "free.csv"}
     rows = {k: [] for k in files}
     counts = {k: 0 for k in files}
@@ -490,9 +624,15 @@ def write_campaign(cfg, drv, runs, out):
     for exp, direction, first, last in runs:
         counts[exp] += 1
         run_no = counts[exp]
-        idx = np.arange(first, last + 1, every_for[exp])
+        if cfg.robot == "A":
+            idx = np.arange(first, last + 1, every_for[exp])
+            tc, wk = t[idx], wheel[idx]
+        else:   # robot B: samples at exact multiples of 1 / rate (30 Hz is not on the 2 ms steps)
+            tc = t[first] + np.arange(0.0, t[last] - t[first] + 1e-9, 1.0 / rate_for[exp])
+            wk = np.stack([np.interp(tc, t, wheel[:, 0]), np.interp(tc, t, wheel[:, 1])], axis=1)
+            idx = tc
         tau = cfg.tau + (rng.normal(0.0, cfg.tau_sd) if cfg.tau_sd > 0 else 0.0)
-        ts = t[idx] - tau              # the true time each ground-truth sample shows
+        ts = tc - tau                  # the true time each ground-truth sample shows
         px = np.interp(ts, t, pose[:, 0])
         py = np.interp(ts, t, pose[:, 1])
         pth = np.interp(ts, t, pose[:, 2])
@@ -505,11 +645,11 @@ def write_campaign(cfg, drv, runs, out):
         c, s = math.cos(th0), math.sin(th0)
         dx, dy = gx - x0, gy - y0
         rx, ry, rth = c * dx + s * dy, -s * dx + c * dy, gth - th0
-        tk = np.floor(wheel[idx] / (2 * math.pi) * cfg.ticks).astype(np.int64)
+        tk = np.floor(wk / (2 * math.pi) * cfg.ticks).astype(np.int64)
         tk -= tk[0]
         for k in range(len(idx)):
             # 0.1 mm / 0.1 mrad steps: rounding adds 0.03 rms to 0.2 mm / 0.5 mrad noise
-            rows[exp].append(f"{run_no},{direction},{t[idx[k]] - t[first]:.2f},{tk[k, 0]},{tk[k, 1]},"
+            rows[exp].append(f"{run_no},{direction},{tc[k] - t[first]:.{cfg.t_decimals}f},{tk[k, 0]},{tk[k, 1]},"
                              f"{rx[k]:.4f},{ry[k]:.4f},{rth[k]:.4f}")
         if cfg.tau_sd > 0:
             drv.run_taus = getattr(drv, "run_taus", []) + [tau]
@@ -518,12 +658,12 @@ def write_campaign(cfg, drv, runs, out):
         if not rows[exp]:
             continue
         with open(os.path.join(out, name), "w") as f:
-            f.write(f"# DART 6.12 physics campaign, class {cfg.cls}, seed {cfg.seed} "
+            f.write(f"# DART 6.12 physics campaign, class {cfg.cls}, seed {cfg.seed}{design_tag(cfg)} "
                     "(bench/dart/dart_campaign.py)\n")
             f.write("run,direction,t_s,ticks_left,ticks_right,x_gt_m,y_gt_m,theta_gt_rad\n")
             f.write("\n".join(rows[exp]) + "\n")
     with open(os.path.join(out, "campaign.toml"), "w") as f:
-        f.write(f"# DART 6.12 physics campaign: class {cfg.cls}, seed {cfg.seed}; "
+        f.write(f"# DART 6.12 physics campaign: class {cfg.cls}, seed {cfg.seed}{design_tag(cfg)}; "
                 f"expected verdict {CLASSES[cfg.cls]} (see truth.md)\n")
         f.write("[robot]\n")
         f.write(f"wheelbase_m            = {cfg.b_nom}\n")
@@ -612,7 +752,7 @@ def write_truth(cfg, rows, out, drv):
     scrub = [-(r["whole_res"][2] * r["sign"]) / abs(r["ideal_turn"]) for r in turns]
     per_m = [r["steady_res"][0] * r["direction"] / max(r["travel"], 1e-9) for r in lines]
     L = []
-    L.append(f"# Measured cause: class `{cfg.cls}`, seed {cfg.seed}\n")
+    L.append(f"# Measured cause: class `{cfg.cls}`, seed {cfg.seed}{design_tag(cfg)}\n")
     L.append(f"Expected verdict: **{CLASSES[cfg.cls]}**\n")
     L.append("Robot (true vs nominal): wheelbase "
              f"{cfg.b_true:.4f} m vs {cfg.b_nom} (E_b {cfg.eb:.4f}); wheel diameters "
@@ -622,6 +762,12 @@ def write_truth(cfg, rows, out, drv):
                                        f"{cfg.swivel_friction:.3f} N m" if cfg.castor != "ball" else "")
              + f"; v {cfg.v:.3f} m/s, w {cfg.w:.2f} rad/s; hard stops {cfg.hard_stop}; "
              f"abrupt turn starts {cfg.abrupt_turn_start}.\n")
+    if cfg.robot != "A":
+        L.append(f"Design {cfg.robot}: mass {cfg.mass:.1f} kg, centre of mass at ({cfg.com[0]:+.2f}, "
+                 f"{cfg.com[2]:+.2f}) m from the axle midpoint (forward, up), castor at x {cfg.castor_x:+.2f} m; "
+                 f"square side {cfg.side} m, back-and-forth {cfg.fb_dist} m, figure eights of "
+                 f"{cfg.eight_radius} m circles at {cfg.free_speed} m/s; pauses {cfg.pause} s; "
+                 f"motion capture at {cfg.rate:g} Hz ({cfg.free_rate:g} Hz on the figure eights).\n")
     L.append(f"Motion capture: white noise {cfg.sig_xy * 1e3:.2f} mm, {cfg.sig_th * 1e3:.2f} mrad; "
              f"marker at ({cfg.marker[0] * 1e3:+.2f}, {cfg.marker[1] * 1e3:+.2f}) mm; clock offset "
              f"{cfg.tau * 1e3:+.1f} ms (v tau = {cfg.v * cfg.tau * 1e3:+.2f} mm); per-run clock sd "
@@ -659,10 +805,15 @@ def main():
     ap.add_argument("--quick", action="store_true", help="half-size campaign (for the committed tests)")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="override a Config attribute (exploring the physics)")
-    ap.add_argument("--rate", type=float, default=RATE, help="sample rate of the CSVs (Hz)")
+    ap.add_argument("--rate", type=float, default=None,
+                    help="sample rate of the squares and back-and-forth runs (Hz; default: the design's)")
+    ap.add_argument("--robot", choices=("A", "B"), default="A",
+                    help="robot design: A (default; the committed campaigns) or B (bigger, heavier, "
+                         "front castor, recorded at 30 or 100 Hz)")
     a = ap.parse_args()
-    globals()["RATE"] = a.rate
-    cfg = Config(a.cls, a.seed, a.quick)
+    cfg = Config(a.cls, a.seed, a.quick, a.robot)
+    if a.rate is not None:
+        cfg.rate = a.rate
     for kv in a.set:
         k, v = kv.split("=", 1)
         if not hasattr(cfg, k):
