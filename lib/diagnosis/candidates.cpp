@@ -36,26 +36,21 @@ std::vector<int> EffectParams(sim::EffectKind k) {
 
 std::vector<int> EffectParams(sim::EffectKind k, const CampaignData& c) {
   if (k != sim::EffectKind::kStopSlide) return EffectParams(k);
-  bool line_stop = false;
-  double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+  bool line_stop = false, turn_stop = false;
   for (const DiagRun& r : c.runs)
-    for (const DiagRun::Stop& st : r.stops) {
-      if (st.cls != static_cast<signed char>(sim::MotionClass::kTurn)) {
-        line_stop = true;
-        continue;
-      }
-      if (!(st.turn_m > 0.0)) continue;
-      const double w = st.rate_right - st.rate_left, ratio = w * w / st.turn_m;
-      lo = std::min(lo, ratio);
-      hi = std::max(hi, ratio);
-    }
-  // The turn part needs slides that differ from E_b's constant share of
-  // the angle by more than 20 % between turns.
-  const bool turn_part = hi > 0.0 && hi > 1.2 * lo;
+    for (const DiagRun::Stop& st : r.stops)
+      (st.cls == static_cast<signed char>(sim::MotionClass::kTurn) ? turn_stop : line_stop) = true;
   std::vector<int> out;
-  if (line_stop || !turn_part) out.push_back(kParamSlideD);
-  if (turn_part) out.push_back(kParamSlideA);
+  if (line_stop || !turn_stop) out.push_back(kParamSlideD);
+  if (turn_stop) out.push_back(kParamSlideA);
   return out;
+}
+
+std::vector<int> FittedParams(sim::EffectKind effect, const std::vector<Candidate>& candidates,
+                              const CampaignData& c) {
+  for (const Candidate& cd : candidates)
+    if (cd.effect == effect && !cd.fitted_params.empty()) return cd.fitted_params;
+  return EffectParams(effect, c);
 }
 
 /// A typical size of each effect parameter (the realistic ranges of the
@@ -447,19 +442,30 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
     const sim::EffectKind kind = effects[ei];
     Candidate& cd = out.candidates[ei];
     cd.effect = kind;
-    const std::vector<int> eparams = EffectParams(kind, c);
+    std::vector<int> eparams = EffectParams(kind, c);
+    // stop_slide's turn part on spot turns of one angle and rate is a
+    // constant extra turn, E_b's footprint, unless the samples resolve the
+    // coast after the turns: fitted only when it can be told from E_d, E_b.
+    bool turn_part_dropped = false;
+    if (kind == sim::EffectKind::kStopSlide && eparams.size() == 2) {
+      Candidate probe;
+      Eigen::MatrixXd unused;
+      if (!Identify(x, {kParamSlideA}, probe, unused) || probe.weak) {
+        eparams = {kParamSlideD};
+        turn_part_dropped = true;
+      }
+    }
+    cd.fitted_params = eparams;
     if (!eparams.empty()) {
       cd.parameters = static_cast<int>(eparams.size());
       // A parameter error frees a baseline parameter itself: nothing to
       // tell it apart from.
       if (!sim::IsParameterError(kind) && !Identify(x, eparams, cd, out.projected[ei])) return;
       mean_fits[ei] = FitMeanEffect(x, kind, eparams, cd);
-      if (kind == sim::EffectKind::kStopSlide && eparams.size() < EffectParams(kind).size())
+      if (turn_part_dropped)
         cd.note = std::string(cd.note.empty() ? "" : cd.note + "; ") +
-                  (std::find(eparams.begin(), eparams.end(), kParamSlideA) == eparams.end()
-                       ? "its turn part a is not fitted: every spot turn here has the same angle and rate, so a "
-                         "slide after it is a constant extra turn, which the baseline's E_b absorbs"
-                       : "its straight part d is not fitted: no stop after a straight or arc motion");
+                  "its turn part a is not fitted: a slide after spot turns of one angle and rate is a constant "
+                  "extra turn, which the baseline's E_b absorbs, and these samples do not resolve the coast";
     } else if (IsNoiseEffect(kind)) {
       FitNoiseEffect(x, kind, cd);
     } else {
@@ -479,7 +485,7 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
   for (std::size_t i = 0; i < effects.size(); ++i) {
     if (mean_fits[i].eps.empty()) continue;
     std::vector<int> key = b.free;
-    for (int k : EffectParams(effects[i], c)) key.push_back(k);
+    for (int k : out.candidates[i].fitted_params) key.push_back(k);
     out.mean_fits.emplace(std::move(key), std::move(mean_fits[i]));
   }
   return out;

@@ -72,15 +72,26 @@ struct Candidate {
     std::string text;          ///< which samples carry the evidence, in words
   };
   ClockCheck clock;
+  /// Mean effects: the mean-model parameters fitted (EffectParams(effect,
+  /// campaign) less a part these data cannot tell from E_d, E_b:
+  /// stop_slide's turn part a on turns of one angle and rate whose coast
+  /// the samples do not resolve); empty for the noise effects.
+  std::vector<int> fitted_params;
 };
+
+/// The mean parameters `effect` was fitted with among `candidates`
+/// (Candidate::fitted_params), or EffectParams(effect, c) when it is not
+/// among them.
+std::vector<int> FittedParams(sim::EffectKind effect, const std::vector<Candidate>& candidates,
+                              const CampaignData& c);
 
 /// Mean-model parameters of an effect (empty for the noise effects).
 std::vector<int> EffectParams(sim::EffectKind k);
 /// The mean-model parameters of an effect these runs can show: stop_slide's
-/// d only with a stop after a straight or arc motion, its a only when the
-/// spot turns' slides a w^2 are not proportional to their angles (turns of
-/// one angle at one rate: a constant extra turn, E_b's footprint), else
-/// EffectParams(k). Never empty for a mean effect.
+/// d only with a stop after a straight or arc motion, its a only with a
+/// stop after a spot turn, else EffectParams(k). Never empty for a mean
+/// effect. (Whether a is told from E_b is the candidate fit's business:
+/// Candidate::fitted_params.)
 std::vector<int> EffectParams(sim::EffectKind k, const CampaignData& c);
 
 /// The effects the piece noise model carries (piece_noise.hpp):

@@ -347,7 +347,7 @@ DiagnoseSummary Diagnose(const CampaignData& recorded, const DiagnoseOptions& op
   // 4-5. Significance and verdict.
   Verdict v = DecideVerdict(fits, out.score_p_value, out.null_quantile_alpha,
                             VerdictOptions{options.alpha, options.min_heldout_shrink, options.full_shrink,
-                                           options.likelihood_tests});
+                                           options.likelihood_tests, options.negligible});
   out.p_value = v.p_value;
   out.tests_p_value = v.tests_p_value;
   out.tests = v.tests;

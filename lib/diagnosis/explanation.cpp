@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -33,11 +34,11 @@ struct SetFit {
 /// The mean parameters a set of effects fits: the baseline's free ones
 /// (E_d, E_b; none against a given model), then each mean effect's
 /// parameters in the set's order.
-std::vector<int> MeanParamsOf(const CampaignData& c, const std::vector<int>& free,
-                              const std::vector<sim::EffectKind>& set) {
+std::vector<int> MeanParamsOf(const CampaignData& c, const std::vector<Candidate>& candidates,
+                              const std::vector<int>& free, const std::vector<sim::EffectKind>& set) {
   std::vector<int> params = free;
   for (sim::EffectKind e : set)
-    for (int k : EffectParams(e, c)) params.push_back(k);
+    for (int k : FittedParams(e, candidates, c)) params.push_back(k);
   return params;
 }
 
@@ -116,13 +117,13 @@ SetFit FitSet(const CampaignData& c, const MeanModel& model, const BaselineFit& 
 class MeanPartCache {
  public:
   MeanPartCache(const CampaignData& c, const MeanModel& model, const BaselineFit& b, int threads,
-                const std::map<std::vector<int>, MeanFit>& known)
-      : c_(c), model_(model), b_(b), threads_(threads), known_(known) {}
+                const std::map<std::vector<int>, MeanFit>& known, const std::vector<Candidate>& candidates)
+      : c_(c), model_(model), b_(b), threads_(threads), known_(known), candidates_(candidates) {}
   /// Fits the mean parts of `sets` not fitted yet (in parallel).
   void Prepare(const std::vector<std::vector<sim::EffectKind>>& sets) {
     std::vector<std::vector<int>> missing;
     for (const auto& set : sets) {
-      std::vector<int> key = MeanParamsOf(c_, b_.free, set);
+      std::vector<int> key = MeanParamsOf(c_, candidates_, b_.free, set);
       if (parts_.count(key) || std::find(missing.begin(), missing.end(), key) != missing.end()) continue;
       if (const auto it = known_.find(key); it != known_.end()) {
         parts_.emplace(key, MeanPartFrom(c_, model_, it->second, key));
@@ -137,7 +138,7 @@ class MeanPartCache {
     for (std::size_t i = 0; i < missing.size(); ++i) parts_.emplace(std::move(missing[i]), std::move(fitted[i]));
   }
   /// The mean part of `set` (Prepare'd before).
-  const MeanPart& Get(const std::vector<sim::EffectKind>& set) const { return parts_.at(MeanParamsOf(c_, b_.free, set)); }
+  const MeanPart& Get(const std::vector<sim::EffectKind>& set) const { return parts_.at(MeanParamsOf(c_, candidates_, b_.free, set)); }
 
  private:
   const CampaignData& c_;
@@ -145,6 +146,7 @@ class MeanPartCache {
   const BaselineFit& b_;
   int threads_;
   const std::map<std::vector<int>, MeanFit>& known_;
+  const std::vector<Candidate>& candidates_;
   std::map<std::vector<int>, MeanPart> parts_;
 };
 
@@ -366,9 +368,10 @@ void Size(const CampaignData& c, const MeanModel& model, const BaselineFit& base
 
 std::string PracticalFloor(sim::EffectKind effect, const std::map<std::string, double>& params, double negligible) {
   const double scale = negligible / 0.25;
+  // A parameter not given has no known size: never below the floor.
   auto get = [&](const char* k) {
     const auto it = params.find(k);
-    return it == params.end() ? 0.0 : std::abs(it->second);
+    return it == params.end() ? std::numeric_limits<double>::infinity() : std::abs(it->second);
   };
   if (!(scale > 0.0)) return {};
   switch (effect) {
@@ -449,7 +452,7 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
   const bool given_noise = !b.noise_fit.fit_wheel_noise;
   const BaselineFit weighted = given_noise ? RefittedWeights(c, b) : BaselineFit{};
   const std::map<std::vector<int>, MeanFit> not_known;
-  MeanPartCache means(c, model, given_noise ? weighted : b, options.threads, given_noise ? not_known : known);
+  MeanPartCache means(c, model, given_noise ? weighted : b, options.threads, given_noise ? not_known : known, candidates);
   means.Prepare({{}});
   const SetFit base = FitSet(c, model, b, folds, {}, means.Get({}), options.gap);
   const double gap_before = Gap(gap_score, null_median), gap_cv_before = Gap(base.heldout_gap, null_median);

@@ -1,6 +1,8 @@
 // Significance and verdict of the diagnosis (see verdict.hpp).
 #include "diagnosis/verdict.hpp"
 
+#include "diagnosis/explanation.hpp"
+
 #include <algorithm>
 #include <string>
 
@@ -31,7 +33,9 @@ void Significance(const CandidateFits& fits, double score_p_value, const Verdict
     for (const Candidate& cd : fits.candidates)
       if (cd.tested) {
         ++out.tests;
-        if (!cd.impossible) min_p = std::min(min_p, cd.lr_p_value);
+        const bool negligible =
+            !PracticalFloor(cd.effect, cd.params, options.negligible).empty() || !cd.clock.supported;
+        if (!cd.impossible && !negligible) min_p = std::min(min_p, cd.lr_p_value);
       }
     out.tests_p_value = std::min(1.0, out.tests * min_p);
     out.p_value = options.likelihood_tests && out.tests > 0
@@ -95,10 +99,34 @@ void Decide(const CandidateFits& fits, double score_p_value, double null_quantil
            out.tests * cd.lr_p_value < route_alpha &&
            cd.evidence > 0.0 && cd.gap_after <= null_quantile_alpha;
   };
+  // Identifiable (and, for a clock, supported by the moving samples) first;
+  // then those that qualify, a mechanism that acts where motions start or
+  // stop (castor_kick, castor_swivel, stop_slide) before a noise effect
+  // (kicks that vary from start to start also read as bumps: DART's swivel
+  // castors); then by evidence.
+  auto usable = [](const Candidate& cd) { return cd.identifiable && cd.clock.supported; };
+  auto mean_effect = [](const Candidate& cd) {
+    return cd.effect == sim::EffectKind::kCastorKick || cd.effect == sim::EffectKind::kCastorSwivel ||
+           cd.effect == sim::EffectKind::kStopSlide;
+  };
+  auto clock_effect = [](const Candidate& cd) {
+    return cd.effect == sim::EffectKind::kTimeOffset || cd.effect == sim::EffectKind::kRunTimeOffset;
+  };
   std::stable_sort(rank.begin(), rank.end(), [&](std::size_t a, std::size_t b) {
-    if (fits.candidates[a].identifiable != fits.candidates[b].identifiable) return fits.candidates[a].identifiable;
-    if (qualifies(fits.candidates[a]) != qualifies(fits.candidates[b])) return qualifies(fits.candidates[a]);
-    return fits.candidates[a].evidence > fits.candidates[b].evidence;
+    const Candidate &ca = fits.candidates[a], &cb = fits.candidates[b];
+    if (usable(ca) != usable(cb)) return usable(ca);
+    if (qualifies(ca) != qualifies(cb)) return qualifies(ca);
+    // A clock the moving samples support explains the stops too (the
+    // ground truth lags on through a stop by v tau: a slide's footprint);
+    // a slide cannot explain the moving samples.
+    if (qualifies(ca) && qualifies(cb) && (clock_effect(ca) && cb.effect == sim::EffectKind::kStopSlide))
+      return true;
+    if (qualifies(ca) && qualifies(cb) && (clock_effect(cb) && ca.effect == sim::EffectKind::kStopSlide))
+      return false;
+    if (qualifies(ca) && qualifies(cb) && mean_effect(ca) != mean_effect(cb) &&
+        IsNoiseEffect(mean_effect(ca) ? cb.effect : ca.effect))
+      return mean_effect(ca);
+    return ca.evidence > cb.evidence;
   });
   if (out.significant && !rank.empty() && !qualifies(fits.candidates[rank.front()])) {
     // No candidate closes the gap G measures: the likelihood-ratio route.

@@ -8,8 +8,15 @@
 //  false-alarm rate stays at most alpha.
 //  Verdict: `none` when p >= alpha; else the top candidate if it closes
 //  enough of the held-out gap and leaves no significant gap; else the
-//  likelihood-ratio route; else `unexplained`. Effects the data cannot tell
-//  apart are listed.
+//  likelihood-ratio route; else `unexplained`. Among candidates that
+//  qualify, a mechanism at the starts and stops of motions (castor_kick,
+//  castor_swivel, stop_slide: a systematic shift with the turn's or the
+//  drive's sign) ranks before a noise effect (scatter, which such kicks
+//  imitate when they vary: DART's swivel castors read as bumps); a clock offset the moving samples do not
+//  support ranks after everything identifiable. A test whose fit lies
+//  below its practical floor (a 0.2 ms clock) counts in the Bonferroni
+//  factor but is no evidence. Effects the data cannot tell apart are
+//  listed.
 #pragma once
 
 #include <string>
@@ -28,6 +35,10 @@ struct VerdictOptions {
   double full_shrink = 0.9;
   /// Combine G with the likelihood-ratio tests. Default true.
   bool likelihood_tests = true;
+  /// DiagnoseOptions::negligible: a test whose fit is below its practical
+  /// floor (explanation.hpp PracticalFloor) is no evidence of a gap that
+  /// matters. Default 0.25.
+  double negligible = 0.25;
 };
 
 struct Verdict {
