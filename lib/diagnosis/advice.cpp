@@ -14,7 +14,9 @@ namespace umbmark::diag {
 namespace {
 /// Scale and unit an engineer reads a parameter in.
 std::pair<double, const char*> ParamUnit(const std::string& name, const std::string& effect) {
-  // stop_slide: d [s^2/m] and a [s^2/rad] in their own units.
+  // stop_slide: d [s^2/m] and a [s^2/rad] in their own units; its shape
+  // (arc, back) is a pure number.
+  if (effect == "stop_slide" && (name == "arc" || name == "back")) return {1.0, ""};
   if (effect == "stop_slide" || name == "d") return {1.0, name == "a" ? " s^2/rad" : " s^2/m"};
   if (name == "dx" || name == "dy" || name == "sigma" || name == "sigma_xy") return {1e3, " mm"};
   if (name == "kappa" || name == "sigma_theta") return {1e3, " mrad"};

@@ -26,7 +26,7 @@ std::vector<int> EffectParams(sim::EffectKind k) {
     case sim::EffectKind::kParameterDrift: return {kParamDrift};
     case sim::EffectKind::kGtOffset: return {kParamDx, kParamDy};
     case sim::EffectKind::kTimeOffset: return {kParamTau};
-    case sim::EffectKind::kStopSlide: return {kParamSlideD, kParamSlideA};
+    case sim::EffectKind::kStopSlide: return {kParamSlideD, kParamSlideA, kParamSlideArc, kParamSlideBack};
     case sim::EffectKind::kCastorSwivel: return {kParamSwivel};
     case sim::EffectKind::kWheelbaseError: return {kParamEb};
     case sim::EffectKind::kDiameterRatioError: return {kParamEd};
@@ -36,13 +36,21 @@ std::vector<int> EffectParams(sim::EffectKind k) {
 
 std::vector<int> EffectParams(sim::EffectKind k, const CampaignData& c) {
   if (k != sim::EffectKind::kStopSlide) return EffectParams(k);
-  bool line_stop = false, turn_stop = false;
+  bool line_stop = false, turn_stop = false, arc_stop = false, forward_stop = false, backward_stop = false;
   for (const DiagRun& r : c.runs)
-    for (const DiagRun::Stop& st : r.stops)
+    for (const DiagRun::Stop& st : r.stops) {
       (st.cls == static_cast<signed char>(sim::MotionClass::kTurn) ? turn_stop : line_stop) = true;
+      if (st.cls == static_cast<signed char>(sim::MotionClass::kTurn)) continue;
+      // Curving at the stop (a radius under 25 wheel separations): an
+      // arc's coast may keep its curvature.
+      arc_stop = arc_stop || std::abs(st.rate_right - st.rate_left) > 0.02 * std::abs(st.rate_right + st.rate_left);
+      (st.rate_left + st.rate_right < 0.0 ? backward_stop : forward_stop) = true;
+    }
   std::vector<int> out;
   if (line_stop || !turn_stop) out.push_back(kParamSlideD);
   if (turn_stop) out.push_back(kParamSlideA);
+  if (arc_stop) out.push_back(kParamSlideArc);
+  if (forward_stop && backward_stop) out.push_back(kParamSlideBack);
   return out;
 }
 
@@ -72,6 +80,9 @@ double TypicalMagnitude(int param) {
     case kParamSwivel: return 0.005;
     case kParamSlideD: return 0.065;
     case kParamSlideA: return 0.01;
+    // Its shape: a coast along the arc (1), a backward coast 30 % longer.
+    case kParamSlideArc: return 1.0;
+    case kParamSlideBack: return 0.3;
     default: return 1.0;
   }
 }
@@ -142,10 +153,14 @@ void LikelihoodRatioTest(Candidate& cd, double ll, double ll_base) {
 
 /// Whether a mean effect can be told apart from E_d, E_b on these data;
 /// false: `cd` is filled as not identifiable. `projected`: the effect's
-/// whitened footprint orthogonal to the baseline's.
-bool Identify(const Shared& x, const std::vector<int>& eparams, Candidate& cd, Eigen::MatrixXd& projected) {
+/// whitened footprint orthogonal to the baseline's. `at`: where the
+/// footprint is taken (default the baseline, every effect zero).
+bool Identify(const Shared& x, const std::vector<int>& eparams, Candidate& cd, Eigen::MatrixXd& projected,
+              const ParamVector* at = nullptr) {
   // Identifiability against E_d, E_b.
-  const Eigen::MatrixXd De = x.model.Jacobian(x.b.p, eparams, x.b.eps);
+  std::vector<double> eps_at;
+  if (at) x.model.Residuals(*at, eps_at);
+  const Eigen::MatrixXd De = at ? x.model.Jacobian(*at, eparams, eps_at) : x.model.Jacobian(x.b.p, eparams, x.b.eps);
   Eigen::VectorXd tmp;
   Eigen::MatrixXd Jw_e;
   Whiten(x.b.W, x.b.eps, De, tmp, Jw_e);
@@ -446,12 +461,20 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
     // stop_slide's turn part on spot turns of one angle and rate is a
     // constant extra turn, E_b's footprint, unless the samples resolve the
     // coast after the turns: fitted only when it can be told from E_d, E_b.
+    // A slide's footprint is taken at a typical-size slide: at d = a = 0
+    // the coast ends at once, and only its constant extra length and turn
+    // (E_d's and E_b's footprints) would show, and its shape none.
     bool turn_part_dropped = false;
-    if (kind == sim::EffectKind::kStopSlide && eparams.size() == 2) {
+    ParamVector slide_at = x.b.p;
+    slide_at[kParamSlideD] = TypicalMagnitude(kParamSlideD);
+    slide_at[kParamSlideA] = TypicalMagnitude(kParamSlideA);
+    const bool slide = kind == sim::EffectKind::kStopSlide;
+    if (slide && std::find(eparams.begin(), eparams.end(), kParamSlideA) != eparams.end() &&
+        std::find(eparams.begin(), eparams.end(), kParamSlideD) != eparams.end()) {
       Candidate probe;
       Eigen::MatrixXd unused;
-      if (!Identify(x, {kParamSlideA}, probe, unused) || probe.weak) {
-        eparams = {kParamSlideD};
+      if (!Identify(x, {kParamSlideA}, probe, unused, &slide_at) || probe.weak) {
+        eparams.erase(std::find(eparams.begin(), eparams.end(), kParamSlideA));
         turn_part_dropped = true;
       }
     }
@@ -460,7 +483,8 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
       cd.parameters = static_cast<int>(eparams.size());
       // A parameter error frees a baseline parameter itself: nothing to
       // tell it apart from.
-      if (!sim::IsParameterError(kind) && !Identify(x, eparams, cd, out.projected[ei])) return;
+      if (!sim::IsParameterError(kind) && !Identify(x, eparams, cd, out.projected[ei], slide ? &slide_at : nullptr))
+        return;
       mean_fits[ei] = FitMeanEffect(x, kind, eparams, cd);
       if (turn_part_dropped)
         cd.note = std::string(cd.note.empty() ? "" : cd.note + "; ") +

@@ -19,7 +19,7 @@ ParamVector NominalParams() {
 
 const char* ParamName(int index) {
   static const char* names[kNumParams] = {"E_d", "E_b", "s", "k", "a", "kappa", "r", "dx",
-                                                    "dy",  "tau", "kappa", "d", "a"};
+                                                    "dy",  "tau", "kappa", "d", "a", "arc", "back"};
   return index >= 0 && index < kNumParams ? names[index] : "?";
 }
 
@@ -57,13 +57,14 @@ inline Pose2 Relative(const Pose2& a, const Pose2& b) {
 struct TrueFactors {
   double c_L, c_R, scale, back, wheelbase, scrub;
   double kappa, swivel, slide_d, slide_a;  ///< castor_kick, castor_swivel, stop_slide
+  double slide_arc, slide_back;            ///< stop_slide's shape (model.hpp)
 };
 
 TrueFactors Factors(const ParamVector& p, double wheelbase) {
   const double E_d = p[kParamEd];
   return {CorrectionLeft(E_d),    CorrectionRight(E_d),  1.0 + p[kParamScale], 1.0 + p[kParamAsym],
           p[kParamEb] * wheelbase, 1.0 - p[kParamScrub], p[kParamKappa],      p[kParamSwivel],
-          p[kParamSlideD],         p[kParamSlideA]};
+          p[kParamSlideD],         p[kParamSlideA],       p[kParamSlideArc],   p[kParamSlideBack]};
 }
 
 }  // namespace
@@ -107,7 +108,11 @@ double CoastProgress(double rate, double k, double tau) {
 
 /// stop_slide at stop `st` from pose q: the coast between tau0 and tau1
 /// seconds after the wheels stopped, at the true speed the motion ended
-/// with (along the heading, or turning in the turn's sense).
+/// with (along the heading, or turning in the turn's sense). After an arc
+/// the heading turns on by slide_arc w/v times the distance coasted (1: a
+/// coast along the arc, as a rigid body on locked wheels does: both
+/// contacts slide forward, their friction forces cancel in torque); a
+/// backward coast is (1 + slide_back) times d v^2.
 Pose2 Slide(const DiagRun::Stop& st, const TrueFactors& f, double drift, Pose2 q, double tau0, double tau1) {
   double vl, vr;
   TrueTravel(f, drift, st.rate_left, st.rate_right, vl, vr);
@@ -117,8 +122,10 @@ Pose2 Slide(const DiagRun::Stop& st, const TrueFactors& f, double drift, Pose2 q
     return q;
   }
   const double v = 0.5 * (vl + vr);
-  const double along = CoastProgress(v, f.slide_d, tau1) - CoastProgress(v, f.slide_d, tau0);
-  return {q.x + along * std::cos(q.theta), q.y + along * std::sin(q.theta), q.theta};
+  const double d = v < 0.0 ? f.slide_d * (1.0 + f.slide_back) : f.slide_d;
+  const double along = CoastProgress(v, d, tau1) - CoastProgress(v, d, tau0);
+  const double turn = f.slide_arc != 0.0 && std::abs(v) > 1e-9 ? f.slide_arc * (vr - vl) / f.wheelbase / v * along : 0.0;
+  return {q.x + along * std::cos(q.theta), q.y + along * std::sin(q.theta), q.theta + turn};
 }
 
 /// The pose after fraction `u` in [0, 1] of interval i's time from `q`
@@ -240,7 +247,7 @@ void MeanModel::Residuals(const ParamVector& p, std::vector<double>& eps) const 
 Eigen::MatrixXd MeanModel::Jacobian(const ParamVector& p, const std::vector<int>& params,
                                     const std::vector<double>& eps0) const {
   static const double kStep[kNumParams] = {1e-6, 1e-6, 1e-6, 1e-6, 1e-6, 1e-7, 1e-8,
-                                                 1e-6, 1e-6, 1e-5, 1e-7, 1e-5, 1e-5};
+                                                 1e-6, 1e-6, 1e-5, 1e-7, 1e-5, 1e-5, 1e-5, 1e-5};
   Eigen::MatrixXd J(eps0.size(), params.size());
   std::vector<double> eps;
   for (std::size_t k = 0; k < params.size(); ++k) {

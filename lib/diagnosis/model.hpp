@@ -15,7 +15,9 @@
 //   stop slide   at the end of a motion's last interval when a stop follows:
 //                d v|v| along the heading (straight, arc; v the true speed
 //                of the axle midpoint at the end) or a w|w| in heading
-//                (spot turn; w the true rate)
+//                (spot turn; w the true rate); after an arc the heading
+//                turns on by arc w/v times the distance coasted, and a
+//                backward coast is (1 + back) times as long
 //   predicted ground truth  the pose at t - tau, reported at (dx, dy)
 // with c_L = 2/(E_d + 1), c_R = 2/(1/E_d + 1). A piece's residual is
 //   eps = Rel(GT_a, GT_b) - Rel(P_a, P_b)        ([x, y, theta], start frame of the piece)
@@ -58,6 +60,14 @@ enum ParamIndex : int {
   kParamSwivel,   ///< castor_swivel.kappa [rad]
   kParamSlideD,   ///< stop_slide.d [s^2/m]
   kParamSlideA,   ///< stop_slide.a [s^2/rad]
+  /// stop_slide's shape beyond the contract's d, a (what a physics engine
+  /// shows; 0 is the contract's slide): the share of an arc's curvature
+  /// the coast keeps (heading turns on by arc w/v times the distance
+  /// coasted; 1: along the arc), and a backward coast's extra length (d
+  /// (1 + back) v^2 backwards: braking shifts load off the driven wheels
+  /// onto a castor).
+  kParamSlideArc,
+  kParamSlideBack,
   kNumParams
 };
 using ParamVector = std::array<double, kNumParams>;
