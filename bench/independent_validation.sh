@@ -128,9 +128,9 @@ BEGIN {
       if (cls[c] == "pair_settle_clock")
         eff = sprintf("standstill_motion:sigma_xy=%.6g,sigma_theta=%.6g --effect run_time_offset:tau_sd=%.6g", \
                       f * sqrt(2) * gxy, f * sqrt(2) * gth, f2 * sqrt(2) * gxy / v)
-      # Issue 21's physics effects, drawn after everything else: a slide of
-      # f times one piece's along-track noise after a leg at full speed and
-      # of f2 times a piece's heading noise after a spot turn (hard braking:
+      # Issue 21 physics effects, drawn after everything else: a slide of
+      # f times one piece along-track noise after a leg at full speed and
+      # of f2 times a piece heading noise after a spot turn (hard braking:
       # no acceleration limit, else the robot stops at creep speed and
       # barely slides); a swivel castor sized like castor_kick.
       if (cls[c] == "stop_slide") {

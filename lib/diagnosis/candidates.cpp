@@ -407,6 +407,7 @@ void FitNoiseEffect(const Shared& x, sim::EffectKind kind, Candidate& cd) {
   const double gcv = ComputeGap(c, cv.scores, x.options.gap).score;
   cd.heldout_shrink = Shrink(Gap(gcv, x.null_median), x.gap_cv_before);
   if (kind == sim::EffectKind::kRunTimeOffset) CheckRunTimeOffset(x, bases, ne, cf, cd);
+  else cd.footprint = CheckNoiseFootprint(c, x.b.eps, bases, ne);
   // With the wheel noise given (diagnose --baseline --kl --kr), bumps at
   // their rate bound are their Gaussian limit: many small travel errors,
   // rate x sigma_b^2 of variance per metre, i.e. wheel noise growing with
@@ -486,6 +487,19 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
       if (!sim::IsParameterError(kind) && !Identify(x, eparams, cd, out.projected[ei], slide ? &slide_at : nullptr))
         return;
       mean_fits[ei] = FitMeanEffect(x, kind, eparams, cd);
+      // A turn part that comes out negative beyond 2 SE (a slide against
+      // the turn) is E_b's constant extra turn read through a coast the
+      // samples barely catch (10 Hz, a 16 ms coast): refitted without it.
+      if (slide && !turn_part_dropped && cd.params.count("a") &&
+          cd.params.at("a") < -2.0 * cd.param_se.at("a")) {
+        eparams.erase(std::find(eparams.begin(), eparams.end(), kParamSlideA));
+        cd.fitted_params = eparams;
+        cd.params.clear();
+        cd.param_se.clear();
+        cd.parameters = static_cast<int>(eparams.size());
+        turn_part_dropped = true;
+        mean_fits[ei] = FitMeanEffect(x, kind, eparams, cd);
+      }
       if (turn_part_dropped)
         cd.note = std::string(cd.note.empty() ? "" : cd.note + "; ") +
                   "its turn part a is not fitted: a slide after spot turns of one angle and rate is a constant "

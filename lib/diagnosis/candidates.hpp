@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 
 #include "core/progress.hpp"
+#include "diagnosis/footprint.hpp"
 #include "diagnosis/baseline.hpp"
 #include "diagnosis/cross_validation.hpp"
 #include "diagnosis/gap_stats.hpp"
@@ -72,6 +73,10 @@ struct Candidate {
     std::string text;          ///< which samples carry the evidence, in words
   };
   ClockCheck clock;
+  /// Noise effects (not the clocks): whether adjacent stretches of a leg
+  /// have independent heading errors, as every listed noise effect gives
+  /// (footprint.hpp); inconsistent: never named.
+  FootprintCheck footprint;
   /// Mean effects: the mean-model parameters fitted (EffectParams(effect,
   /// campaign) less a part these data cannot tell from E_d, E_b:
   /// stop_slide's turn part a on turns of one angle and rate whose coast

@@ -494,7 +494,7 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
   std::vector<sim::EffectKind> pool;
   for (const Candidate& cd : candidates)
     if (cd.identifiable && (!cd.weak || cd.heldout_loglik_gain > 0.0) && !Contains(chosen, cd.effect) &&
-        cd.clock.supported)
+        cd.clock.supported && cd.footprint.consistent)
       pool.push_back(cd.effect);
   ex.stop_reason = "the largest explanation considered";
   while (static_cast<int>(chosen.size()) < options.max_effects) {

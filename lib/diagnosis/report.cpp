@@ -96,6 +96,13 @@ nlohmann::json CandidatesJson(const DiagnoseSummary& s) {
                               {"moving_value_s", Num(c.clock.value)},
                               {"moving_se_s", Num(c.clock.se)},
                               {"evidence", c.clock.text}};
+    if (c.footprint.checked)
+      added["footprint_check"] = {{"consistent", c.footprint.consistent},
+                                  {"pairs", c.footprint.pairs},
+                                  {"z", Num(c.footprint.z)},
+                                  {"correlation", Num(c.footprint.correlation)},
+                                  {"expected_correlation", Num(c.footprint.expected_correlation)},
+                                  {"evidence", c.footprint.text}};
     added.update({{"effect", sim::EffectToString(c.effect)},
                      {"params", params},
                      {"shrink", Num(c.shrink)},
@@ -234,6 +241,7 @@ void CandidatesSection(TextReport& o, const DiagnoseSummary& s) {
     }
     if (!c.note.empty()) params += "(" + c.note + ")";
     if (c.clock.checked) params += " [" + c.clock.text + "]";
+    if (c.footprint.checked && !c.footprint.consistent) params += " [" + c.footprint.text + "]";
     if (const auto why = UnphysicalFit(sim::EffectToString(c.effect), c.params, b.runs, c.param_se); !why.empty())
       params += " IMPOSSIBLE VALUE, a symptom (the gap is something else): " + why;
     o.line(fmt::format("    {:<20} {:>8.3f} {:>9.3f} {:>9.1f} n {:>10}  {}", sim::EffectToString(c.effect), c.shrink,

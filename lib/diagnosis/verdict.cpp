@@ -69,6 +69,13 @@ std::string UnexplainedReason(const Verdict& out, const Candidate* best, const s
   if (clock)
     reason += fmt::format("; {} would close {:.0f}% held out, but {}", sim::EffectToString(clock->effect),
                               100.0 * clock->heldout_shrink, clock->clock.text);
+  // Likewise a noise effect whose footprint the data contradict.
+  for (const Candidate& cd : out.candidates)
+    if (cd.identifiable && cd.footprint.checked && !cd.footprint.consistent) {
+      reason += fmt::format("; the noise effects would close up to {:.0f}% held out, but {}",
+                            100.0 * cd.heldout_shrink, cd.footprint.text);
+      break;
+    }
   return reason;
 }
 
@@ -87,7 +94,7 @@ void Decide(const CandidateFits& fits, double score_p_value, double null_quantil
   // A clock offset whose moving samples do not show it (Candidate::clock)
   // is a footprint of something at the stops: never named.
   auto qualifies = [&](const Candidate& cd) {
-    return cd.identifiable && cd.clock.supported && cd.evidence > 0.0 &&
+    return cd.identifiable && cd.clock.supported && cd.footprint.consistent && cd.evidence > 0.0 &&
            cd.heldout_shrink >= options.min_heldout_shrink &&
            (cd.gap_after <= null_quantile_alpha || cd.heldout_shrink >= options.full_shrink);
   };
@@ -95,7 +102,8 @@ void Decide(const CandidateFits& fits, double score_p_value, double null_quantil
   // see it): significant after Bonferroni, gains held out, and leaves no
   // significant G.
   auto found_alone = [&](const Candidate& cd) {
-    return found_by_tests && cd.identifiable && cd.clock.supported && cd.tested && !cd.impossible &&
+    return found_by_tests && cd.identifiable && cd.clock.supported && cd.footprint.consistent && cd.tested &&
+           !cd.impossible &&
            out.tests * cd.lr_p_value < route_alpha &&
            cd.evidence > 0.0 && cd.gap_after <= null_quantile_alpha;
   };
@@ -104,7 +112,7 @@ void Decide(const CandidateFits& fits, double score_p_value, double null_quantil
   // stop (castor_kick, castor_swivel, stop_slide) before a noise effect
   // (kicks that vary from start to start also read as bumps: DART's swivel
   // castors); then by evidence.
-  auto usable = [](const Candidate& cd) { return cd.identifiable && cd.clock.supported; };
+  auto usable = [](const Candidate& cd) { return cd.identifiable && cd.clock.supported && cd.footprint.consistent; };
   auto mean_effect = [](const Candidate& cd) {
     return cd.effect == sim::EffectKind::kCastorKick || cd.effect == sim::EffectKind::kCastorSwivel ||
            cd.effect == sim::EffectKind::kStopSlide;
