@@ -107,35 +107,48 @@ void Decide(const CandidateFits& fits, double score_p_value, double null_quantil
            out.tests * cd.lr_p_value < route_alpha &&
            cd.evidence > 0.0 && cd.gap_after <= null_quantile_alpha;
   };
-  // Identifiable (and, for a clock, supported by the moving samples) first;
-  // then those that qualify, a mechanism that acts where motions start or
-  // stop (castor_kick, castor_swivel, stop_slide) before a noise effect
-  // (kicks that vary from start to start also read as bumps: DART's swivel
-  // castors); then by evidence.
+  // Usable (identifiable; a clock supported by the moving samples; a noise
+  // effect whose footprint the data do not contradict) first, then those
+  // that qualify, then by evidence.
   auto usable = [](const Candidate& cd) { return cd.identifiable && cd.clock.supported && cd.footprint.consistent; };
-  auto mean_effect = [](const Candidate& cd) {
-    return cd.effect == sim::EffectKind::kCastorKick || cd.effect == sim::EffectKind::kCastorSwivel ||
-           cd.effect == sim::EffectKind::kStopSlide;
-  };
-  auto clock_effect = [](const Candidate& cd) {
-    return cd.effect == sim::EffectKind::kTimeOffset || cd.effect == sim::EffectKind::kRunTimeOffset;
-  };
   std::stable_sort(rank.begin(), rank.end(), [&](std::size_t a, std::size_t b) {
     const Candidate &ca = fits.candidates[a], &cb = fits.candidates[b];
     if (usable(ca) != usable(cb)) return usable(ca);
     if (qualifies(ca) != qualifies(cb)) return qualifies(ca);
-    // A clock the moving samples support explains the stops too (the
-    // ground truth lags on through a stop by v tau: a slide's footprint);
-    // a slide cannot explain the moving samples.
-    if (qualifies(ca) && qualifies(cb) && (clock_effect(ca) && cb.effect == sim::EffectKind::kStopSlide))
-      return true;
-    if (qualifies(ca) && qualifies(cb) && (clock_effect(cb) && ca.effect == sim::EffectKind::kStopSlide))
-      return false;
-    if (qualifies(ca) && qualifies(cb) && mean_effect(ca) != mean_effect(cb) &&
-        IsNoiseEffect(mean_effect(ca) ? cb.effect : ca.effect))
-      return mean_effect(ca);
     return ca.evidence > cb.evidence;
   });
+  // A noise effect on top yields to a qualifying mechanism where motions
+  // start or stop (castor_kick, castor_swivel, stop_slide; possible
+  // values): kicks or slides that vary from start to start also read as
+  // bumps (DART's swivel castors), but bumps have no turn's or drive's sign.
+  // (Clocks are not noise effects here: a clock the moving samples support
+  // outranks a slide by evidence, as the ground truth lags on through a
+  // stop by v tau.)
+  auto start_stop = [](const Candidate& cd) {
+    return (cd.effect == sim::EffectKind::kCastorKick || cd.effect == sim::EffectKind::kCastorSwivel ||
+            cd.effect == sim::EffectKind::kStopSlide) && !cd.impossible;
+  };
+  auto pure_noise = [](const Candidate& cd) {
+    return IsNoiseEffect(cd.effect) && cd.effect != sim::EffectKind::kRunTimeOffset;
+  };
+  auto promote_first = [&](auto&& which) {
+    for (std::size_t k = 1; k < rank.size(); ++k)
+      if (qualifies(fits.candidates[rank[k]]) && which(fits.candidates[rank[k]])) {
+        std::rotate(rank.begin(), rank.begin() + static_cast<std::ptrdiff_t>(k),
+                    rank.begin() + static_cast<std::ptrdiff_t>(k) + 1);
+        return;
+      }
+  };
+  if (!rank.empty() && qualifies(fits.candidates[rank.front()]) && pure_noise(fits.candidates[rank.front()]))
+    promote_first(start_stop);
+  // A slide on top yields to a qualifying clock the moving samples support:
+  // the slide cannot explain those samples, the clock explains the stops
+  // too.
+  if (!rank.empty() && fits.candidates[rank.front()].effect == sim::EffectKind::kStopSlide)
+    promote_first([](const Candidate& cd) {
+      return (cd.effect == sim::EffectKind::kTimeOffset || cd.effect == sim::EffectKind::kRunTimeOffset) &&
+             cd.clock.checked && cd.clock.supported;
+    });
   if (out.significant && !rank.empty() && !qualifies(fits.candidates[rank.front()])) {
     // No candidate closes the gap G measures: the likelihood-ratio route.
     std::size_t best = rank.size();
