@@ -109,10 +109,12 @@ double CoastProgress(double rate, double k, double tau) {
 /// stop_slide at stop `st` from pose q: the coast between tau0 and tau1
 /// seconds after the wheels stopped, at the true speed the motion ended
 /// with (along the heading, or turning in the turn's sense). After an arc
-/// the heading turns on by slide_arc w/v times the distance coasted (1: a
-/// coast along the arc, as a rigid body on locked wheels does: both
-/// contacts slide forward, their friction forces cancel in torque); a
-/// backward coast is (1 + slide_back) times d v^2.
+/// the heading turns on by slide_arc w/v times the distance coasted: 1, the
+/// coast keeps the arc's curvature; 2, the heading keeps turning at the
+/// arc's rate w through the whole coast (2 d v long) while the speed runs
+/// down -- a rigid body on two locked wheels whose contacts both slide
+/// forward (v > w b / 2), so that their friction forces cancel in torque
+/// (DART: 2.1-2.6). A backward coast is (1 + slide_back) times d v^2.
 Pose2 Slide(const DiagRun::Stop& st, const TrueFactors& f, double drift, Pose2 q, double tau0, double tau1) {
   double vl, vr;
   TrueTravel(f, drift, st.rate_left, st.rate_right, vl, vr);

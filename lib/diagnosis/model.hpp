@@ -61,9 +61,10 @@ enum ParamIndex : int {
   kParamSlideD,   ///< stop_slide.d [s^2/m]
   kParamSlideA,   ///< stop_slide.a [s^2/rad]
   /// stop_slide's shape beyond the contract's d, a (what a physics engine
-  /// shows; 0 is the contract's slide): the share of an arc's curvature
-  /// the coast keeps (heading turns on by arc w/v times the distance
-  /// coasted; 1: along the arc), and a backward coast's extra length (d
+  /// shows; 0 is the contract's slide): how far the heading turns on after
+  /// an arc (arc w/v times the distance coasted; 1: along the arc, 2: at
+  /// the arc's rate through the coast, as two locked wheels sliding forward
+  /// do), and a backward coast's extra length (d
   /// (1 + back) v^2 backwards: braking shifts load off the driven wheels
   /// onto a castor).
   kParamSlideArc,
