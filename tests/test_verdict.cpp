@@ -71,3 +71,77 @@ TEST_CASE("verdict: an impossible fit is never found by its own likelihood-ratio
   CHECK(symptom.significant);  // the gap score alone
   CHECK(symptom.verdict == "unexplained");
 }
+
+namespace {
+
+/// A candidate that qualifies on its own: closes `shrink` of the held-out
+/// gap, leaves no significant gap, with `evidence` nats.
+Candidate Qualifying(umbmark::sim::EffectKind kind, double evidence, double shrink = 0.95) {
+  Candidate c = Tested(kind, 1e-12, false);
+  c.evidence = evidence;
+  c.heldout_shrink = shrink;
+  c.gap_after = 3.0;
+  return c;
+}
+
+Verdict Decide(const std::vector<Candidate>& cands) {
+  CandidateFits fits;
+  fits.candidates = cands;
+  fits.projected.resize(cands.size());
+  return DecideVerdict(fits, 1e-12, 13.3, VerdictOptions{});
+}
+
+}  // namespace
+
+TEST_CASE("verdict: a noise effect yields to a start/stop mechanism that also qualifies", "[diagnose][verdict]") {
+  using umbmark::sim::EffectKind;
+  // DART's swivel castor: kicks that vary from start to start read as bumps
+  // with more evidence, but bumps have no turn's sign.
+  CHECK(Decide({Qualifying(EffectKind::kBumpOutliers, 900.0), Qualifying(EffectKind::kCastorSwivel, 600.0)}).verdict ==
+        "castor_swivel");
+  // Not at an impossible value (a symptom), and not when it does not qualify.
+  Candidate impossible = Qualifying(EffectKind::kCastorSwivel, 600.0);
+  impossible.impossible = true;
+  CHECK(Decide({Qualifying(EffectKind::kBumpOutliers, 900.0), impossible}).verdict == "bump_outliers");
+  CHECK(Decide({Qualifying(EffectKind::kBumpOutliers, 900.0), Qualifying(EffectKind::kCastorSwivel, 600.0, 0.05)})
+            .verdict == "bump_outliers");
+  // Mean effects other than the start/stop mechanisms keep the evidence
+  // order (a scale error does not outrank bumps: DART's floor strips).
+  CHECK(Decide({Qualifying(EffectKind::kBumpOutliers, 900.0), Qualifying(EffectKind::kScaleError, 600.0)}).verdict ==
+        "bump_outliers");
+  // The order of the input does not matter (the ranking is one sort, then
+  // the promotion).
+  CHECK(Decide({Qualifying(EffectKind::kCastorSwivel, 600.0), Qualifying(EffectKind::kTimeOffset, 700.0),
+                Qualifying(EffectKind::kBumpOutliers, 900.0)})
+            .verdict == "castor_swivel");
+  CHECK(Decide({Qualifying(EffectKind::kBumpOutliers, 900.0), Qualifying(EffectKind::kTimeOffset, 700.0),
+                Qualifying(EffectKind::kCastorSwivel, 600.0)})
+            .verdict == "castor_swivel");
+}
+
+TEST_CASE("verdict: a slide yields to a clock the moving samples support; an unsupported clock is never named",
+          "[diagnose][verdict]") {
+  using umbmark::sim::EffectKind;
+  Candidate clock = Qualifying(EffectKind::kRunTimeOffset, 400000.0, 0.999);
+  clock.clock.checked = true;
+  const Candidate slide = Qualifying(EffectKind::kStopSlide, 411000.0, 0.999);
+  // The ground truth lags on through every stop by v tau: a slide imitates
+  // it at the stops, but only the clock explains the moving samples.
+  CHECK(Decide({slide, clock}).verdict == "run_time_offset");
+  clock.clock.supported = false;  // the moving samples do not show it
+  CHECK(Decide({slide, clock}).verdict == "stop_slide");
+  clock.evidence = 500000.0;
+  CHECK(Decide({clock, slide}).verdict == "stop_slide");
+}
+
+TEST_CASE("verdict: a noise effect whose footprint the data contradict is never named", "[diagnose][verdict]") {
+  using umbmark::sim::EffectKind;
+  Candidate floor = Qualifying(EffectKind::kMotionNoiseFloor, 30.0);
+  floor.footprint.checked = true;
+  floor.footprint.consistent = false;
+  floor.footprint.text = "adjacent stretches of the legs have heading errors that cancel";
+  const Verdict v = Decide({floor});
+  CHECK(v.significant);
+  CHECK(v.verdict == "unexplained");
+  CHECK(v.reason.find("cancel") != std::string::npos);
+}
