@@ -312,6 +312,22 @@ void CheckRunTimeOffset(const Shared& x, const std::vector<PieceBases>& bases, c
 }
 
 /// A mean effect fitted jointly with E_d, E_b.
+/// Why a slide may not show: the median speed at the stops after straight
+/// or arc motions and the slide a typical d would give there.
+std::string SlideSpeedNote(const CampaignData& c) {
+  std::vector<double> v;
+  for (const DiagRun& r : c.runs)
+    for (const DiagRun::Stop& st : r.stops)
+      if (st.cls != static_cast<signed char>(sim::MotionClass::kTurn))
+        v.push_back(0.5 * std::abs(st.rate_left + st.rate_right));
+  if (v.empty()) return {};
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  const double med = v[v.size() / 2], d = TypicalMagnitude(kParamSlideD);
+  return fmt::format("; the motions end at {:.3f} m/s (median over {} stops): a slide of typical size (d = {:.3f} "
+                     "s^2/m) would be {:.3f} mm there",
+                     med, v.size(), d, 1e3 * d * med * med);
+}
+
 MeanFit FitMeanEffect(const Shared& x, sim::EffectKind kind, const std::vector<int>& eparams, Candidate& cd) {
   const CampaignData& c = x.c;
   std::vector<int> joint = x.b.free;
@@ -484,8 +500,10 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
       cd.parameters = static_cast<int>(eparams.size());
       // A parameter error frees a baseline parameter itself: nothing to
       // tell it apart from.
-      if (!sim::IsParameterError(kind) && !Identify(x, eparams, cd, out.projected[ei], slide ? &slide_at : nullptr))
+      if (!sim::IsParameterError(kind) && !Identify(x, eparams, cd, out.projected[ei], slide ? &slide_at : nullptr)) {
+        if (slide) cd.note += SlideSpeedNote(c);
         return;
+      }
       mean_fits[ei] = FitMeanEffect(x, kind, eparams, cd);
       // A turn part that comes out negative beyond 2 SE (a slide against
       // the turn) is E_b's constant extra turn read through a coast the
