@@ -383,6 +383,58 @@ MeanFit FitMeanEffect(const Shared& x, sim::EffectKind kind, const std::vector<i
   return mf;
 }
 
+/// A mean effect's candidate: identifiability, fit, parameter standard
+/// errors (false: not identifiable, `cd` says why). stop_slide's turn part
+/// on spot turns of one angle and rate is a constant extra turn, E_b's
+/// footprint, unless the samples resolve the coast after the turns: fitted
+/// only when it can be told from E_d, E_b. A slide's footprint is taken at
+/// a typical-size slide: at d = a = 0 the coast ends at once, and only its
+/// constant extra length and turn (E_d's and E_b's footprints) would show,
+/// and its shape none.
+bool FitMeanCandidate(const Shared& x, sim::EffectKind kind, Candidate& cd, Eigen::MatrixXd& projected, MeanFit& mf) {
+  std::vector<int> eparams = EffectParams(kind, x.c);
+  const bool slide = kind == sim::EffectKind::kStopSlide;
+  ParamVector slide_at = x.b.p;
+  slide_at[kParamSlideD] = TypicalMagnitude(kParamSlideD);
+  slide_at[kParamSlideA] = TypicalMagnitude(kParamSlideA);
+  auto has = [&](int k) { return std::find(eparams.begin(), eparams.end(), k) != eparams.end(); };
+  bool turn_part_dropped = false;
+  if (slide && has(kParamSlideA) && has(kParamSlideD)) {
+    Candidate probe;
+    Eigen::MatrixXd unused;
+    if (!Identify(x, {kParamSlideA}, probe, unused, &slide_at) || probe.weak) {
+      eparams.erase(std::find(eparams.begin(), eparams.end(), kParamSlideA));
+      turn_part_dropped = true;
+    }
+  }
+  cd.fitted_params = eparams;
+  cd.parameters = static_cast<int>(eparams.size());
+  // A parameter error frees a baseline parameter itself: nothing to tell
+  // it apart from.
+  if (!sim::IsParameterError(kind) && !Identify(x, eparams, cd, projected, slide ? &slide_at : nullptr)) {
+    if (slide) cd.note += SlideSpeedNote(x.c);
+    return false;
+  }
+  mf = FitMeanEffect(x, kind, eparams, cd);
+  // A turn part that comes out negative beyond 2 SE (a slide against the
+  // turn) is E_b's constant extra turn read through a coast the samples
+  // barely catch (10 Hz, a 16 ms coast): refitted without it.
+  if (slide && !turn_part_dropped && cd.params.count("a") && cd.params.at("a") < -2.0 * cd.param_se.at("a")) {
+    eparams.erase(std::find(eparams.begin(), eparams.end(), kParamSlideA));
+    cd.fitted_params = eparams;
+    cd.params.clear();
+    cd.param_se.clear();
+    cd.parameters = static_cast<int>(eparams.size());
+    turn_part_dropped = true;
+    mf = FitMeanEffect(x, kind, eparams, cd);
+  }
+  if (turn_part_dropped)
+    cd.note = std::string(cd.note.empty() ? "" : cd.note + "; ") +
+              "its turn part a is not fitted: a slide after spot turns of one angle and rate is a constant extra "
+              "turn, which the baseline's E_b absorbs, and these samples do not resolve the coast";
+  return true;
+}
+
 /// correlated_noise or bump_outliers on the baseline's residuals.
 void FitNoiseEffect(const Shared& x, sim::EffectKind kind, Candidate& cd) {
   const CampaignData& c = x.c;
@@ -474,54 +526,8 @@ CandidateFits FitCandidates(const CampaignData& c, const MeanModel& model, const
     const sim::EffectKind kind = effects[ei];
     Candidate& cd = out.candidates[ei];
     cd.effect = kind;
-    std::vector<int> eparams = EffectParams(kind, c);
-    // stop_slide's turn part on spot turns of one angle and rate is a
-    // constant extra turn, E_b's footprint, unless the samples resolve the
-    // coast after the turns: fitted only when it can be told from E_d, E_b.
-    // A slide's footprint is taken at a typical-size slide: at d = a = 0
-    // the coast ends at once, and only its constant extra length and turn
-    // (E_d's and E_b's footprints) would show, and its shape none.
-    bool turn_part_dropped = false;
-    ParamVector slide_at = x.b.p;
-    slide_at[kParamSlideD] = TypicalMagnitude(kParamSlideD);
-    slide_at[kParamSlideA] = TypicalMagnitude(kParamSlideA);
-    const bool slide = kind == sim::EffectKind::kStopSlide;
-    if (slide && std::find(eparams.begin(), eparams.end(), kParamSlideA) != eparams.end() &&
-        std::find(eparams.begin(), eparams.end(), kParamSlideD) != eparams.end()) {
-      Candidate probe;
-      Eigen::MatrixXd unused;
-      if (!Identify(x, {kParamSlideA}, probe, unused, &slide_at) || probe.weak) {
-        eparams.erase(std::find(eparams.begin(), eparams.end(), kParamSlideA));
-        turn_part_dropped = true;
-      }
-    }
-    cd.fitted_params = eparams;
-    if (!eparams.empty()) {
-      cd.parameters = static_cast<int>(eparams.size());
-      // A parameter error frees a baseline parameter itself: nothing to
-      // tell it apart from.
-      if (!sim::IsParameterError(kind) && !Identify(x, eparams, cd, out.projected[ei], slide ? &slide_at : nullptr)) {
-        if (slide) cd.note += SlideSpeedNote(c);
-        return;
-      }
-      mean_fits[ei] = FitMeanEffect(x, kind, eparams, cd);
-      // A turn part that comes out negative beyond 2 SE (a slide against
-      // the turn) is E_b's constant extra turn read through a coast the
-      // samples barely catch (10 Hz, a 16 ms coast): refitted without it.
-      if (slide && !turn_part_dropped && cd.params.count("a") &&
-          cd.params.at("a") < -2.0 * cd.param_se.at("a")) {
-        eparams.erase(std::find(eparams.begin(), eparams.end(), kParamSlideA));
-        cd.fitted_params = eparams;
-        cd.params.clear();
-        cd.param_se.clear();
-        cd.parameters = static_cast<int>(eparams.size());
-        turn_part_dropped = true;
-        mean_fits[ei] = FitMeanEffect(x, kind, eparams, cd);
-      }
-      if (turn_part_dropped)
-        cd.note = std::string(cd.note.empty() ? "" : cd.note + "; ") +
-                  "its turn part a is not fitted: a slide after spot turns of one angle and rate is a constant "
-                  "extra turn, which the baseline's E_b absorbs, and these samples do not resolve the coast";
+    if (const std::vector<int> eparams = EffectParams(kind, c); !eparams.empty()) {
+      if (!FitMeanCandidate(x, kind, cd, out.projected[ei], mean_fits[ei])) return;
     } else if (IsNoiseEffect(kind)) {
       FitNoiseEffect(x, kind, cd);
     } else {

@@ -79,34 +79,11 @@ std::string UnexplainedReason(const Verdict& out, const Candidate* best, const s
   return reason;
 }
 
-/// Ranks the candidates and names the verdict with its reason.
-void Decide(const CandidateFits& fits, double score_p_value, double null_quantile_alpha, const VerdictOptions& options,
-            Verdict& out) {
-  // Level of each route: half of alpha each when both are combined.
-  const double route_alpha = options.likelihood_tests && out.tests > 0 ? 0.5 * options.alpha : options.alpha;
-  const bool found_by_tests = options.likelihood_tests && out.tests > 0 && out.tests_p_value < route_alpha;
+/// The candidates' order, best first (`qualifies`: Decide's rule).
+template <typename Qualifies>
+std::vector<std::size_t> Rank(const CandidateFits& fits, const Qualifies& qualifies) {
   std::vector<std::size_t> rank(fits.candidates.size());
   for (std::size_t i = 0; i < rank.size(); ++i) rank[i] = i;
-  // Best first: effects that close most of the held-out gap with positive
-  // evidence, by evidence; then the others by evidence; unidentifiable last.
-  // A winner must also leave no significant gap behind, unless it closes
-  // nearly all of it (a tiny misfit of a huge effect still scores high).
-  // A clock offset whose moving samples do not show it (Candidate::clock)
-  // is a footprint of something at the stops: never named.
-  auto qualifies = [&](const Candidate& cd) {
-    return cd.identifiable && cd.clock.supported && cd.footprint.consistent && cd.evidence > 0.0 &&
-           cd.heldout_shrink >= options.min_heldout_shrink &&
-           (cd.gap_after <= null_quantile_alpha || cd.heldout_shrink >= options.full_shrink);
-  };
-  // Found by its own likelihood-ratio test (the gap G may be too diffuse to
-  // see it): significant after Bonferroni, gains held out, and leaves no
-  // significant G.
-  auto found_alone = [&](const Candidate& cd) {
-    return found_by_tests && cd.identifiable && cd.clock.supported && cd.footprint.consistent && cd.tested &&
-           !cd.impossible &&
-           out.tests * cd.lr_p_value < route_alpha &&
-           cd.evidence > 0.0 && cd.gap_after <= null_quantile_alpha;
-  };
   // Usable (identifiable; a clock supported by the moving samples; a noise
   // effect whose footprint the data do not contradict) first, then those
   // that qualify, then by evidence.
@@ -149,6 +126,36 @@ void Decide(const CandidateFits& fits, double score_p_value, double null_quantil
       return (cd.effect == sim::EffectKind::kTimeOffset || cd.effect == sim::EffectKind::kRunTimeOffset) &&
              cd.clock.checked && cd.clock.supported;
     });
+  return rank;
+}
+
+/// Ranks the candidates and names the verdict with its reason.
+void Decide(const CandidateFits& fits, double score_p_value, double null_quantile_alpha, const VerdictOptions& options,
+            Verdict& out) {
+  // Level of each route: half of alpha each when both are combined.
+  const double route_alpha = options.likelihood_tests && out.tests > 0 ? 0.5 * options.alpha : options.alpha;
+  const bool found_by_tests = options.likelihood_tests && out.tests > 0 && out.tests_p_value < route_alpha;
+  // Best first: effects that close most of the held-out gap with positive
+  // evidence, by evidence; then the others by evidence; unidentifiable last.
+  // A winner must also leave no significant gap behind, unless it closes
+  // nearly all of it (a tiny misfit of a huge effect still scores high).
+  // A clock offset whose moving samples do not show it (Candidate::clock)
+  // is a footprint of something at the stops: never named.
+  auto qualifies = [&](const Candidate& cd) {
+    return cd.identifiable && cd.clock.supported && cd.footprint.consistent && cd.evidence > 0.0 &&
+           cd.heldout_shrink >= options.min_heldout_shrink &&
+           (cd.gap_after <= null_quantile_alpha || cd.heldout_shrink >= options.full_shrink);
+  };
+  // Found by its own likelihood-ratio test (the gap G may be too diffuse to
+  // see it): significant after Bonferroni, gains held out, and leaves no
+  // significant G.
+  auto found_alone = [&](const Candidate& cd) {
+    return found_by_tests && cd.identifiable && cd.clock.supported && cd.footprint.consistent && cd.tested &&
+           !cd.impossible &&
+           out.tests * cd.lr_p_value < route_alpha &&
+           cd.evidence > 0.0 && cd.gap_after <= null_quantile_alpha;
+  };
+  std::vector<std::size_t> rank = Rank(fits, qualifies);
   if (out.significant && !rank.empty() && !qualifies(fits.candidates[rank.front()])) {
     // No candidate closes the gap G measures: the likelihood-ratio route.
     std::size_t best = rank.size();
