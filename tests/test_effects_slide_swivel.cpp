@@ -156,6 +156,12 @@ TEST_CASE("stop_slide, castor_swivel: bad parameters are refused with the allowe
   CHECK(CheckMessage("castor_swivel:kappa=inf").find("must be in [-0.5, 0.5] rad") != std::string::npos);
   CHECK(CheckMessage("castor_swivel:kappa=0.5").empty());
   CHECK(CheckMessage("stop_slide:d=0.06,a=0.01").empty());
+  // Its shape (beyond the contract; 0 by default).
+  CHECK(CheckMessage("stop_slide:d=0.06,arc=-1").find("stop_slide.arc = -1 must be in [0, 4]") != std::string::npos);
+  CHECK(CheckMessage("stop_slide:d=0.06,arc=nan").find("must be in [0, 4]") != std::string::npos);
+  CHECK(CheckMessage("stop_slide:d=0.06,back=-1").find("stop_slide.back = -1 must be in [-0.9, 4]") !=
+        std::string::npos);
+  CHECK(CheckMessage("stop_slide:d=0.06,a=0.01,arc=2,back=0.4").empty());
 
   using testing::Q;
   const auto dir = testing::TempDir("slide-cli");
@@ -165,7 +171,8 @@ TEST_CASE("stop_slide, castor_swivel: bad parameters are refused with the allowe
     f << "[robot]\nwheelbase_m = 0.3\nwheel_diameter_left_m = 0.08\nwheel_diameter_right_m = 0.08\n\n"
          "[[experiment]]\nkind = \"back_and_forth\"\ndistance_m = 1.0\nfile = \"bf.csv\"\n";
   }
-  for (const char* bad : {"stop_slide:d=-1", "stop_slide:d=nan", "castor_swivel:kappa=0.7"}) {
+  for (const char* bad : {"stop_slide:d=-1", "stop_slide:d=nan", "castor_swivel:kappa=0.7", "stop_slide:d=0.05,arc=5",
+                          "stop_slide:d=0.05,back=inf"}) {
     const auto r = testing::RunCli("simulate " + Q(in) + " --out " + Q(dir / "x") + " --effect " + bad);
     INFO(bad << ": " << r.err);
     CHECK(r.status == 2);
@@ -299,3 +306,71 @@ TEST_CASE("diagnose: a swivel castor is named castor_swivel with kappa recovered
   CHECK_THAT(c->params.at("kappa"), WithinAbs(0.008, 5.0 * c->param_se.at("kappa")));
   CHECK(c->heldout_shrink > 0.5);
 }
+
+TEST_CASE("stop_slide's shape: simulate's arc and back coasts are the diagnosis model's, and diagnose recovers them",
+          "[diagnose][issue21]") {
+  // Squares, back-and-forth runs (backward stops) and figure eights (arc
+  // stops), noise-free: the model at the true parameters reproduces the
+  // simulator's poses (the coast's 1 ms steps aside), and without the
+  // shape it is millimetres and milliradians off.
+  testing::SmallCampaign s = testing::MakeSmallCampaign(5, 2, 2);
+  s.manifest.robot.ticks_per_rev.reset();
+  testing::AddFreeExperiment(s.manifest, "free.csv");
+  s.sim.free_runs = 2;
+  s.sim.truth.k_L = s.sim.truth.k_R = 0.0;
+  s.sim.ground_truth = GroundTruthNoise{0.0, 0.0};
+  s.sim.effects.slide_d = 0.05;
+  s.sim.effects.slide_a = 0.01;
+  s.sim.effects.slide_arc = 2.0;
+  s.sim.effects.slide_back = 0.4;
+  const diag::CampaignData c = testing::BuildSmallCampaign(s);
+  const diag::MeanModel model(c);
+  diag::ParamVector p = diag::NominalParams();
+  p[diag::kParamEd] = s.sim.truth.E_d;
+  p[diag::kParamEb] = s.sim.truth.E_b;
+  p[diag::kParamSlideD] = 0.05;
+  p[diag::kParamSlideA] = 0.01;
+  p[diag::kParamSlideArc] = 2.0;
+  p[diag::kParamSlideBack] = 0.4;
+  std::vector<double> eps;
+  model.Residuals(p, eps);
+  double worst = 0.0;
+  for (double e : eps) worst = std::max(worst, std::abs(e));
+  CHECK(worst < 1e-5);
+  // A backward leg at 0.5 m/s coasts 0.4 x 0.05 x 0.25 = 5 mm further.
+  p[diag::kParamSlideBack] = 0.0;
+  model.Residuals(p, eps);
+  worst = 0.0;
+  for (double e : eps) worst = std::max(worst, std::abs(e));
+  CHECK(worst > 4e-3);
+  p[diag::kParamSlideBack] = 0.4;
+  p[diag::kParamSlideArc] = 0.0;
+  model.Residuals(p, eps);
+  worst = 0.0;
+  for (std::size_t j = 0; j < eps.size(); j += 3) worst = std::max(worst, std::abs(eps[j + 2]));
+  CHECK(worst > 1e-3);  // the heading after an arc's coast: 2 w/v d v^2 = 2 d v w
+}
+
+TEST_CASE("diagnose recovers stop_slide's arc and back from a noisy campaign", "[diagnose][issue21]") {
+  testing::SmallCampaign s = testing::MakeSmallCampaign(83, 5, 10);
+  testing::AddFreeExperiment(s.manifest, "free.csv");
+  s.sim.free_runs = 4;
+  s.sim.sample_rate_hz = 50.0;
+  s.sim.effects.slide_d = 0.04;
+  s.sim.effects.slide_a = 0.01;
+  s.sim.effects.slide_arc = 2.0;
+  s.sim.effects.slide_back = 0.5;
+  const diag::DiagnoseSummary d = diag::Diagnose(testing::BuildSmallCampaign(s), Fast());
+  INFO(d.verdict_reason);
+  CHECK(d.verdict == "stop_slide");
+  const diag::Candidate* c = Find(d, sim::EffectKind::kStopSlide);
+  REQUIRE(c);
+  REQUIRE(c->params.count("arc"));
+  REQUIRE(c->params.count("back"));
+  CHECK_THAT(c->params.at("d"), WithinAbs(0.04, 5.0 * c->param_se.at("d")));
+  CHECK_THAT(c->params.at("back"), WithinAbs(0.5, 5.0 * c->param_se.at("back")));
+  CHECK_THAT(c->params.at("arc"), WithinAbs(2.0, 5.0 * c->param_se.at("arc")));
+  CHECK(c->param_se.at("back") < 0.1);
+  CHECK(c->param_se.at("arc") < 0.5);
+}
+

@@ -127,7 +127,9 @@ Pose2 Slide(const DiagRun::Stop& st, const TrueFactors& f, double drift, Pose2 q
   const double d = v < 0.0 ? f.slide_d * (1.0 + f.slide_back) : f.slide_d;
   const double along = CoastProgress(v, d, tau1) - CoastProgress(v, d, tau0);
   const double turn = f.slide_arc != 0.0 && std::abs(v) > 1e-9 ? f.slide_arc * (vr - vl) / f.wheelbase / v * along : 0.0;
-  return {q.x + along * std::cos(q.theta), q.y + along * std::sin(q.theta), q.theta + turn};
+  // Along the curve the coast follows (constant curvature): its chord.
+  const double h = 0.5 * turn, chord = along * Sinc(h);
+  return {q.x + chord * std::cos(q.theta + h), q.y + chord * std::sin(q.theta + h), q.theta + turn};
 }
 
 /// The pose after fraction `u` in [0, 1] of interval i's time from `q`

@@ -425,7 +425,10 @@ class RunExecutor {
     coast_.t0 = t;
     coast_.turn = m.cls == MotionClass::kTurn;
     coast_.rate = coast_.turn ? (rate[1] - rate[0]) / truth_.true_wheelbase_m : 0.5 * (rate[0] + rate[1]);
-    coast_.k = coast_.turn ? fx_.slide_a : fx_.slide_d;
+    coast_.k = coast_.turn ? fx_.slide_a : fx_.slide_d * (coast_.rate < 0.0 ? 1.0 + fx_.slide_back : 1.0);
+    // After an arc the heading turns on by arc w/v per metre coasted.
+    if (!coast_.turn && coast_.rate != 0.0)
+      coast_.curvature = fx_.slide_arc * (rate[1] - rate[0]) / truth_.true_wheelbase_m / coast_.rate;
     coast_.active = coast_.k > 0.0 && coast_.rate != 0.0;
   }
 
@@ -435,6 +438,7 @@ class RunExecutor {
   struct Coast {
     bool active = false, turn = false;
     double t0 = 0.0, rate = 0.0, k = 0.0;
+    double curvature = 0.0;  ///< heading turned per metre coasted (stop_slide.arc w/v)
     double Progress(double t) const {
       const double v = std::abs(rate), tau = std::clamp(t - t0, 0.0, 2.0 * k * v);
       return (rate > 0.0 ? 1.0 : -1.0) * (v * tau - tau * tau / (4.0 * k));
@@ -460,8 +464,12 @@ class RunExecutor {
         s.left_m = -0.5 * step * truth_.true_wheelbase_m;
         s.right_m = 0.5 * step * truth_.true_wheelbase_m;
       } else {
-        s.slide_x_m = step * std::cos(pose_.theta);
-        s.slide_y_m = step * std::sin(pose_.theta);
+        // Along the step's mid heading (the coast curves with stop_slide.arc).
+        const double mid = pose_.theta + 0.5 * step * coast_.curvature;
+        s.slide_x_m = step * std::cos(mid);
+        s.slide_y_m = step * std::sin(mid);
+        s.left_m = -0.5 * step * coast_.curvature * truth_.true_wheelbase_m;
+        s.right_m = 0.5 * step * coast_.curvature * truth_.true_wheelbase_m;
       }
       pose_ = AdvancePose(pose_, s.left_m, s.right_m, truth_.true_wheelbase_m, 1.0, s.slide_x_m, s.slide_y_m);
       s.end = pose_;

@@ -52,7 +52,10 @@ const std::vector<EffectDescriptor>& EffectCatalogue() {
        "in run i the ground truth stamped t shows the true pose at t - tau_i, tau_i ~ N(0, tau_sd^2) per run"},
       {EffectKind::kStopSlide,
        "stop_slide",
-       {{"d", &Effects::slide_d, "s^2/m"}, {"a", &Effects::slide_a, "s^2/rad"}},
+       {{"d", &Effects::slide_d, "s^2/m"},
+        {"a", &Effects::slide_a, "s^2/rad"},
+        {"arc", &Effects::slide_arc, ""},
+        {"back", &Effects::slide_back, ""}},
        true,
        "at every stop after a straight or arc motion at speed v the chassis coasts on along its last direction "
        "of travel by d v^2 m while the encoders read still; after a spot turn at rate w it turns on by a w^2 rad"},
@@ -111,6 +114,10 @@ namespace {
 constexpr double kMaxSlideD = 1.0;
 constexpr double kMaxSlideA = 1.0;
 constexpr double kMaxSwivelKappa = 0.5;
+// stop_slide's shape (diagnosis.md, "A slide's shape"): arc 0-4 (2 is two
+// locked wheels sliding forward), a backward coast 0.1-5 times the forward.
+constexpr double kMaxSlideArc = 4.0;
+constexpr double kMinSlideBack = -0.9, kMaxSlideBack = 4.0;
 }  // namespace
 
 std::string Effects::Check() const {
@@ -121,6 +128,13 @@ std::string Effects::Check() const {
                        slide_d, kMaxSlideD);
   if (!(slide_a >= 0.0 && slide_a <= kMaxSlideA))
     return fmt::format("stop_slide.a = {} must be in [0, {}] s^2/rad", slide_a, kMaxSlideA);
+  if (!(slide_arc >= 0.0 && slide_arc <= kMaxSlideArc))
+    return fmt::format("stop_slide.arc = {} must be in [0, {}] (2: the heading keeps turning at the arc's rate "
+                       "through the coast)",
+                       slide_arc, kMaxSlideArc);
+  if (!(slide_back >= kMinSlideBack && slide_back <= kMaxSlideBack))
+    return fmt::format("stop_slide.back = {} must be in [{}, {}] (a backward coast (1 + back) times as long)",
+                       slide_back, kMinSlideBack, kMaxSlideBack);
   if (!(std::abs(swivel_kappa) <= kMaxSwivelKappa))
     return fmt::format("castor_swivel.kappa = {} must be in [-{}, {}] rad", swivel_kappa, kMaxSwivelKappa,
                        kMaxSwivelKappa);

@@ -108,6 +108,12 @@ struct Effects {
   double run_tau_sd = 0.0;         ///< run_time_offset.tau_sd [s]
   double slide_d = 0.0;            ///< stop_slide.d [s^2/m]
   double slide_a = 0.0;            ///< stop_slide.a [s^2/rad]
+  /// stop_slide's shape beyond the contract (0: the contract's slide): after
+  /// an arc the heading turns on by arc w/v times the distance coasted (2:
+  /// at the arc's rate through the coast, two locked wheels sliding
+  /// forward); a backward coast is (1 + back) d v^2 (load on the castor).
+  double slide_arc = 0.0;
+  double slide_back = 0.0;
   double swivel_kappa = 0.0;       ///< castor_swivel.kappa [rad]
   double yaw_delta = 0.0;      ///< gt_yaw_misalignment.delta [rad] (outside)
   double slope_g = 0.0;        ///< floor_slope.g [m/m] (outside)
