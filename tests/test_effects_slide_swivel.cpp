@@ -78,6 +78,35 @@ const diag::Candidate* Find(const diag::DiagnoseSummary& s, sim::EffectKind k) {
   return nullptr;
 }
 
+/// The diagnosis' parameters of the simulated truth (E_d, E_b and the
+/// mean effects the simulator was given).
+diag::ParamVector TrueParams(const testing::SmallCampaign& s) {
+  const sim::Effects& fx = s.sim.effects;
+  diag::ParamVector p = diag::NominalParams();
+  p[diag::kParamEd] = s.sim.truth.E_d;
+  p[diag::kParamEb] = s.sim.truth.E_b;
+  p[diag::kParamScale] = fx.scale_s;
+  p[diag::kParamKappa] = fx.castor_kappa;
+  p[diag::kParamTau] = fx.time_tau;
+  p[diag::kParamSlideD] = fx.slide_d;
+  p[diag::kParamSlideA] = fx.slide_a;
+  p[diag::kParamSlideArc] = fx.slide_arc;
+  p[diag::kParamSlideBack] = fx.slide_back;
+  p[diag::kParamSwivel] = fx.swivel_kappa;
+  return p;
+}
+
+/// Largest |residual| of the noise-free campaign `c` under `p` (every
+/// component, or only headings).
+double Worst(const diag::MeanModel& model, const diag::ParamVector& p, bool heading_only = false) {
+  std::vector<double> eps;
+  model.Residuals(p, eps);
+  double worst = 0.0;
+  for (std::size_t j = heading_only ? 2 : 0; j < eps.size(); j += heading_only ? 3 : 1)
+    worst = std::max(worst, std::abs(eps[j]));
+  return worst;
+}
+
 diag::DiagnoseOptions Fast() {
   diag::DiagnoseOptions o;
   o.null_simulations = 100;
@@ -199,28 +228,14 @@ TEST_CASE("diagnose model: replays stop_slide and castor_swivel exactly (noise-f
   s.sim.effects.time_tau = 0.02;
   const diag::CampaignData c = testing::BuildSmallCampaign(s);
   const diag::MeanModel model(c);
-  diag::ParamVector p = diag::NominalParams();
-  p[diag::kParamEd] = s.sim.truth.E_d;
-  p[diag::kParamEb] = s.sim.truth.E_b;
-  p[diag::kParamScale] = 0.01;
-  p[diag::kParamKappa] = 0.004;
-  p[diag::kParamTau] = 0.02;
-  p[diag::kParamSlideD] = 0.04;
-  p[diag::kParamSlideA] = 0.015;
-  p[diag::kParamSwivel] = -0.007;
-  std::vector<double> eps;
-  model.Residuals(p, eps);
-  double worst = 0.0;
-  for (double e : eps) worst = std::max(worst, std::abs(e));
+  diag::ParamVector p = TrueParams(s);
+  double worst = Worst(model, p);
   // 10 micrometres: with the time offset the simulator reads the quadratic
   // coast between its 1 ms steps linearly (campaign_run.cpp Rest).
   CHECK(worst < 1e-5);
   // Without the two effects the residuals are millimetres.
   p[diag::kParamSlideD] = p[diag::kParamSlideA] = p[diag::kParamSwivel] = 0.0;
-  model.Residuals(p, eps);
-  worst = 0.0;
-  for (double e : eps) worst = std::max(worst, std::abs(e));
-  CHECK(worst > 5e-3);
+  CHECK(Worst(model, p) > 5e-3);
 }
 
 TEST_CASE("diagnose: a sliding stop is named stop_slide with d and a recovered, never a clock offset",
@@ -325,30 +340,14 @@ TEST_CASE("stop_slide's shape: simulate's arc and back coasts are the diagnosis 
   s.sim.effects.slide_back = 0.4;
   const diag::CampaignData c = testing::BuildSmallCampaign(s);
   const diag::MeanModel model(c);
-  diag::ParamVector p = diag::NominalParams();
-  p[diag::kParamEd] = s.sim.truth.E_d;
-  p[diag::kParamEb] = s.sim.truth.E_b;
-  p[diag::kParamSlideD] = 0.05;
-  p[diag::kParamSlideA] = 0.01;
-  p[diag::kParamSlideArc] = 2.0;
-  p[diag::kParamSlideBack] = 0.4;
-  std::vector<double> eps;
-  model.Residuals(p, eps);
-  double worst = 0.0;
-  for (double e : eps) worst = std::max(worst, std::abs(e));
-  CHECK(worst < 1e-5);
+  diag::ParamVector p = TrueParams(s);
+  CHECK(Worst(model, p) < 1e-5);
   // A backward leg at 0.5 m/s coasts 0.4 x 0.05 x 0.25 = 5 mm further.
   p[diag::kParamSlideBack] = 0.0;
-  model.Residuals(p, eps);
-  worst = 0.0;
-  for (double e : eps) worst = std::max(worst, std::abs(e));
-  CHECK(worst > 4e-3);
+  CHECK(Worst(model, p) > 4e-3);
   p[diag::kParamSlideBack] = 0.4;
   p[diag::kParamSlideArc] = 0.0;
-  model.Residuals(p, eps);
-  worst = 0.0;
-  for (std::size_t j = 0; j < eps.size(); j += 3) worst = std::max(worst, std::abs(eps[j + 2]));
-  CHECK(worst > 1e-3);  // the heading after an arc's coast: 2 w/v d v^2 = 2 d v w
+  CHECK(Worst(model, p, /*heading_only=*/true) > 1e-3);  // the heading after an arc's coast: 2 w/v d v^2 = 2 d v w
 }
 
 TEST_CASE("diagnose recovers stop_slide's arc and back from a noisy campaign", "[diagnose][issue21]") {
