@@ -8,15 +8,18 @@
 //  false-alarm rate stays at most alpha.
 //  Verdict: `none` when p >= alpha; else the top candidate if it closes
 //  enough of the held-out gap and leaves no significant gap; else the
-//  likelihood-ratio route; else `unexplained`. Among candidates that
-//  qualify, a mechanism at the starts and stops of motions (castor_kick,
-//  castor_swivel, stop_slide: a systematic shift with the turn's or the
-//  drive's sign) ranks before a noise effect (scatter, which such kicks
-//  imitate when they vary: DART's swivel castors read as bumps); a clock offset the moving samples do not
-//  support ranks after everything identifiable. A test whose fit lies
-//  below its practical floor (a 0.2 ms clock) counts in the Bonferroni
-//  factor but is no evidence. Effects the data cannot tell apart are
-//  listed.
+//  likelihood-ratio route; else `unexplained`. Candidates rank by whether
+//  they are usable (identifiable; a clock the moving samples support; a
+//  noise effect whose footprint the data do not contradict, footprint.hpp),
+//  then whether they qualify, then by evidence; then a noise effect on top
+//  yields to a qualifying mechanism at the starts and stops of motions
+//  (castor_kick, castor_swivel, stop_slide: a shift with the turn's or the
+//  drive's sign, which kicks that vary imitate as scatter: DART's swivel
+//  castors read as bumps), and a slide on top yields to a qualifying clock
+//  the moving samples support (which explains the stops too). A test whose
+//  fit lies below its practical floor (a 0.2 ms clock), or a clock the
+//  moving samples do not support, counts in the Bonferroni factor but is no
+//  evidence. Effects the data cannot tell apart are listed.
 #pragma once
 
 #include <string>
