@@ -398,13 +398,18 @@ bool FitMeanCandidate(const Shared& x, sim::EffectKind kind, Candidate& cd, Eige
   slide_at[kParamSlideD] = TypicalMagnitude(kParamSlideD);
   slide_at[kParamSlideA] = TypicalMagnitude(kParamSlideA);
   auto has = [&](int k) { return std::find(eparams.begin(), eparams.end(), k) != eparams.end(); };
+  // Each part beside d (the turn part a, the shape arc and back) is kept
+  // only where these data tell it from E_d, E_b on its own: a, and against
+  // a given model every part, only when not even weakly absorbed (a weak
+  // part would make the whole slide unidentifiable there).
   bool turn_part_dropped = false;
-  if (slide && has(kParamSlideA) && has(kParamSlideD)) {
+  for (const int part : {kParamSlideA, kParamSlideArc, kParamSlideBack}) {
+    if (!slide || !has(part) || !has(kParamSlideD)) continue;
     Candidate probe;
     Eigen::MatrixXd unused;
-    if (!Identify(x, {kParamSlideA}, probe, unused, &slide_at) || probe.weak) {
-      eparams.erase(std::find(eparams.begin(), eparams.end(), kParamSlideA));
-      turn_part_dropped = true;
+    if (!Identify(x, {part}, probe, unused, &slide_at) || (probe.weak && (part == kParamSlideA || x.b.given))) {
+      eparams.erase(std::find(eparams.begin(), eparams.end(), part));
+      turn_part_dropped = turn_part_dropped || part == kParamSlideA;
     }
   }
   cd.fitted_params = eparams;
