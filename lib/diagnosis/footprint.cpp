@@ -72,7 +72,7 @@ FootprintCheck CheckNoiseFootprint(const CampaignData& c, const std::vector<doub
                                "gives (rank correlation {:.2f}, {:.2f} expected from the ground truth's noise; z = {:.1f} "
                                "over {} pairs)",
                                out.correlation, out.expected_correlation, out.z, out.pairs)
-                 : fmt::format("adjacent stretches of the legs have heading errors that cancel (correlation {:.2f}, "
+                 : fmt::format("adjacent stretches of the legs have heading errors that cancel (rank correlation {:.2f}, "
                                "{:.2f} expected from the ground truth's noise; z = {:.1f} over {} pairs): the error "
                                "comes and goes within a motion (a bounded error such as an eccentric or out-of-round "
                                "wheel), which no noise effect on the list does; never named",

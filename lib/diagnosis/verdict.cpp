@@ -4,6 +4,7 @@
 #include "diagnosis/explanation.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include <Eigen/Dense>
@@ -231,8 +232,12 @@ void Indistinguishable(const CandidateFits& fits, const VerdictOptions& options,
     const Candidate& top = out.candidates.front();
     for (std::size_t i = 1; i < out.candidates.size(); ++i) {
       const Candidate& o = out.candidates[i];
-      if (!o.identifiable || o.heldout_shrink < options.min_heldout_shrink) continue;
-      if (top.evidence - o.evidence < 2.0)
+      // Only what could be named: a clock the moving samples do not show, or
+      // a noise effect whose footprint the runs contradict, is no rival.
+      if (!o.identifiable || o.heldout_shrink < options.min_heldout_shrink || !o.clock.supported ||
+          !o.footprint.consistent)
+        continue;
+      if (std::abs(top.evidence - o.evidence) < 2.0)
         out.indistinguishable.push_back(fmt::format(
             "{} and {} explain the gap about equally well on held-out runs ({:.1f} vs {:.1f} nats)",
             sim::EffectToString(top.effect), sim::EffectToString(o.effect), top.evidence, o.evidence));
