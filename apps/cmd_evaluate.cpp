@@ -336,6 +336,10 @@ std::optional<FileResult> EvaluateInParts(const io::TrajectoryReader& whole, con
   return first;
 }
 
+// Longer than 80 lines on purpose: the command's steps in order (read the
+// parameters, stream every file run by run, summarise, print, then the JSON,
+// plots and report), all sharing the two summaries; each step is a call or
+// a few lines.
 int RunEvaluate(const EvaluateOptions& o) {
   const Integrator integ = *IntegratorFromString(o.integrator);
   io::OutputSet& outs = CommandOutputs();

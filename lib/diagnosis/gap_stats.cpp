@@ -98,6 +98,11 @@ std::vector<Scores> PieceScores(const std::vector<double>& eps, const std::vecto
   return out;
 }
 
+// Longer than 80 lines on purpose: one pass over the pieces fills every
+// subset's accumulator (means, variances, tails, cross-products, run means),
+// and the second turns the same accumulators into the standardized
+// departures G sums; split, the two halves would hand the accumulators back
+// and forth.
 GapSummary ComputeGap(const CampaignData& campaign, const std::vector<Scores>& scores, const GapOptions& options,
                       const std::vector<char>* use) {
   const std::size_t S = campaign.subsets.size();

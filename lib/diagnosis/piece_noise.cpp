@@ -228,6 +228,10 @@ double PieceLogLik(const double* eps, int components, const PieceBases& B, const
 
 namespace {
 
+// Longer than 80 lines on purpose: one maximum-likelihood fit of the
+// variance components (which are active, a rough start by the median
+// chi^2, Fisher scoring with a line search) whose stages share the active
+// set, the current parameters and the pieces in use.
 NoiseParams FitPieceNoiseOnce(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
                          const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start,
                          const PieceNoiseFitOptions& options) {

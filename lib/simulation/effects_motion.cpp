@@ -154,6 +154,11 @@ bool BriefStop(const std::vector<double>& cum_left, const std::vector<double>& c
 
 }  // namespace
 
+// Longer than 80 lines on purpose: one scan over the encoder intervals in
+// which a motion's end (a lasting reversal of either wheel, or a still
+// stretch it cannot move through) depends on the directions and the last
+// moving interval found so far; the tests of a gap and a brief stop are
+// helpers above.
 std::vector<MotionSegment> SegmentMotions(const std::vector<double>& cum_left, const std::vector<double>& cum_right,
                                           double wheelbase_m, const MotionOptions& options) {
   if (auto e = options.Check(); !e.empty()) throw InvalidOptions("MotionOptions: " + e);
