@@ -80,9 +80,13 @@ std::string UnexplainedReason(const Verdict& out, const Candidate* best, const s
   return reason;
 }
 
-/// The candidates' order, best first (`qualifies`: Decide's rule).
+/// The candidates' order, best first (`qualifies`: Decide's rule);
+/// `promoted`: a start/stop mechanism was moved above a qualifying noise
+/// effect without qualifying alone (VerdictOptions::mechanism_shrink).
 template <typename Qualifies>
-std::vector<std::size_t> Rank(const CandidateFits& fits, const Qualifies& qualifies) {
+std::vector<std::size_t> Rank(const CandidateFits& fits, const Qualifies& qualifies, double mechanism_shrink,
+                              bool& promoted) {
+  promoted = false;
   std::vector<std::size_t> rank(fits.candidates.size());
   for (std::size_t i = 0; i < rank.size(); ++i) rank[i] = i;
   // Usable (identifiable; a clock supported by the moving samples; a noise
@@ -111,22 +115,32 @@ std::vector<std::size_t> Rank(const CandidateFits& fits, const Qualifies& qualif
   };
   auto promote_first = [&](auto&& which) {
     for (std::size_t k = 1; k < rank.size(); ++k)
-      if (qualifies(fits.candidates[rank[k]]) && which(fits.candidates[rank[k]])) {
+      if (which(fits.candidates[rank[k]])) {
         std::rotate(rank.begin(), rank.begin() + static_cast<std::ptrdiff_t>(k),
                     rank.begin() + static_cast<std::ptrdiff_t>(k) + 1);
-        return;
+        return true;
       }
+    return false;
   };
-  if (!rank.empty() && qualifies(fits.candidates[rank.front()]) && pure_noise(fits.candidates[rank.front()]))
-    promote_first(start_stop);
+  // The mechanism qualifies, or closes at least mechanism_shrink held out
+  // alone with positive evidence (the noise effect then takes the scatter
+  // left); the best such by evidence (rank's order).
+  if (!rank.empty() && qualifies(fits.candidates[rank.front()]) && pure_noise(fits.candidates[rank.front()])) {
+    if (!promote_first([&](const Candidate& cd) { return qualifies(cd) && start_stop(cd); }))
+      promoted = promote_first([&](const Candidate& cd) {
+        return start_stop(cd) && usable(cd) && cd.evidence > 0.0 && cd.heldout_shrink >= mechanism_shrink;
+      });
+  }
   // A slide on top yields to a qualifying clock the moving samples support:
   // the slide cannot explain those samples, the clock explains the stops
   // too.
-  if (!rank.empty() && fits.candidates[rank.front()].effect == sim::EffectKind::kStopSlide)
-    promote_first([](const Candidate& cd) {
-      return (cd.effect == sim::EffectKind::kTimeOffset || cd.effect == sim::EffectKind::kRunTimeOffset) &&
-             cd.clock.checked && cd.clock.supported;
-    });
+  if (!rank.empty() && fits.candidates[rank.front()].effect == sim::EffectKind::kStopSlide &&
+      promote_first([&](const Candidate& cd) {
+        return qualifies(cd) &&
+               (cd.effect == sim::EffectKind::kTimeOffset || cd.effect == sim::EffectKind::kRunTimeOffset) &&
+               cd.clock.checked && cd.clock.supported;
+      }))
+    promoted = false;
   return rank;
 }
 
@@ -156,8 +170,9 @@ void Decide(const CandidateFits& fits, double score_p_value, double null_quantil
            out.tests * cd.lr_p_value < route_alpha &&
            cd.evidence > 0.0 && cd.gap_after <= null_quantile_alpha;
   };
-  std::vector<std::size_t> rank = Rank(fits, qualifies);
-  if (out.significant && !rank.empty() && !qualifies(fits.candidates[rank.front()])) {
+  bool promoted = false;
+  std::vector<std::size_t> rank = Rank(fits, qualifies, options.mechanism_shrink, promoted);
+  if (out.significant && !rank.empty() && !qualifies(fits.candidates[rank.front()]) && !promoted) {
     // No candidate closes the gap G measures: the likelihood-ratio route.
     std::size_t best = rank.size();
     for (std::size_t k = 0; k < rank.size(); ++k)
@@ -177,11 +192,16 @@ void Decide(const CandidateFits& fits, double score_p_value, double null_quantil
     out.reason = fmt::format("the gap is not significant ({} >= alpha = {})", p_text, options.alpha);
   } else {
     const Candidate* best = out.candidates.empty() || !out.candidates.front().identifiable ? nullptr : &out.candidates.front();
-    if (best && qualifies(*best)) {
+    if (best && (qualifies(*best) || promoted)) {
       out.verdict = sim::EffectToString(best->effect);
       out.reason = fmt::format(
           "{} closes {:.0f}% of the gap on held-out runs (held-out log-likelihood +{:.1f} nats over the baseline)",
           out.verdict, 100.0 * best->heldout_shrink, best->heldout_loglik_gain);
+      if (promoted && out.candidates.size() > 1)
+        out.reason += fmt::format("; a mechanism at the starts and stops of motions, ranked before {} (which closes "
+                                  "{:.0f}% as scatter, without the turn's or the drive's sign)",
+                                  sim::EffectToString(out.candidates[1].effect),
+                                  100.0 * out.candidates[1].heldout_shrink);
     } else if (best && found_alone(*best)) {
       out.verdict = sim::EffectToString(best->effect);
       out.reason = fmt::format(

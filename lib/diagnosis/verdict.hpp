@@ -42,6 +42,12 @@ struct VerdictOptions {
   /// floor (explanation.hpp PracticalFloor) is no evidence of a gap that
   /// matters. Default 0.25.
   double negligible = 0.25;
+  /// A mechanism at the starts and stops of motions (castor_kick,
+  /// castor_swivel, stop_slide) that closes at least this fraction of the
+  /// held-out gap alone outranks a qualifying noise effect even when it
+  /// leaves scatter behind (kicks that vary from start to start: the noise
+  /// effect beside it takes the scatter). Default 0.8.
+  double mechanism_shrink = 0.8;
 };
 
 struct Verdict {
