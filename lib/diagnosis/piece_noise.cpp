@@ -228,13 +228,12 @@ double PieceLogLik(const double* eps, int components, const PieceBases& B, const
 
 namespace {
 
-// Longer than 80 lines on purpose: one maximum-likelihood fit of the
-// variance components (which are active, a rough start by the median
-// chi^2, Fisher scoring with a line search) whose stages share the active
-// set, the current parameters and the pieces in use.
-NoiseParams FitPieceNoiseOnce(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
-                         const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start,
-                         const PieceNoiseFitOptions& options) {
+/// The variance components FitPieceNoiseOnce estimates (slots of
+/// NoiseParams, see Slot), with those it does not fit set to 0 in `n`. A
+/// component no used piece shows (no standstill in these runs, say) cannot
+/// be estimated: it stays at 0.
+std::vector<int> ActiveComponents(const std::vector<PieceBases>& bases, const std::vector<Piece>& pieces,
+                                  const std::vector<char>& use, const PieceNoiseFitOptions& options, NoiseParams& n) {
   std::vector<int> active;
   if (options.fit_wheel_noise) active = {0, 1};
   if (options.correlated) active.push_back(2);
@@ -248,14 +247,11 @@ NoiseParams FitPieceNoiseOnce(const std::vector<double>& eps, const std::vector<
     active.push_back(7);
   }
   if (options.run_time) active.push_back(8);
-  NoiseParams n = start;
   n.bump_rate = n.bump_s2 = 0.0;
   if (!options.correlated) n.c_LR = 0.0;
   if (!options.motion_floor) n.floor_s2 = 0.0;
   if (!options.standstill) n.stand_xy2 = n.stand_th2 = 0.0;
   if (!options.run_time) n.run_tau2 = 0.0;
-  // A component no used piece shows (no standstill in these runs, say)
-  // cannot be estimated: it stays at 0.
   std::erase_if(active, [&](int m) {
     if (m < 5) return false;
     for (std::size_t j = 0; j < pieces.size(); ++j)
@@ -263,13 +259,15 @@ NoiseParams FitPieceNoiseOnce(const std::vector<double>& eps, const std::vector<
     Slot(n, m) = 0.0;
     return true;
   });
-  const int p = static_cast<int>(active.size());
-  Clamp(n, options);
-  if (p == 0) return n;  // everything given
+  return active;
+}
 
-  // Rough start: scale the fitted variances so the median chi^2 per piece
-  // matches its expectation (median, so that pieces the mean model misses
-  // do not set the scale).
+/// Rough start: scales the active variances of `n` so that the median
+/// chi^2 per piece matches its expectation (median, so that pieces the mean
+/// model misses do not set the scale). False when no piece is in use.
+bool RoughStart(const std::vector<double>& eps, const std::vector<PieceBases>& bases, const std::vector<Piece>& pieces,
+                const std::vector<char>& use, const std::vector<int>& active, const PieceNoiseFitOptions& options,
+                NoiseParams& n) {
   for (int pass = 0; pass < 4; ++pass) {
     std::vector<double> ratio;
     for (std::size_t j = 0; j < pieces.size(); ++j) {
@@ -286,13 +284,27 @@ NoiseParams FitPieceNoiseOnce(const std::vector<double>& eps, const std::vector<
       }
       ratio.push_back(m / (d == 3 ? 2.366 : 1.386));  // median of chi^2_d
     }
-    if (ratio.empty()) return n;
+    if (ratio.empty()) return false;
     std::nth_element(ratio.begin(), ratio.begin() + static_cast<std::ptrdiff_t>(ratio.size() / 2), ratio.end());
     const double f = std::clamp(ratio[ratio.size() / 2], 1e-4, 1e4);
     if (std::abs(f - 1.0) < 0.3) break;
     for (int m : active) Slot(n, m) *= f;
     Clamp(n, options);
   }
+  return true;
+}
+
+/// One maximum-likelihood fit of the variance components: which are active,
+/// a rough start, then Fisher scoring (with a line search when asked).
+NoiseParams FitPieceNoiseOnce(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
+                         const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start,
+                         const PieceNoiseFitOptions& options) {
+  NoiseParams n = start;
+  const std::vector<int> active = ActiveComponents(bases, pieces, use, options, n);
+  const int p = static_cast<int>(active.size());
+  Clamp(n, options);
+  if (p == 0) return n;  // everything given
+  if (!RoughStart(eps, bases, pieces, use, active, options, n)) return n;
 
   double ll = options.line_search ? Objective(eps, bases, pieces, use, n) : 0.0;
   for (int it = 0; it < options.max_iterations; ++it) {

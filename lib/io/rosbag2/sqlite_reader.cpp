@@ -27,6 +27,31 @@ std::string Text(sqlite3_stmt* s, int col) {
   return t ? reinterpret_cast<const char*>(t) : "";
 }
 
+/// The SQLite URI that opens `path` read-only without writing beside it.
+std::string ReadOnlyUri(const std::string& path) {
+  std::error_code ec;
+  // A database in WAL mode (file header byte 18 = 2) makes even a read-only
+  // connection create -shm/-wal files beside it. With no -wal file there is
+  // nothing beyond the main file, so it is opened immutable: nothing is
+  // written next to the input. Otherwise (rollback journal, or a live WAL)
+  // the normal read-only open with locking applies.
+  bool immutable = false;
+  {
+    std::ifstream f(path, std::ios::binary);
+    char head[100] = {};
+    if (f.read(head, sizeof(head)) && std::memcmp(head, "SQLite format 3", 16) == 0 && head[18] == 2 &&
+        !std::filesystem::exists(path + "-wal", ec))
+      immutable = true;
+  }
+  std::string uri = "file:";
+  for (char c : std::filesystem::absolute(path, ec).string()) {
+    if (c == '?' || c == '#' || c == '%') uri += fmt::format("%{:02x}", static_cast<unsigned char>(c));
+    else uri += c;
+  }
+  uri += immutable ? "?mode=ro&immutable=1" : "?mode=ro";
+  return uri;
+}
+
 }  // namespace
 
 void SqliteBagFile::Fail(const std::string& what) const { throw InputError(path_, what); }
@@ -38,25 +63,7 @@ void SqliteBagFile::Fail(const std::string& what) const { throw InputError(path_
 SqliteBagFile::SqliteBagFile(std::string path) : path_(std::move(path)) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path_, ec)) Fail("not a regular file");
-  // A database in WAL mode (file header byte 18 = 2) makes even a read-only
-  // connection create -shm/-wal files beside it. With no -wal file there is
-  // nothing beyond the main file, so it is opened immutable: nothing is
-  // written next to the input. Otherwise (rollback journal, or a live WAL)
-  // the normal read-only open with locking applies.
-  bool immutable = false;
-  {
-    std::ifstream f(path_, std::ios::binary);
-    char head[100] = {};
-    if (f.read(head, sizeof(head)) && std::memcmp(head, "SQLite format 3", 16) == 0 && head[18] == 2 &&
-        !std::filesystem::exists(path_ + "-wal", ec))
-      immutable = true;
-  }
-  std::string uri = "file:";
-  for (char c : std::filesystem::absolute(path_, ec).string()) {
-    if (c == '?' || c == '#' || c == '%') uri += fmt::format("%{:02x}", static_cast<unsigned char>(c));
-    else uri += c;
-  }
-  uri += immutable ? "?mode=ro&immutable=1" : "?mode=ro";
+  const std::string uri = ReadOnlyUri(path_);
   // A constructor that throws runs no destructor, and sqlite3_open_v2 hands
   // out a handle even when it fails: close it on every throw below.
   struct CloseOnThrow {
