@@ -13,7 +13,13 @@
 #   also diagnoses every campaign with that executable (a baseline); NICE=N
 #   sets the generators' niceness (default 10); ROBOT=B generates robot
 #   design B (bigger and heavier, front castor, 30/100 Hz motion capture;
-#   default A, the design of the committed campaigns).
+#   default A, the design of the committed campaigns); SCATTER=1 (or a
+#   wheel-ground noise k in m^1/2) generates with a real robot's scatter
+#   (contact noise, random start pose and castor angle per run; the expected
+#   verdict is then the causes measured in the engine); CASES="cls:seed ..."
+#   lists the campaigns instead of N per class (a class may be two joined by
+#   '+': two causes at once). Besides right/wrong, each row says which named
+#   effects are no expected cause ("invents").
 # Needs /usr/bin/python3 with dartpy and numpy (apt-get install python3-dartpy).
 set -euo pipefail
 
@@ -32,18 +38,27 @@ BEFORE=${BEFORE:-}
 CLASSES=${CLASSES:-"clean stop_slide swivel_castor offset_castor floor_strips turn_scrub marker_offset clock_fixed clock_per_run eccentric_hubs"}
 OUT=${KEEP:-$(mktemp -d "${TMPDIR:-/tmp}/umbmark-dart.XXXXXX")}
 mkdir -p "$OUT"
-echo "DART validation: robot ${ROBOT:-A}, $N campaigns per class from seed $SEED${QUICK:+ (quick)}; campaigns in $OUT"
+echo "DART validation: robot ${ROBOT:-A}, ${CASES:+the listed cases}${CASES:-$N campaigns per class from seed $SEED}${QUICK:+ (quick)}${SCATTER:+, with a real robot scatter}; campaigns in $OUT"
 
 # Generate (JOBS at a time; a full campaign takes 20-60 s of one core).
 start=$(date +%s)
 cases=()
-for cls in $CLASSES; do
-  for ((i = 0; i < N; ++i)); do cases+=("$cls $((SEED + i))"); done
-done
+if [[ -n "${CASES:-}" ]]; then
+  for c in $CASES; do cases+=("${c%%:*} ${c##*:}"); done
+  CLASSES=$(for c in $CASES; do echo "${c%%:*}"; done | awk '!seen[$0]++' | tr '\n' ' ')
+else
+  for cls in $CLASSES; do
+    for ((i = 0; i < N; ++i)); do cases+=("$cls $((SEED + i))"); done
+  done
+fi
+scatter=()
+if [[ -n "${SCATTER:-}" ]]; then
+  if [[ "$SCATTER" == 1 ]]; then scatter=(--scatter); else scatter=(--scatter "$SCATTER"); fi
+fi
 generate() {  # CLASS SEED
   local dir="$OUT/$1-$2"
   [[ -f "$dir/truth.md" ]] && return 0
-  nice -n "${NICE:-10}" "$PY" "$GEN" "$1" "$2" "$dir" ${QUICK:+--quick} --robot "${ROBOT:-A}" >"$dir.log" 2>&1 ||
+  nice -n "${NICE:-10}" "$PY" "$GEN" "$1" "$2" "$dir" ${QUICK:+--quick} --robot "${ROBOT:-A}" "${scatter[@]}" >"$dir.log" 2>&1 ||
     { echo "generator failed: $1 $2 (see $dir.log)" >&2; return 1; }
 }
 failed=0
@@ -62,9 +77,9 @@ v = json.load(sys.stdin)["verdict"]
 print(v["effect"], "+".join(v.get("effects", [])) or "-")'
 }
 
-printf '\n%-15s %6s %-16s %-16s %-40s %s\n' class seed expected verdict effects "${BEFORE:+before}"
+printf '\n%-28s %6s %-28s %-16s %-44s %s\n' class seed expected verdict effects "${BEFORE:+before}"
 declare -A right total
-all_right=0; all=0
+all_right=0; all=0; inventing=0
 for c in "${cases[@]}"; do
   read -r cls seed <<<"$c"
   dir="$OUT/$cls-$seed"
@@ -78,11 +93,16 @@ for c in "${cases[@]}"; do
   elif [[ "$got" == "$expected" ]]; then ok=1; fi
   right[$cls]=$(( ${right[$cls]:-0} + ok )); total[$cls]=$(( ${total[$cls]:-0} + 1 ))
   all_right=$(( all_right + ok )); all=$(( all + 1 ))
-  printf '%-15s %6s %-16s %-16s %-40s %s %s\n' "$cls" "$seed" "$expected" "$got" "$effects" "$before" \
-    "$([[ $ok == 1 ]] && echo ok || echo WRONG)"
+  invents=""   # named effects that are no expected cause (an outside cause: any name is one)
+  for e in ${effects//+/ }; do
+    [[ "$e" == - || "+$expected+" == *"+$e+"* ]] || invents+="${invents:+,}$e"
+  done
+  [[ -n "$invents" ]] && inventing=$(( inventing + 1 ))
+  printf '%-28s %6s %-28s %-16s %-44s %s %s%s\n' "$cls" "$seed" "$expected" "$got" "$effects" "$before" \
+    "$([[ $ok == 1 ]] && echo ok || echo WRONG)" "${invents:+  invents $invents}"
 done
 echo
 echo "per class (right / campaigns):"
-for cls in $CLASSES; do printf '  %-15s %d / %d\n' "$cls" "${right[$cls]}" "${total[$cls]}"; done
-echo "total: $all_right / $all right"
+for cls in $CLASSES; do printf '  %-28s %d / %d\n' "$cls" "${right[$cls]}" "${total[$cls]}"; done
+echo "total: $all_right / $all right; $inventing / $all name an effect that is no expected cause"
 echo "measured causes: $OUT/*/truth.md"

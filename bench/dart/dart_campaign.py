@@ -23,7 +23,7 @@ Two robot designs (--robot): A, the default (wheelbase 0.26-0.36 m, 4-7 kg,
 rear castor); B, a bigger, heavier robot with a front castor and a different
 recording (see Config._robot_b).
 
-Usage: dart_campaign.py CLASS SEED OUTDIR [--quick] [--robot A|B]
+Usage: dart_campaign.py CLASS[+CLASS] SEED OUTDIR [--quick] [--robot A|B] [--scatter [K]]
 """
 import argparse
 import math
@@ -40,6 +40,7 @@ FREE_SPEED = 0.2     # m/s along the figure eights
 G = 9.81
 WHEEL_MU_SWIVEL = 0.275   # castor classes: drive-wheel grip just under the slip threshold
 WHEEL_MU_SWIVEL_B = 0.25  # ... of robot B (its threshold: see _apply_class_b)
+ROUGH_K = 0.0002          # --scatter: default wheel-ground contact noise k (m^1/2): about 2 mm of return scatter
 
 # Expected verdict per class, decided from the physics (truth.md checks it).
 CLASSES = {
@@ -151,10 +152,24 @@ class Config:
         self.castor_wheel = (0.05, 1e-5)                  # mass, inertia of the castor wheel
         self.strip_h = (0.006, 0.010)
         self.t_decimals = 2               # time stamps on the sample grid: 10 ms steps are exact
+        # A real robot's scatter (--scatter, issue 28; off: campaigns as before)
+        self.rough_k = 0.0                # wheel-ground contact noise k [m^1/2]
+        self.random_start = False         # random start pose and castor angle per run
+
+    def set_scatter(self, k):
+        """A real robot's scatter (issue 28): wheel-ground contact noise (each
+        wheel's contact slips by N(0, k^2 |travel|), Driver._roughen), and the
+        operator puts the robot down only roughly on the start mark (+-2 cm,
+        +-3 deg) with the swivel castor pointing anywhere."""
+        self.rough_k = k
+        self.random_start = k > 0.0
 
     def _apply_class(self, rng):
+        for c in self.cls.split("+"):
+            self._apply_one_class(rng, c)
+
+    def _apply_one_class(self, rng, c):
         U = rng.uniform
-        c = self.cls
         if c == "stop_slide":
             # Hard braking (wheels locked at once) on a low-friction floor; the
             # chassis coasts ~ v^2 / (2 mu_eff g) after legs and turns on after turns.
@@ -257,8 +272,11 @@ class Config:
 
     def _apply_class_b(self, rng):
         """Robot B's physical causes (tuned on B's seed 1 only)."""
+        for c in self.cls.split("+"):
+            self._apply_one_class_b(rng, c)
+
+    def _apply_one_class_b(self, rng, c):
         U = rng.uniform
-        c = self.cls
         if c == "stop_slide":
             # hard braking on a low-friction floor (the ball castor carries ~20 %)
             self.mu = U(0.60, 0.75)
@@ -359,6 +377,7 @@ class Robot:
         sn.setRelativeTransform(iso(pos))
         sn.createCollisionAspect()
         sn.createDynamicsAspect().setFrictionCoeff(mu)
+        return sn
 
     def _castor(self):
         cfg, rc, xc, drop = self.cfg, self.cfg.castor_r, self.cfg.castor_x, self.cfg.fork_drop
@@ -416,6 +435,9 @@ class Driver:
         self.prev_dir = 0        # drive direction of the last line/arc
         self.unyaw = 0.0
         self.last_yaw = None
+        # --scatter: its own random stream, so that the other draws stay as before
+        self.srng = np.random.default_rng(cfg.seed + 15485863)
+        self.run_starts = []             # (x, y, yaw, castor angle) drawn per run
         self._record()
 
     def ticks(self):
@@ -444,6 +466,34 @@ class Driver:
         self.robot.wheels[1].setCommand(0, cmd_r)
         self.robot.world.step()
         self._record()
+        if self.cfg.rough_k > 0.0:
+            self._roughen()
+
+    def _roughen(self):
+        """Wheel-ground contact noise: after each engine step each wheel's contact
+        slips along its rolling direction by N(0, k^2 |travel|), travel that
+        wheel's rolling distance in the step (Chong & Kleeman's wheel noise; the
+        encoders do not see it). The chassis is moved by the slips at
+        position level, about the axle midpoint; velocities and contacts are
+        left as they are (changing the wheels' radius instead lifts a wheel off
+        the floor whenever it shrinks, and the lost traction shortened every leg
+        by 0.2 %)."""
+        cfg = self.cfg
+        slip = [0.0, 0.0]
+        for i, r in enumerate((cfg.r_left, cfg.r_right)):
+            travel = abs(self.hist_wheel[-1][i] - self.hist_wheel[-2][i]) * r
+            if travel > 0.0:
+                slip[i] = cfg.rough_k * math.sqrt(travel) * self.srng.normal()
+        if slip == [0.0, 0.0]:
+            return
+        skel = self.robot.skel
+        q = skel.getPositions()
+        yaw = self.robot.pose()[2]
+        ds, dth = 0.5 * (slip[0] + slip[1]), (slip[1] - slip[0]) / cfg.b_true
+        q[2] += dth
+        q[3] += ds * math.cos(yaw)
+        q[4] += ds * math.sin(yaw)
+        skel.setPositions(q)
 
     def idle(self, seconds):
         for _ in range(int(round(seconds / DT))):
@@ -459,10 +509,16 @@ class Driver:
         skel = self.robot.skel
         q = skel.getPositions()
         q[0:6] = [0.0, 0.0, 0.0, 0.0, 0.0, self.robot.r_mean + 0.0003]
+        castor = 0.0                                   # castor straightened, trailing
+        if self.cfg.random_start:                      # --scatter: put down roughly, castor anywhere
+            x, y, yaw = self.srng.uniform(-0.02, 0.02), self.srng.uniform(-0.02, 0.02), self.srng.uniform(-0.05, 0.05)
+            castor = self.srng.uniform(-math.pi, math.pi)
+            q[2], q[3], q[4] = yaw, x, y
+            self.run_starts.append((x, y, yaw, castor))
         skel.setPositions(q)
         skel.setVelocities(np.zeros(skel.getNumDofs()))
         if self.robot.swivel is not None:
-            self.robot.swivel.setPosition(0, 0.0)     # castor straightened, trailing
+            self.robot.swivel.setPosition(0, castor)
         self.prev_turn, self.prev_dir = 0, 0
         self.idle(0.3)      # settles; longer than any clock offset looks back
 
@@ -532,6 +588,7 @@ class Driver:
     def _place_strips(self, dist):
         x, y, th = self.robot.pose()
         n = self.rng.poisson(0.6 * abs(dist))
+        self.n_strips = getattr(self, "n_strips", 0) + n
         sgn = 1.0 if dist >= 0 else -1.0
         b2 = self.cfg.b_true / 2
         for _ in range(n):
@@ -599,6 +656,7 @@ def run_campaign(cfg):
         run("back_and_forth", "fwd_back", drv.back_and_forth)
     for _ in range(cfg.n_free):
         run("free", "free", drv.figure_eight)
+    drv.runs = runs
     return drv, runs
 
 
@@ -664,7 +722,7 @@ def write_campaign(cfg, drv, runs, out):
             f.write("\n".join(rows[exp]) + "\n")
     with open(os.path.join(out, "campaign.toml"), "w") as f:
         f.write(f"# DART 6.12 physics campaign: class {cfg.cls}, seed {cfg.seed}{design_tag(cfg)}; "
-                f"expected verdict {CLASSES[cfg.cls]} (see truth.md)\n")
+                f"expected verdict {label(cfg.cls)} (see truth.md)\n")
         f.write("[robot]\n")
         f.write(f"wheelbase_m            = {cfg.b_nom}\n")
         f.write(f"wheel_diameter_left_m  = {cfg.d_nom}\n")
@@ -732,6 +790,80 @@ def fmt_ms(vals, unit_scale, unit, dec=2):
     return f"{v.mean():+.{dec}f}{' ' + unit if unit else ''} (sd {sd:.{dec}f}, n {len(v)})"
 
 
+def label(cls):
+    """The class's expected verdict as labelled (a pair: both effects)."""
+    return "+".join(CLASSES[c] for c in cls.split("+"))
+
+
+def t_value(v):
+    v = np.asarray(v, float)
+    if len(v) < 2:
+        return 0.0
+    se = v.std(ddof=1) / math.sqrt(len(v))
+    return v.mean() / se if se > 0 else (math.inf if v.mean() != 0 else 0.0)
+
+
+# A cause measured on the true poses counts when its mean is at least this
+# large and 4 standard errors from 0 (mm, mrad, fraction of the turn).
+MIN_SLIDE, MIN_TURN_ON, MIN_SCRUB, MIN_KICK, MIN_CLOCK_MM, MIN_MARKER = 1.0e-3, 2.0e-3, 0.005, 2.0e-3, 2.0e-3, 2.0e-3
+
+
+def measured_causes(cfg, rows, drv):
+    """The contract effects the engine actually produced, measured on its true
+    poses (slides, scrub, castor kicks) or known from the recording (marker,
+    clocks, strips placed); returns [(effect, evidence)] and the expected
+    verdict they make (an outside cause, eccentric hubs: `unexplained`)."""
+    lines = [r for r in rows if r["kind"] == "line"]
+    turns = [r for r in rows if r["kind"] == "turn"]
+    moves = [r for r in rows if r["kind"] != "turn"]
+    out = []
+    slide = [r["stop_res"][0] * r["direction"] for r in lines]
+    turn_on = [r["stop_res"][2] * r["sign"] for r in turns]
+    if (np.mean(slide) > MIN_SLIDE and t_value(slide) > 4) or (np.mean(turn_on) > MIN_TURN_ON and t_value(turn_on) > 4):
+        out.append(("stop_slide", f"slide {np.mean(slide) * 1e3:+.2f} mm, turn-on {np.mean(turn_on) * 1e3:+.2f} mrad"))
+    scrub = [-(r["whole_res"][2] * r["sign"]) / abs(r["ideal_turn"]) for r in turns]
+    if scrub and np.mean(scrub) > MIN_SCRUB and t_value(scrub) > 4:
+        out.append(("turn_scrub", f"k {np.mean(scrub):.4f}"))
+    fwd = lambda before: [r["start_res"][2] for r in moves if r["before"] == before and r["direction"] > 0]
+    ccw, cw = fwd("ccw"), fwd("cw")
+    if len(ccw) > 1 and len(cw) > 1:
+        follow = 0.5 * (np.mean(ccw) - np.mean(cw))
+        se = 0.5 * math.sqrt(np.var(ccw, ddof=1) / len(ccw) + np.var(cw, ddof=1) / len(cw))
+        if follow > MIN_KICK and follow > 4 * se:
+            out.append(("castor_swivel", f"start heading after ccw {np.mean(ccw) * 1e3:+.1f}, after cw "
+                                         f"{np.mean(cw) * 1e3:+.1f} mrad"))
+    kick = [r["start_res"][2] * r["direction"] for r in moves if r["before"] in ("none", "ccw", "cw")]
+    if len(kick) > 1 and abs(np.mean(kick)) > MIN_KICK and abs(t_value(kick)) > 4:
+        out.append(("castor_kick", f"start heading in the drive direction {np.mean(kick) * 1e3:+.1f} mrad"))
+    if getattr(drv, "n_strips", 0) > 0:
+        out.append(("bump_outliers", f"{drv.n_strips} strips under the left wheel"))
+    if math.hypot(*cfg.marker) > MIN_MARKER:
+        out.append(("gt_offset", f"marker {math.hypot(*cfg.marker) * 1e3:.1f} mm off"))
+    if abs(cfg.tau) * cfg.v > MIN_CLOCK_MM:
+        out.append(("time_offset", f"v tau {abs(cfg.tau) * cfg.v * 1e3:.1f} mm"))
+    taus = getattr(drv, "run_taus", [])
+    if len(taus) > 1 and np.std(taus, ddof=1) * cfg.v > MIN_CLOCK_MM:
+        out.append(("run_time_offset", f"v tau_sd {np.std(taus, ddof=1) * cfg.v * 1e3:.1f} mm"))
+    if cfg.ecc > 0:
+        return out, "unexplained"
+    return out, "+".join(e for e, _ in out) or "none"
+
+
+def return_scatter(drv):
+    """Run-to-run scatter of the TRUE return pose of runs of one experiment and
+    direction (in each run's start frame): mean over the groups of sqrt(var x + var y)."""
+    pose = np.asarray(drv.hist_pose)
+    groups = {}
+    for exp, direction, first, last in getattr(drv, "runs", []):
+        x0, y0, th0 = pose[first]
+        dx, dy = pose[last, 0] - x0, pose[last, 1] - y0
+        c, s = math.cos(th0), math.sin(th0)
+        groups.setdefault((exp, direction), []).append((c * dx + s * dy, -s * dx + c * dy))
+    sds = [math.sqrt(np.var([p[0] for p in g], ddof=1) + np.var([p[1] for p in g], ddof=1))
+           for g in groups.values() if len(g) > 1]
+    return float(np.mean(sds)) if sds else 0.0
+
+
 def write_truth(cfg, rows, out, drv):
     with open(os.path.join(out, "truth.csv"), "w") as f:
         f.write("# per motion: TRUE pose change minus ideal rolling from the true wheel angles "
@@ -753,7 +885,19 @@ def write_truth(cfg, rows, out, drv):
     per_m = [r["steady_res"][0] * r["direction"] / max(r["travel"], 1e-9) for r in lines]
     L = []
     L.append(f"# Measured cause: class `{cfg.cls}`, seed {cfg.seed}{design_tag(cfg)}\n")
-    L.append(f"Expected verdict: **{CLASSES[cfg.cls]}**\n")
+    if cfg.rough_k > 0 or "+" in cfg.cls:
+        # with a real robot's scatter or two causes: the answer the engine's causes make
+        causes, expected = measured_causes(cfg, rows, drv)
+        L.append(f"Expected verdict: **{expected}**\n")
+        L.append(f"Class label: {label(cfg.cls)}; causes measured in the engine: "
+                 + ("; ".join(f"{e} ({ev})" for e, ev in causes) or "none") + ".\n")
+        L.append(f"Scatter: wheel-ground contact noise k {cfg.rough_k:.5f} m^1/2; true return scatter {return_scatter(drv) * 1e3:.2f} mm "
+                 "(runs of one experiment and direction); start pose and castor angle per run: "
+                 + ", ".join(f"({x * 1e3:+.0f} mm, {y * 1e3:+.0f} mm, {yaw * 1e3:+.0f} mrad, castor {c:+.2f} rad)"
+                             for x, y, yaw, c in drv.run_starts[:4]) + (" ..." if len(drv.run_starts) > 4 else "")
+                 + ".\n")
+    else:
+        L.append(f"Expected verdict: **{CLASSES[cfg.cls]}**\n")
     L.append("Robot (true vs nominal): wheelbase "
              f"{cfg.b_true:.4f} m vs {cfg.b_nom} (E_b {cfg.eb:.4f}); wheel diameters "
              f"{2 * cfg.r_left:.5f} / {2 * cfg.r_right:.5f} m vs {cfg.d_nom} "
@@ -799,7 +943,7 @@ def write_truth(cfg, rows, out, drv):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("cls", choices=sorted(CLASSES))
+    ap.add_argument("cls", help="a class (" + ", ".join(CLASSES) + ") or two joined by '+' (two causes at once)")
     ap.add_argument("seed", type=int)
     ap.add_argument("out")
     ap.add_argument("--quick", action="store_true", help="half-size campaign (for the committed tests)")
@@ -810,8 +954,16 @@ def main():
     ap.add_argument("--robot", choices=("A", "B"), default="A",
                     help="robot design: A (default; the committed campaigns) or B (bigger, heavier, "
                          "front castor, recorded at 30 or 100 Hz)")
+    ap.add_argument("--scatter", nargs="?", type=float, const=ROUGH_K, default=0.0, metavar="K",
+                    help=f"a real robot's scatter: wheel-ground contact noise K m^1/2 (default "
+                         f"{ROUGH_K}), random start pose and castor angle per run; the expected verdict is "
+                         "then decided from the causes measured in the engine")
     a = ap.parse_args()
+    for c in a.cls.split("+"):
+        if c not in CLASSES:
+            raise SystemExit(f"unknown class {c}; one of {', '.join(CLASSES)}")
     cfg = Config(a.cls, a.seed, a.quick, a.robot)
+    cfg.set_scatter(a.scatter)
     if a.rate is not None:
         cfg.rate = a.rate
     for kv in a.set:
