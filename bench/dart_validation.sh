@@ -38,7 +38,9 @@ BEFORE=${BEFORE:-}
 CLASSES=${CLASSES:-"clean stop_slide swivel_castor offset_castor floor_strips turn_scrub marker_offset clock_fixed clock_per_run eccentric_hubs"}
 OUT=${KEEP:-$(mktemp -d "${TMPDIR:-/tmp}/umbmark-dart.XXXXXX")}
 mkdir -p "$OUT"
-echo "DART validation: robot ${ROBOT:-A}, ${CASES:+the listed cases}${CASES:-$N campaigns per class from seed $SEED}${QUICK:+ (quick)}${SCATTER:+, with a real robot scatter}; campaigns in $OUT"
+what="$N campaigns per class from seed $SEED"
+[[ -n "${CASES:-}" ]] && what="the listed cases"
+echo "DART validation: robot ${ROBOT:-A}, $what${QUICK:+ (quick)}${SCATTER:+, with a real robot scatter}; campaigns in $OUT"
 
 # Generate (JOBS at a time; a full campaign takes 20-60 s of one core).
 start=$(date +%s)
