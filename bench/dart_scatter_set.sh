@@ -8,6 +8,9 @@
 # expected verdict of each campaign is decided from the causes measured in
 # the engine (truth.md), not from its class label.
 #
+# ROBOT=B generates the same set for robot B (the second design) on seeds
+# 9301-9316.
+#
 # Usage: bench/dart_scatter_set.sh [BUILD_DIR] [KEEP_DIR] [JOBS]
 #   (about 10-15 minutes on 2 cores; KEEP_DIR keeps the campaigns, and a
 #   second call with the same KEEP_DIR only diagnoses them again)
@@ -16,9 +19,14 @@ BUILD=${1:-build}
 KEEP=${2:-$(mktemp -d "${TMPDIR:-/tmp}/umbmark-dart-scatter.XXXXXX")}
 JOBS=${3:-2}
 HERE=$(cd "$(dirname "$0")" && pwd)
-CASES="clean:9201 clean:9202
-stop_slide:9203 swivel_castor:9204 floor_strips:9205 turn_scrub:9206
-marker_offset:9207 clock_fixed:9208 clock_per_run:9209 eccentric_hubs:9210
-marker_offset+stop_slide:9211 clock_fixed+turn_scrub:9212 swivel_castor+marker_offset:9213
-floor_strips+clock_per_run:9214 stop_slide+clock_fixed:9215 turn_scrub+marker_offset:9216"
-CASES=$(echo $CASES) SCATTER=1 KEEP="$KEEP" bash "$HERE/dart_validation.sh" "$BUILD" 1 9201 "$JOBS"
+# robot A: seeds 9201-9216; ROBOT=B (the second design): seeds 9301-9316
+base=$([[ "${ROBOT:-A}" == B ]] && echo 9300 || echo 9200)
+CASES=""
+i=0
+for cls in clean clean stop_slide swivel_castor floor_strips turn_scrub marker_offset clock_fixed clock_per_run \
+  eccentric_hubs marker_offset+stop_slide clock_fixed+turn_scrub swivel_castor+marker_offset \
+  floor_strips+clock_per_run stop_slide+clock_fixed turn_scrub+marker_offset; do
+  i=$((i + 1))
+  CASES+="$cls:$((base + i)) "
+done
+CASES="$CASES" SCATTER=1 KEEP="$KEEP" ROBOT="${ROBOT:-A}" bash "$HERE/dart_validation.sh" "$BUILD" 1 "$((base + 1))" "$JOBS"
