@@ -25,9 +25,11 @@
 # Usage: bench/injection_recovery.sh [BUILD_DIR] [OUT_DIR] [SET] [JOBS]
 #   SET: tuning (default), heldout, all, or session names ("s1 s2").
 #   INJECTIONS="time_offset_p80 ..." restricts the injections (names below).
-#   UMBMARK=/path/umbmark diagnoses with another executable (a before/after).
+#   UMBMARK=/path/umbmark diagnoses with another executable (a before/after:
+#   give each executable its own OUT_DIR; OUT/import may be copied over).
 # Prints one row per injection and the totals; OUT_DIR keeps every manifest,
-# injected CSV, diagnosis JSON and score (scores.json, table.md).
+# injected CSV, diagnosis JSON and score (scores.json, table.md). A second
+# call with the same OUT_DIR diagnoses only what has no diagnosis.json yet.
 set -euo pipefail
 
 BUILD=${1:-build}
