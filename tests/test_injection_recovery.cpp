@@ -139,6 +139,23 @@ TEST_CASE("injection into real runs follows the contract's definitions", "[injec
     CHECK(shift / moving > 0.004);
     CHECK(miss < 0.2 * shift);
   }
+  SECTION("castor_kick: the heading jumps by kappa at every start of a leg, and nowhere else") {
+    auto tab = recorded;
+    InjectOptions o;
+    o.effects = {ParseEffect("castor_kick:kappa=0.01")};
+    const auto sum = umbmark_bench::InjectTable(tab, o);
+    int jumps = 0;
+    double off = 0.0;  // largest change of the heading difference that is no kick
+    for (std::size_t i = 1; i < n; ++i) {
+      if (recorded.rows[i][recorded.run] != recorded.rows[i - 1][recorded.run]) continue;
+      const double step = (pose(tab, i).th - pose(recorded, i).th) - (pose(tab, i - 1).th - pose(recorded, i - 1).th);
+      if (std::abs(step - 0.01) < 1e-6) ++jumps;
+      else off = std::max(off, std::abs(step));
+    }
+    CHECK(jumps == sum.starts_kicked);
+    CHECK(jumps >= 24);  // six squares of four legs (and a few one-wheel starts of a few mm)
+    CHECK(off < 1e-6);
+  }
   SECTION("scale_error and turn_scrub: legs longer by s, spot turns short by k of the wheels' travel") {
     umbmark_bench::RecordedRun run;  // run 1 of the squares
     for (std::size_t i = 0; i < n && recorded.rows[i][recorded.run] == recorded.rows[0][recorded.run]; ++i) {
