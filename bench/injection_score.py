@@ -178,6 +178,17 @@ def summary_line(label, t):
             f"{t['size_ok']}/{t['sized']}, none {t['none']}/{t['n']}, inventions {t['invents']}/{t['n']}")
 
 
+def agreement(bases):
+    """The issue's check on the sessions without injection: how many lead
+    with the same named effect (the first of verdict.effects)."""
+    firsts = [r["effects"][0] if r["effects"] else r["verdict"] for r in bases]
+    if not firsts:
+        return ""
+    common = max(set(firsts), key=firsts.count)
+    return (f"first named effect without injection: {', '.join(firsts)}; "
+            f"{firsts.count(common)} of {len(firsts)} agree ({common})")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("out")
@@ -193,7 +204,8 @@ def main():
              summary_line("the issue's ten injections", core),
              summary_line("the other contract effects", other),
              "sessions without injection: " + "; ".join(f"{r['session']} {r['verdict']} ({', '.join(r['effects'])})"
-                                                       for r in bases)]
+                                                       for r in bases),
+             agreement(bases)]
     text = "\n".join(lines)
     with open(os.path.join(a.out, "table.md"), "w") as f:
         f.write(text + "\n")
