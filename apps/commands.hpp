@@ -25,5 +25,6 @@ Command SetupDiagnose(CLI::App& parent);
 Command SetupPredict(CLI::App& parent);
 Command SetupFitNoise(CLI::App& parent);
 Command SetupSummarize(CLI::App& parent);
+Command SetupCalibrateLidar(CLI::App& parent);
 
 }  // namespace umbmark::cli

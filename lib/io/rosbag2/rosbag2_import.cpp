@@ -771,6 +771,7 @@ Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotPar
     const std::string& wheel_topic = bag.topics()[choice.wheels].name;
     RecordingSummary rs{path, d.wheels.size(), d.gt.size(), 0, 0, d.left_joint, d.right_joint,
                         static_cast<double>(d.wheels.back().t_ns - d.wheels.front().t_ns) * 1e-9};
+    rs.first_stamp_ns = d.wheels.front().t_ns;
     const auto spans = SplitRuns(d.wheels, o.pause_s);
     if (spans.empty())
       throw InputError(path, fmt::format("the wheels never move on {} ({} samples): no run to import", wheel_topic,

@@ -59,6 +59,7 @@ struct RecordingSummary {
   std::size_t runs_dropped = 0;  ///< runs with a gap in the wheel topic (see warnings)
   std::string left_joint, right_joint;  ///< the joints used (JointState)
   double duration_s = 0.0;
+  std::int64_t first_stamp_ns = 0;  ///< the first wheel sample's stamp (the runs' t_s count from it)
 };
 
 struct Rosbag2Import {

@@ -1,0 +1,96 @@
+// Keyframe registration of a drive's scans (see lidar_pairs.hpp).
+#include "calibration/lidar_pairs.hpp"
+
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include <Eigen/Dense>
+#include <fmt/format.h>
+
+#include "core/angles.hpp"
+#include "core/errors.hpp"
+
+namespace umbmark::calibration {
+
+namespace {
+
+// Angle of the least determined position direction of a registration's
+// covariance (in its own frame).
+double OpenDirection(const std::array<double, 9>& cov) {
+  Eigen::Matrix2d p;
+  p << cov[0], cov[1], cov[3], cov[4];
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(p);
+  const Eigen::Vector2d v = es.eigenvectors().col(1);  // largest eigenvalue last
+  return std::atan2(v.y(), v.x());
+}
+
+}  // namespace
+
+std::string PairOptions::Validate() const {
+  if (!(keyframe_distance_m > 0.0)) return fmt::format("keyframe_distance_m = {}: must be > 0", keyframe_distance_m);
+  if (!(keyframe_angle_rad > 0.0)) return fmt::format("keyframe_angle_rad = {}: must be > 0", keyframe_angle_rad);
+  if (!(keyframe_max_s > 0.0)) return fmt::format("keyframe_max_s = {}: must be > 0", keyframe_max_s);
+  if (!(min_paired_fraction >= 0.0 && min_paired_fraction <= 1.0))
+    return fmt::format("min_paired_fraction = {}: must be in [0, 1]", min_paired_fraction);
+  if (!(max_dilution > 0.0)) return fmt::format("max_dilution = {}: must be > 0", max_dilution);
+  if (min_points < 3) return fmt::format("min_points = {}: must be >= 3", min_points);
+  return match.Validate();
+}
+
+PairResult RegisterScanPairs(const std::vector<scan::LaserScan>& scans, const PairOptions& o) {
+  if (const std::string err = o.Validate(); !err.empty()) throw InvalidOptions(err);
+  PairResult out;
+  std::unique_ptr<scan::ScanModel> model;
+  std::size_t kf = 0;
+  Pose2 lidar0_T_kf, kf_T_prev, velocity;  // velocity: prev_T_cur of the last step
+  for (std::size_t j = 0; j < scans.size(); ++j) {
+    const scan::LaserScan& s = scans[j];
+    ++out.scans;
+    // Scan j becomes the keyframe; the velocity is kept unless tracking was lost.
+    auto restart = [&](bool keep_velocity) {
+      model = std::make_unique<scan::ScanModel>(s);
+      if (model->usable() < o.min_points) model.reset();
+      kf = j;
+      kf_T_prev = {};
+      if (!keep_velocity) velocity = {};
+    };
+    if (!model) {
+      restart(false);
+      continue;
+    }
+    const std::vector<scan::Point2> points = scan::ScanPoints(s);
+    const scan::MatchResult m = scan::MatchScan(*model, points, Compose(kf_T_prev, velocity), o.match);
+    if (m.pairs < o.min_points) {
+      ++out.lost;
+      lidar0_T_kf = Compose(lidar0_T_kf, Compose(kf_T_prev, velocity));  // dead reckoning over the gap
+      restart(false);
+      continue;
+    }
+    velocity = Compose(Inverse(kf_T_prev), m.pose);
+    kf_T_prev = m.pose;
+    const double dt = static_cast<double>(s.t_ns - scans[kf].t_ns) * 1e-9;
+    const bool next = std::hypot(m.pose.x, m.pose.y) >= o.keyframe_distance_m ||
+                      std::abs(m.pose.theta) >= o.keyframe_angle_rad || dt >= o.keyframe_max_s ||
+                      m.PairedFraction() < o.min_paired_fraction;
+    if (!next) continue;
+    ScanPair p;
+    p.t_a_ns = scans[kf].t_ns;
+    p.t_b_ns = s.t_ns;
+    p.lidar_a_T_lidar_b = m.pose;
+    p.covariance = m.Covariance();
+    p.pairs = m.pairs;
+    p.lidar0_T_lidar_a = lidar0_T_kf;
+    p.undetermined = scan::UndeterminedDirections(m.information, m.pairs, 0.0, o.max_dilution);
+    p.open_direction_rad = std::numeric_limits<double>::quiet_NaN();
+    if (!p.undetermined.empty() && p.undetermined.front() != "heading")
+      p.open_direction_rad = WrapAngle(lidar0_T_kf.theta + OpenDirection(p.covariance));
+    out.pairs.push_back(std::move(p));
+    lidar0_T_kf = Compose(lidar0_T_kf, m.pose);
+    restart(true);
+  }
+  out.lidar0_T_lidar_last = Compose(lidar0_T_kf, kf_T_prev);
+  return out;
+}
+
+}  // namespace umbmark::calibration

@@ -1,0 +1,134 @@
+// `umbmark calibrate-lidar` end to end on recordings written by independent
+// writers (tests/data/rosbag2/lidar/, generator/drive_gen.mjs: MCAP by
+// @mcap/core, CDR by @foxglove/rosmsg2-serialization; a robot with known
+// wheels, lidar mount and scan clock drives 100 s of ordinary teleop motion
+// in a ray-cast room; the truth is in lidar/README-truth.json), and bad input.
+#include <catch2/catch.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "support/run_cli.hpp"
+
+using umbmark::testing::Q;
+using umbmark::testing::RunCli;
+using umbmark::testing::Slurp;
+using umbmark::testing::TempDir;
+using Catch::Matchers::Contains;
+
+namespace {
+
+const std::filesystem::path kLidar = std::filesystem::path(UMBMARK_SOURCE_DIR) / "tests/data/rosbag2/lidar";
+
+// The truth lies within the reported 95 % interval widened to 99.9 % (a
+// factor 3.29 / 1.96), and within an absolute bound from the issue's
+// targets for a 5-minute drive, relaxed for this 100 s one.
+void CheckWithin(const nlohmann::json& j, const char* key, double truth, double bound) {
+  INFO(key);
+  const double v = j.at(key).get<double>();
+  CHECK(std::abs(v - truth) <= bound);
+}
+
+void CheckInterval(const nlohmann::json& ci, double value, double truth) {
+  const double lo = ci.at(0).get<double>(), hi = ci.at(1).get<double>();
+  CHECK(lo <= value);
+  CHECK(value <= hi);
+  const double half = 0.5 * (hi - lo) * 3.29 / 1.96;
+  CHECK(std::abs(truth - value) <= half);
+}
+
+}  // namespace
+
+TEST_CASE("calibrate-lidar: an upside-down lidar, a late scan clock and a gyro from a bag") {
+  const auto dir = TempDir("calibrate-lidar");
+  const auto r = RunCli("calibrate-lidar " + Q(kLidar / "drive_upside.mcap") + " --scan /scan --wheels /joint_states --imu /imu --robot " +
+                        Q(kLidar / "robot.toml") + " --json " + Q(dir / "out.json") + " --ros2 " + Q(dir / "diff_drive.yaml"));
+  INFO(r.out << r.err);
+  REQUIRE(r.status == 0);
+  const auto truth = nlohmann::json::parse(Slurp((kLidar / "README-truth.json").string()))["drive_upside.mcap"];
+  const auto j = nlohmann::json::parse(Slurp((dir / "out.json").string()));
+  const auto& p = j["parameters"];
+  CheckWithin(p, "wheelbase_m", truth["wheelbase_m"], 0.005 * 0.2856);
+  CheckWithin(p, "wheel_diameter_left_m", truth["wheel_diameter_left_m"], 0.003 * 0.066);
+  CheckWithin(p, "wheel_diameter_right_m", truth["wheel_diameter_right_m"], 0.003 * 0.066);
+  const auto& m = j["lidar_mount"];
+  CHECK(m["upside_down"] == true);
+  CheckWithin(m, "x_m", truth["mount"][0], 0.01);
+  CheckWithin(m, "y_m", truth["mount"][1], 0.01);
+  CheckWithin(m, "yaw_rad", truth["mount"][2], 0.005);
+  CheckInterval(m["x_m_ci95"], m["x_m"], truth["mount"][0]);
+  CheckInterval(m["y_m_ci95"], m["y_m"], truth["mount"][1]);
+  CheckInterval(m["yaw_rad_ci95"], m["yaw_rad"], truth["mount"][2]);
+  CheckWithin(j, "scan_time_offset_s", truth["scan_time_offset_s"], 0.01);
+  CheckInterval(j["scan_time_offset_s_ci95"], j["scan_time_offset_s"], truth["scan_time_offset_s"]);
+  CheckWithin(j, "gyro_scale", truth["gyro_scale"], 0.006);
+  CheckWithin(j, "gyro_bias_rad_s", truth["gyro_bias_rad_s"], 1e-3);
+  CHECK(j["scale_source"] == "lidar_ranges");
+  REQUIRE(j["covariance"].size() == 9);
+  CHECK(j["covariance"][0].size() == 9);
+  for (const char* k : {"wheelbase_m", "wheel_diameter_left_m", "wheel_diameter_right_m", "lidar_mount", "scan_time_offset_s", "gyro_scale"})
+    CHECK(j["excitation"].contains(k));
+  // /tf_static composed in 3-D (base_footprint -> base_link -> laser, roll pi): upside down, yaw 0.5 + 3 deg.
+  CHECK(m["tf_static"]["upside_down"] == true);
+  CHECK(m["tf_static"]["yaw_rad"].get<double>() == Approx(0.5 + 3 * M_PI / 180).margin(1e-9));
+  CHECK(m["tf_static"]["x_m"].get<double>() == Approx(0.10).margin(1e-9));
+  // /tf_static has the yaw 3 deg off: named.
+  CHECK_THAT(r.err, Contains("/tf_static's mount of the lidar") && Contains("yaw differs by"));
+  // The --ros2 file: multipliers and the mount as a URDF origin with roll pi.
+  const std::string yaml = Slurp((dir / "diff_drive.yaml").string());
+  CHECK_THAT(yaml, Contains("wheel_separation_multiplier:") && Contains("left_wheel_radius_multiplier:"));
+  const auto xyz = yaml.find("<origin xyz=\""), rpy = yaml.find("rpy=\"");
+  REQUIRE(xyz != std::string::npos);
+  REQUIRE(rpy != std::string::npos);
+  double x = 0, y = 0, z = 0, roll = 0, pitch = 1, yaw = 0;
+  REQUIRE(std::sscanf(yaml.c_str() + xyz + 13, "%lf %lf %lf", &x, &y, &z) == 3);
+  REQUIRE(std::sscanf(yaml.c_str() + rpy + 5, "%lf %lf %lf", &roll, &pitch, &yaw) == 3);
+  CHECK(x == Approx(m["x_m"].get<double>()).margin(1e-4));
+  CHECK(y == Approx(m["y_m"].get<double>()).margin(1e-4));
+  CHECK(z == Approx(0.18).margin(1e-4));  // kept from /tf_static (base_link -> laser)
+  CHECK(roll == Approx(M_PI).margin(1e-6));
+  CHECK(pitch == 0.0);
+  CHECK(yaw == Approx(m["yaw_rad"].get<double>()).margin(1e-6));
+  CHECK_THAT(yaml, Contains("static_transform_publisher") && Contains("--frame-id base_link --child-frame-id laser"));
+}
+
+TEST_CASE("calibrate-lidar: a namespaced /tf_static that agrees, and --distance-m") {
+  const auto truth = nlohmann::json::parse(Slurp((kLidar / "README-truth.json").string()))["drive_ns.mcap"];
+  const auto r = RunCli("calibrate-lidar " + Q(kLidar / "drive_ns.mcap") + " --scan /scan --wheels /joint_states --tf-static "
+                        "/robot1/tf_static --robot " + Q(kLidar / "robot.toml") + " --json -");
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  CHECK(j["lidar_mount"]["upside_down"] == false);
+  CheckWithin(j["lidar_mount"], "yaw_rad", truth["mount"][2], 0.005);
+  CheckWithin(j, "scan_time_offset_s", truth["scan_time_offset_s"], 0.01);
+  CHECK(j["lidar_mount"]["tf_static"]["frames"] == "base_link -> laser");
+  CHECK_THAT(r.err, !Contains("disagrees"));
+  CHECK(j["gyro_scale"].is_null());
+  CHECK(j["excitation"].size() == 5);
+}
+
+TEST_CASE("calibrate-lidar: bad input exits 1 or 2 naming the problem, writing nothing") {
+  const auto dir = TempDir("calibrate-lidar-bad");
+  const std::string bag = Q(kLidar / "drive_ns.mcap"), robot = " --robot " + Q(kLidar / "robot.toml");
+  const std::string json = " --json " + Q(dir / "out.json");
+  auto r = RunCli("calibrate-lidar " + bag + " --scan /laser_scan --wheels /joint_states" + robot + json);
+  CHECK(r.status == 1);
+  CHECK_THAT(r.err, Contains("--scan topic /laser_scan is not in the recording") && Contains("/scan"));
+  r = RunCli("calibrate-lidar " + bag + " --scan /joint_states --wheels /joint_states" + robot + json);
+  CHECK(r.status == 1);
+  CHECK_THAT(r.err, Contains("must be sensor_msgs/msg/LaserScan"));
+  r = RunCli("calibrate-lidar " + bag + " --scan /scan --wheels /joint_states --odometry /odom" + robot + json);
+  CHECK(r.status == 2);
+  r = RunCli("calibrate-lidar " + bag + " --scan /scan --wheels /joint_states --imu /scan" + robot + json);
+  CHECK(r.status == 1);
+  CHECK_THAT(r.err, Contains("--imu topic /scan"));
+  r = RunCli("calibrate-lidar " + Q(dir / "missing.mcap") + " --scan /scan --wheels /joint_states" + robot + json);
+  CHECK(r.status == 1);
+  r = RunCli("calibrate-lidar " + bag + " --scan /scan --wheels /joint_states --distance-m -3" + robot + json);
+  CHECK(r.status == 2);
+  CHECK_FALSE(std::filesystem::exists(dir / "out.json"));
+}
