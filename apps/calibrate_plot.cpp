@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "evaluation/run_track.hpp"
-#include "io/svg_plot.hpp"
+#include "report/svg_plot.hpp"
 
 namespace umbmark::cli {
 

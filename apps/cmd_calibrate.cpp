@@ -25,11 +25,11 @@
 #include "progress.hpp"
 #include "core/angles.hpp"
 #include "core/errors.hpp"
-#include "io/atomic_write.hpp"
-#include "io/html_report.hpp"
-#include "io/data_file.hpp"
-#include "io/manifest.hpp"
-#include "io/ros2_params.hpp"
+#include "output/atomic_write.hpp"
+#include "report/html_report.hpp"
+#include "formats/data_file.hpp"
+#include "formats/manifest.hpp"
+#include "formats/ros2_params.hpp"
 
 namespace umbmark::cli {
 

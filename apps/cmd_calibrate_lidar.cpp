@@ -2,7 +2,7 @@
 //   --robot R.toml [--imu TOPIC] [--tf-static TOPIC] [--distance-m D] [--ros2 FILE] [--json FILE]`:
 // the wheels, the lidar's mounting pose, the scan clock and the gyro jointly
 // from one ordinary drive (contract section "Calibration from a bag without
-// motion capture"). Reads with io/rosbag2/lidar_drive.hpp, computes with
+// motion capture"). Reads with import/lidar_drive.hpp, computes with
 // calibration/lidar_calibrate.hpp, prints.
 #include <cmath>
 #include <memory>
@@ -15,8 +15,8 @@
 #include "common.hpp"
 #include "core/angles.hpp"
 #include "core/errors.hpp"
-#include "io/ros2_params.hpp"
-#include "io/rosbag2/lidar_drive.hpp"
+#include "formats/ros2_params.hpp"
+#include "import/lidar_drive.hpp"
 
 namespace umbmark::cli {
 namespace {

@@ -14,7 +14,7 @@
 
 #include "commands.hpp"
 #include "diagnosis/design_check.hpp"
-#include "io/manifest.hpp"
+#include "formats/manifest.hpp"
 #include "diagnose_report.hpp"
 #include "progress.hpp"
 #include "common.hpp"
@@ -22,9 +22,10 @@
 #include "evaluation/data_warnings.hpp"
 #include "diagnosis/pieces.hpp"
 #include "diagnosis/diagnose.hpp"
-#include "io/atomic_write.hpp"
-#include "io/params_json.hpp"
-#include "io/svg_plot.hpp"
+#include "output/atomic_write.hpp"
+#include "formats/file_text.hpp"
+#include "formats/params_json.hpp"
+#include "report/svg_plot.hpp"
 
 namespace umbmark::cli {
 

@@ -21,13 +21,13 @@
 #include "core/errors.hpp"
 #include "evaluation/data_warnings.hpp"
 #include "evaluation/run_track.hpp"
-#include "io/atomic_write.hpp"
-#include "io/html_report.hpp"
-#include "io/data_file.hpp"
-#include "io/params_json.hpp"
-#include "io/run_prefetch.hpp"
-#include "io/manifest.hpp"
-#include "io/svg_plot.hpp"
+#include "output/atomic_write.hpp"
+#include "report/html_report.hpp"
+#include "formats/data_file.hpp"
+#include "formats/params_json.hpp"
+#include "formats/run_prefetch.hpp"
+#include "formats/manifest.hpp"
+#include "report/svg_plot.hpp"
 
 namespace umbmark::cli {
 

@@ -27,12 +27,13 @@
 #include "error_models/odometry_covariance.hpp"
 #include "error_models/wheel_noise_fit.hpp"
 #include "error_models/wheel_noise_fit_data.hpp"
-#include "io/atomic_write.hpp"
-#include "io/html_report.hpp"
-#include "io/data_file.hpp"
-#include "io/manifest.hpp"
-#include "io/ros2_params.hpp"
-#include "io/svg_plot.hpp"
+#include "output/atomic_write.hpp"
+#include "formats/file_text.hpp"
+#include "report/html_report.hpp"
+#include "formats/data_file.hpp"
+#include "formats/manifest.hpp"
+#include "formats/ros2_params.hpp"
+#include "report/svg_plot.hpp"
 
 namespace umbmark::cli {
 namespace {

@@ -14,11 +14,11 @@
 #include "core/angles.hpp"
 #include "core/errors.hpp"
 #include "evaluation/data_warnings.hpp"
-#include "io/atomic_write.hpp"
-#include "io/campaign_writer.hpp"
-#include "io/optiodom.hpp"
-#include "io/rosbag2/rosbag2_import.hpp"
-#include "io/rosbag2/wheel_checks.hpp"
+#include "output/atomic_write.hpp"
+#include "formats/campaign_writer.hpp"
+#include "import/optiodom.hpp"
+#include "import/rosbag2_import.hpp"
+#include "import/wheel_checks.hpp"
 
 namespace umbmark::cli {
 

@@ -14,11 +14,12 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "core/errors.hpp"
-#include "io/atomic_write.hpp"
-#include "io/csv_writer.hpp"
-#include "io/html_report.hpp"
-#include "io/params_json.hpp"
-#include "io/svg_plot.hpp"
+#include "output/atomic_write.hpp"
+#include "formats/file_text.hpp"
+#include "formats/csv_writer.hpp"
+#include "report/html_report.hpp"
+#include "formats/params_json.hpp"
+#include "report/svg_plot.hpp"
 
 namespace umbmark::cli {
 namespace {

@@ -10,9 +10,9 @@
 #include "core/errors.hpp"
 #include "core/plausible_units.hpp"
 #include "core/utf8.hpp"
-#include "io/atomic_write.hpp"
-#include "io/manifest.hpp"
-#include "io/robot_toml.hpp"
+#include "output/atomic_write.hpp"
+#include "formats/manifest.hpp"
+#include "formats/robot_toml.hpp"
 
 namespace umbmark::cli {
 

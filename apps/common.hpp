@@ -13,7 +13,7 @@
 #include "core/robot.hpp"
 #include "core/runs.hpp"
 #include "evaluation/trajectory_eval.hpp"
-#include "io/output_set.hpp"
+#include "output/output_set.hpp"
 
 namespace umbmark::cli {
 
@@ -80,7 +80,7 @@ void CheckPathArguments(const CLI::App& app);
 
 /// The process's output set: every command registers its inputs and outputs
 /// here, calls Check() before writing anything, and writes through Write()
-/// (see io/output_set.hpp). One command runs per process.
+/// (see output/output_set.hpp). One command runs per process.
 io::OutputSet& CommandOutputs();
 
 /// Registers the command's input files with CommandOutputs(): each path, and

@@ -9,8 +9,8 @@
 #include <fmt/format.h>
 
 #include "diagnosis/advice.hpp"
-#include "io/html_report.hpp"
-#include "io/svg_plot.hpp"
+#include "report/html_report.hpp"
+#include "report/svg_plot.hpp"
 
 namespace umbmark::cli {
 

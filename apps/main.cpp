@@ -24,7 +24,7 @@
 #include "common.hpp"
 #include "core/errors.hpp"
 #include "core/utf8.hpp"
-#include "io/atomic_write.hpp"
+#include "output/atomic_write.hpp"
 #include "umbmark/version.hpp"
 #include "progress.hpp"
 

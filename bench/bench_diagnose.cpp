@@ -75,8 +75,8 @@
 #include "core/angles.hpp"
 #include "diagnosis/pieces.hpp"
 #include "diagnosis/diagnose.hpp"
-#include "io/atomic_write.hpp"
-#include "io/campaign_writer.hpp"
+#include "output/atomic_write.hpp"
+#include "formats/campaign_writer.hpp"
 #include "simulation/campaign_sim.hpp"
 #include "simulation/effects.hpp"
 

@@ -24,7 +24,7 @@
 
 #include "core/angles.hpp"
 #include "core/errors.hpp"
-#include "io/trajectory_csv.hpp"
+#include "formats/trajectory_csv.hpp"
 
 namespace {
 

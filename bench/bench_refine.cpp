@@ -23,7 +23,7 @@
 #include "calibration/refine.hpp"
 #include "core/errors.hpp"
 #include "evaluation/return_error.hpp"
-#include "io/optiodom.hpp"
+#include "import/optiodom.hpp"
 
 namespace {
 

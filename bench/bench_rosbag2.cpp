@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "core/errors.hpp"
-#include "io/robot_toml.hpp"
-#include "io/rosbag2/rosbag2_import.hpp"
+#include "formats/robot_toml.hpp"
+#include "import/rosbag2_import.hpp"
 
 int main(int argc, char** argv) {
   if (argc != 3) {

@@ -16,8 +16,8 @@
 #include "calibration/umbmark.hpp"
 #include "core/errors.hpp"
 #include "evaluation/return_error.hpp"
-#include "io/robot_toml.hpp"
-#include "io/rosbag2/rosbag2_import.hpp"
+#include "formats/robot_toml.hpp"
+#include "import/rosbag2_import.hpp"
 
 namespace {
 

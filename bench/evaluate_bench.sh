@@ -9,7 +9,7 @@
 # and prints MB/s of both, their ratio (wall clock and CPU time), and the
 # peak memory of each process (/usr/bin/time -v). Targets (issue 23): ratio
 # >= 3 (wall clock), umbmark peak memory <= 128 MB. evaluate reads the next
-# run on a second thread while it evaluates the one before (io/run_prefetch),
+# run on a second thread while it evaluates the one before (formats/run_prefetch),
 # so on one core the wall ratio falls back to about the CPU-time ratio.
 # The file is deleted at the end.
 #   usage: bench/evaluate_bench.sh [BUILD_DIR]      (default: build)

@@ -41,7 +41,7 @@
 #include "calibration/heldout.hpp"
 #include "calibration/refine.hpp"
 #include "evaluation/trajectory_eval.hpp"
-#include "io/optiodom.hpp"
+#include "import/optiodom.hpp"
 
 using namespace umbmark;
 namespace fs = std::filesystem;

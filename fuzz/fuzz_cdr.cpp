@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "io/rosbag2/cdr.hpp"
-#include "io/rosbag2/messages.hpp"
+#include "ros2/cdr.hpp"
+#include "ros2/messages.hpp"
 
 using namespace umbmark::io::rosbag2;
 

@@ -13,8 +13,8 @@
 
 #include "core/angles.hpp"
 #include "core/errors.hpp"
-#include "io/endpoint_csv.hpp"
-#include "io/trajectory_csv.hpp"
+#include "formats/endpoint_csv.hpp"
+#include "formats/trajectory_csv.hpp"
 
 namespace {
 

@@ -15,8 +15,8 @@
 #include "calibration/umbmark.hpp"
 #include "core/angles.hpp"
 #include "core/errors.hpp"
-#include "io/campaign_writer.hpp"
-#include "io/endpoint_csv.hpp"
+#include "formats/campaign_writer.hpp"
+#include "formats/endpoint_csv.hpp"
 
 namespace {
 

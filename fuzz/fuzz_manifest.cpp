@@ -11,8 +11,8 @@
 
 #include "core/errors.hpp"
 #include "core/plausible_units.hpp"
-#include "io/campaign_writer.hpp"
-#include "io/manifest.hpp"
+#include "formats/campaign_writer.hpp"
+#include "formats/manifest.hpp"
 
 namespace {
 

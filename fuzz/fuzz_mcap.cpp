@@ -10,7 +10,7 @@
 #include <string>
 
 #include "core/errors.hpp"
-#include "io/rosbag2/mcap_reader.hpp"
+#include "ros2/mcap_reader.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const std::string path = "/tmp/umbmark-fuzz-mcap-" + std::to_string(::getpid()) + ".mcap";

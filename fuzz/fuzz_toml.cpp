@@ -8,8 +8,8 @@
 #include <string_view>
 
 #include "core/errors.hpp"
-#include "io/manifest.hpp"
-#include "io/robot_toml.hpp"
+#include "formats/manifest.hpp"
+#include "formats/robot_toml.hpp"
 
 namespace {
 

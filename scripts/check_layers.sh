@@ -3,24 +3,35 @@
 # header from a higher layer (or from a peer folder of the same layer). The
 # layers, lowest first (docs/architecture.md):
 #
-#   0 core                          data types, angles, poses, errors
-#   1 stats, kinematics, scan       numerics; wheel travel -> pose; scan registration
-#   2 model                         the true robot and its controller
-#   3 io, error_models, evaluation  files; noise propagation; return errors
-#   4 calibration, simulation       UMBmark + refine; simulators
-#   5 diagnosis                     sim-to-real gap
-#   6 apps                          the command-line suite
+#   0   core                          data types, angles, poses, errors
+#   1   stats, kinematics, scan       numerics; wheel travel -> pose; scan registration
+#   2   model                         the true robot and its controller
+#   3   error_models, evaluation      noise propagation; return errors
+#   3.1 output, report                the file rooms: atomic writes, output sets, locks;
+#                                     SVG plots and HTML pages
+#   3.2 formats                       CSV, TOML, manifest, params JSON, ROS 2 YAML, campaigns
+#   3.3 ros2                          bag containers, CDR, messages, /tf (reading only)
+#   3.4 ground_truth                  ground-truth sources read from a recording
+#   3.5 import                        the importers (rosbag2, OptiOdom) and their checks
+#   4   calibration, simulation       UMBmark + refine; simulators
+#   5   diagnosis                     sim-to-real gap
+#   6   apps                          the command-line suite
 #
-# A folder may include its own headers and those of any lower layer. Only
-# apps and diagnosis may include io (the computing layers never touch files;
+# (ranks below are tenths: 3.2 is 32). A folder may include its own headers
+# and those of any lower layer. Only the file rooms themselves, apps and
+# diagnosis may include a file room (the computing layers never touch files;
 # diagnosis still reads its campaign itself). A folder of lib/ not in the
 # table is an error: add it here and to docs/architecture.md.
 # Usage: check_layers.sh [repo root]   (exit 0 clean, 1 on a violation)
 set -euo pipefail
 root=${1:-$(cd "$(dirname "$0")/.." && pwd)}
-declare -A rank=([core]=0 [stats]=1 [kinematics]=1 [scan]=1 [model]=2 [io]=3 [error_models]=3 [evaluation]=3
-  [calibration]=4 [simulation]=4 [diagnosis]=5 [apps]=6)
-declare -A io_allowed=([io]=1 [diagnosis]=1 [apps]=1)
+declare -A rank=([core]=0 [stats]=10 [kinematics]=10 [scan]=10 [model]=20 [error_models]=30 [evaluation]=30
+  [output]=31 [report]=31 [formats]=32 [ros2]=33 [ground_truth]=34 [import]=35
+  [calibration]=40 [simulation]=40 [diagnosis]=50 [apps]=60)
+declare -A file_room=([output]=1 [report]=1 [formats]=1 [ros2]=1 [ground_truth]=1 [import]=1)
+declare -A file_room_users=([diagnosis]=1 [apps]=1)
+# "3.2" for rank 32.
+layer() { local r=${rank[$1]}; if ((r % 10)); then echo "$((r / 10)).$((r % 10))"; else echo "$((r / 10))"; fi; }
 status=0
 cd "$root"
 while IFS= read -r -d '' file; do
@@ -39,10 +50,10 @@ while IFS= read -r -d '' file; do
     [[ -n ${rank[$to]+x} ]] || continue  # not one of ours (e.g. <ceres/...> spelled with quotes)
     [[ $to == "$from" ]] && continue
     if ((rank[$to] >= rank[$from])); then
-      echo "$file:$line: includes \"$header\": layer $to (${rank[$to]}) is not below $from (${rank[$from]})"
+      echo "$file:$line: includes \"$header\": layer $to ($(layer "$to")) is not below $from ($(layer "$from"))"
       status=1
-    elif [[ $to == io && -z ${io_allowed[$from]+x} ]]; then
-      echo "$file:$line: includes \"$header\": only apps and diagnosis may use io"
+    elif [[ -n ${file_room[$to]+x} && -z ${file_room[$from]+x} && -z ${file_room_users[$from]+x} ]]; then
+      echo "$file:$line: includes \"$header\": only the file rooms, apps and diagnosis may use $to"
       status=1
     fi
   done < <(grep -n '^[[:space:]]*#[[:space:]]*include[[:space:]]*"' "$file" || true)

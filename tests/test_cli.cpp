@@ -11,7 +11,7 @@
 #include <sstream>
 
 #include "calibration/calibrate_job.hpp"
-#include "io/optiodom.hpp"
+#include "import/optiodom.hpp"
 #include "support/run_cli.hpp"
 
 using namespace umbmark;

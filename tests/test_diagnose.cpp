@@ -20,7 +20,7 @@
 #include "diagnosis/model.hpp"
 #include "diagnosis/piece_noise.hpp"
 #include "evaluation/data_warnings.hpp"
-#include "io/campaign_writer.hpp"
+#include "formats/campaign_writer.hpp"
 #include "simulation/campaign_sim.hpp"
 #include "support/diag_campaign.hpp"
 #include "support/run_cli.hpp"

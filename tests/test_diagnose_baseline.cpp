@@ -18,7 +18,7 @@
 #include "diagnosis/baseline_given.hpp"
 #include "diagnosis/diagnose.hpp"
 #include "diagnosis/pieces.hpp"
-#include "io/campaign_writer.hpp"
+#include "formats/campaign_writer.hpp"
 #include "simulation/campaign_sim.hpp"
 #include "support/diag_campaign.hpp"
 #include "support/run_cli.hpp"

@@ -21,7 +21,7 @@
 #include "core/angles.hpp"
 #include "evaluation/run_track.hpp"
 #include "evaluation/trajectory_eval.hpp"
-#include "io/trajectory_csv.hpp"
+#include "formats/trajectory_csv.hpp"
 #include "support/run_cli.hpp"
 
 namespace fs = std::filesystem;

@@ -16,7 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "support/run_cli.hpp"
-#include "io/html_report.hpp"
+#include "report/html_report.hpp"
 
 #include "core/angles.hpp"
 #include "error_models/path_spec.hpp"

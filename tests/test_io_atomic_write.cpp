@@ -9,7 +9,8 @@
 #include <string>
 
 #include "core/errors.hpp"
-#include "io/atomic_write.hpp"
+#include "output/atomic_write.hpp"
+#include "formats/file_text.hpp"
 
 namespace fs = std::filesystem;
 using namespace umbmark;

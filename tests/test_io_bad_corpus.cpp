@@ -16,11 +16,11 @@
 #include <vector>
 
 #include "core/errors.hpp"
-#include "io/data_file.hpp"
-#include "io/endpoint_csv.hpp"
-#include "io/manifest.hpp"
-#include "io/robot_toml.hpp"
-#include "io/trajectory_csv.hpp"
+#include "formats/data_file.hpp"
+#include "formats/endpoint_csv.hpp"
+#include "formats/manifest.hpp"
+#include "formats/robot_toml.hpp"
+#include "formats/trajectory_csv.hpp"
 
 using namespace umbmark;
 

@@ -1,6 +1,6 @@
-// RFC 4180 quoting: the writer (io/csv_writer.hpp, used by the endpoint and
+// RFC 4180 quoting: the writer (formats/csv_writer.hpp, used by the endpoint and
 // trajectory writers) quotes exactly the cells that need it, and the readers
-// (io/csv_table.hpp) read every quoted cell back as written: run ids with a
+// (formats/csv_table.hpp) read every quoted cell back as written: run ids with a
 // comma, a double quote, a line break, blanks at the ends or a leading `#`
 // round-trip through files, at every read-chunk boundary; bad quoting is an
 // error at its line and column.
@@ -15,11 +15,11 @@
 #include <vector>
 
 #include "core/errors.hpp"
-#include "io/campaign_writer.hpp"
-#include "io/csv_table.hpp"
-#include "io/csv_writer.hpp"
-#include "io/endpoint_csv.hpp"
-#include "io/trajectory_csv.hpp"
+#include "formats/campaign_writer.hpp"
+#include "formats/csv_table.hpp"
+#include "formats/csv_writer.hpp"
+#include "formats/endpoint_csv.hpp"
+#include "formats/trajectory_csv.hpp"
 #include "support/bits.hpp"
 
 using namespace umbmark;

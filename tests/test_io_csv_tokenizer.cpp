@@ -1,4 +1,4 @@
-// The shared CSV tokenizer (io/csv_table.hpp): its fast number paths must
+// The shared CSV tokenizer (formats/csv_table.hpp): its fast number paths must
 // agree bit for bit with the reference parsers (strtod, which glibc rounds
 // correctly, and std::from_chars), and its line/cell splitting must handle
 // the contract's variants (BOM, CRLF, comments, blank lines, blanks around
@@ -13,7 +13,7 @@
 #include <string>
 
 #include "core/errors.hpp"
-#include "io/csv_table.hpp"
+#include "formats/csv_table.hpp"
 #include "support/bits.hpp"
 
 using namespace umbmark;

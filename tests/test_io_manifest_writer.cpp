@@ -12,8 +12,8 @@
 #include <vector>
 #include <string>
 
-#include "io/campaign_writer.hpp"
-#include "io/manifest.hpp"
+#include "formats/campaign_writer.hpp"
+#include "formats/manifest.hpp"
 #include "support/bits.hpp"
 
 using namespace umbmark;

@@ -9,8 +9,8 @@
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
-#include "io/run_prefetch.hpp"
-#include "io/trajectory_csv.hpp"
+#include "formats/run_prefetch.hpp"
+#include "formats/trajectory_csv.hpp"
 
 using namespace umbmark;
 

@@ -1,4 +1,4 @@
-// The streaming CSV path (io/csv_table.hpp, io/trajectory_csv.hpp): every
+// The streaming CSV path (formats/csv_table.hpp, formats/trajectory_csv.hpp): every
 // result and every error message must be the same whatever the read()
 // chunking, including a token, a CRLF or a BOM split across chunks and a last
 // line without newline; runs come one at a time with the capacity of the
@@ -11,11 +11,11 @@
 #include <vector>
 
 #include "core/errors.hpp"
-#include "io/csv_table.hpp"
-#include "io/data_file.hpp"
-#include "io/endpoint_csv.hpp"
-#include "io/file_text.hpp"
-#include "io/trajectory_csv.hpp"
+#include "formats/csv_table.hpp"
+#include "formats/data_file.hpp"
+#include "formats/endpoint_csv.hpp"
+#include "formats/file_text.hpp"
+#include "formats/trajectory_csv.hpp"
 #include "support/run_cli.hpp"
 
 using namespace umbmark;

@@ -17,7 +17,7 @@
 #include <fmt/format.h>
 
 #include "calibration/umbmark.hpp"
-#include "io/campaign_writer.hpp"
+#include "formats/campaign_writer.hpp"
 #include "model/commanded_square.hpp"
 #include "model/true_robot.hpp"
 #include "simulation/campaign_sim.hpp"

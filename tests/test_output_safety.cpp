@@ -19,7 +19,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "io/output_set.hpp"
+#include "output/output_set.hpp"
 #include "support/run_cli.hpp"
 
 namespace fs = std::filesystem;

@@ -1,4 +1,4 @@
-// The plotting layer (lib/io/svg_plot) and the plots of the commands, checked
+// The plotting layer (lib/report/svg_plot) and the plots of the commands, checked
 // on their SVG: tick values at 1-2-5 steps covering the data, tick marks
 // drawn at those values, legend entries matching what is drawn, calibrate's
 // before/after panels on one common scale, and the --report pages'
@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "io/html_report.hpp"
-#include "io/svg_plot.hpp"
+#include "report/html_report.hpp"
+#include "report/svg_plot.hpp"
 #include "support/run_cli.hpp"
 
 using namespace umbmark;

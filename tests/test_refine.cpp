@@ -21,7 +21,7 @@
 #include "calibration/refine.hpp"
 #include "calibration/umbmark.hpp"
 #include "evaluation/trajectory_eval.hpp"
-#include "io/optiodom.hpp"
+#include "import/optiodom.hpp"
 #include "test_refine_support.hpp"
 
 using namespace umbmark;

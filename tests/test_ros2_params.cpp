@@ -13,7 +13,7 @@
 
 #include "core/errors.hpp"
 #include "error_models/odometry_covariance.hpp"
-#include "io/ros2_params.hpp"
+#include "formats/ros2_params.hpp"
 #include "support/run_cli.hpp"
 
 using namespace umbmark;

@@ -18,12 +18,12 @@
 
 #include "calibration/calibrate_job.hpp"
 #include "core/errors.hpp"
-#include "io/robot_toml.hpp"
-#include "io/rosbag2/bag.hpp"
-#include "io/rosbag2/cdr.hpp"
-#include "io/rosbag2/mcap_reader.hpp"
-#include "io/rosbag2/messages.hpp"
-#include "io/rosbag2/rosbag2_import.hpp"
+#include "formats/robot_toml.hpp"
+#include "ros2/bag.hpp"
+#include "ros2/cdr.hpp"
+#include "ros2/mcap_reader.hpp"
+#include "ros2/messages.hpp"
+#include "import/rosbag2_import.hpp"
 #include "support/run_cli.hpp"
 
 using namespace umbmark;

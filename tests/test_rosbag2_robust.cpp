@@ -21,9 +21,9 @@
 #include <regex>
 
 #include "core/errors.hpp"
-#include "io/robot_toml.hpp"
-#include "io/rosbag2/mcap_reader.hpp"
-#include "io/rosbag2/rosbag2_import.hpp"
+#include "formats/robot_toml.hpp"
+#include "ros2/mcap_reader.hpp"
+#include "import/rosbag2_import.hpp"
 #include "support/run_cli.hpp"
 
 using namespace umbmark;

@@ -10,10 +10,10 @@
 #include <nlohmann/json.hpp>
 
 #include "evaluation/return_error.hpp"
-#include "io/campaign_writer.hpp"
-#include "io/data_file.hpp"
-#include "io/manifest.hpp"
-#include "io/trajectory_csv.hpp"
+#include "formats/campaign_writer.hpp"
+#include "formats/data_file.hpp"
+#include "formats/manifest.hpp"
+#include "formats/trajectory_csv.hpp"
 #include "simulation/campaign_sim.hpp"
 #include "support/run_cli.hpp"
 

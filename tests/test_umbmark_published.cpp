@@ -16,7 +16,7 @@
 
 #include "calibration/calibrate_job.hpp"
 #include "core/angles.hpp"
-#include "io/optiodom.hpp"
+#include "import/optiodom.hpp"
 
 using namespace umbmark;
 

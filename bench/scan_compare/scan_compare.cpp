@@ -25,9 +25,9 @@
 #include <mrpt/slam/CICP.h>
 #include <open3d/Open3D.h>
 
-#include "io/rosbag2/bag.hpp"
-#include "io/rosbag2/messages.hpp"
-#include "io/rosbag2/scan_messages.hpp"
+#include "ros2/bag.hpp"
+#include "ros2/messages.hpp"
+#include "ros2/scan_messages.hpp"
 #include "scan/scan_matcher.hpp"
 
 using namespace umbmark;

@@ -1,6 +1,6 @@
 // In-memory form of the data files (docs/formats.md):
 // endpoint runs (return errors only) and trajectory runs (encoder samples with
-// optional ground truth). Readers live in io/; this header only holds data.
+// optional ground truth). Readers live in formats/; this header only holds data.
 #pragma once
 
 #include <cmath>

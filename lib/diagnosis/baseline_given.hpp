@@ -1,7 +1,7 @@
 // Stage "baseline" of `diagnose --baseline CAL.json [--kl K --kr K]`: the
 // runs are compared with the model the user simulates with, not with one
 // fitted to them. The given model is a `calibrate` JSON's parameters
-// (io/params_json.hpp: refined.parameters when present, else parameters:
+// (formats/params_json.hpp: refined.parameters when present, else parameters:
 // wheelbase_m, wheel_diameter_left_m, wheel_diameter_right_m) and, when
 // given, the wheel noise k_L, k_R [m^1/2] (Chong & Kleeman, eq. 4:
 // variance k^2 |travel| per wheel).

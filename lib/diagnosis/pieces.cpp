@@ -13,8 +13,8 @@
 
 #include "core/angles.hpp"
 #include "core/errors.hpp"
-#include "io/data_file.hpp"
-#include "io/manifest.hpp"
+#include "formats/data_file.hpp"
+#include "formats/manifest.hpp"
 #include "kinematics/diff_drive.hpp"
 #include "kinematics/odometry.hpp"
 #include "model/commanded_square.hpp"

@@ -10,7 +10,7 @@
 #include "diagnosis/advice.hpp"
 #include "diagnosis/diagnose.hpp"
 #include "diagnosis/report_given.hpp"
-#include "io/svg_plot.hpp"
+#include "report/svg_plot.hpp"
 
 namespace umbmark::diag {
 

@@ -3,7 +3,7 @@
 // E_d, E_b, wheel noise k_L, k_R, encoder ticks, ground truth with
 // measurement noise) with any of the contract's effects (effects.hpp), and
 // returns the campaign in the contract's formats (manifest + trajectory or
-// endpoint CSV per experiment; io/campaign_writer.hpp writes them).
+// endpoint CSV per experiment; formats/campaign_writer.hpp writes them).
 //
 // The true robot relative to the manifest's [robot] (what the odometry uses):
 //   D_L,true = c_L D_L (1 + s),  D_R,true = c_R D_R (1 + s) (1 + r i),

@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "core/runs.hpp"
-#include "io/manifest.hpp"
+#include "formats/manifest.hpp"
 #include "simulation/campaign_sim.hpp"
 
 namespace umbmark::testing {
