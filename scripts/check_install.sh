@@ -2,7 +2,8 @@
 # Installs the build in ${BUILD_DIR:-build} into a temporary prefix, builds
 # the consumer project tests/consumer against it (CMake package) and runs
 # it, compiles the same program with pkg-config's flags and runs that, and
-# builds the .deb with CPack, unpacks it and runs its binary.
+# builds the .debs with CPack (umbmark, and python3-umbmark with the Python
+# module), unpacks them and runs the binary and the module.
 # Usage: check_install.sh   (after scripts/build.sh; exit 0 when both work)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -29,4 +30,17 @@ deb=$(find "$tmp/deb" -maxdepth 1 -name 'umbmark_*.deb' -print -quit)
 dpkg-deb --info "$deb" | grep -E '^ (Package|Version|Depends):'
 dpkg-deb -x "$deb" "$tmp/debroot"
 "$tmp/debroot/usr/bin/umbmark" --version
+# The Python module's package (when the build has the module): unpacked, it
+# imports with Debian's python3 and calibrates the bundled example.
+pydeb=$(find "$tmp/deb" -maxdepth 1 -name 'python3-umbmark_*.deb' -print -quit)
+if ls "$BUILD_DIR"/umbmark.cpython-*.so >/dev/null 2>&1; then
+  test -n "$pydeb" || { echo "check_install: no python3-umbmark .deb"; exit 1; }
+  dpkg-deb --info "$pydeb" | grep -E '^ (Package|Version|Depends):'
+  dpkg-deb -x "$pydeb" "$tmp/pyroot"
+  # The module runs the umbmark binary of the package umbmark (unpacked above).
+  UMBMARK_EXE="$tmp/debroot/usr/bin/umbmark" PYTHONPATH="$tmp/pyroot/usr/lib/python3/dist-packages" /usr/bin/python3 -c 'import sys, umbmark
+assert umbmark.__file__.startswith(sys.argv[1]), umbmark.__file__
+r = umbmark.calibrate("data/examples/endpoints.csv", robot="data/examples/robot.toml", side=0.75, no_heldout=True)
+print("python3-umbmark", umbmark.__version__, "E_d =", r.E_d)' "$tmp/pyroot"
+fi
 echo "install: CMake package, pkg-config and .deb OK"

@@ -6,6 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 bash scripts/build.sh
+bash scripts/python_path.sh  # `import umbmark` from the build tree (docs/python.md)
 OUT=${BUILD_DIR:-build}/example
 UMB=${BUILD_DIR:-build}/umbmark
 echo "== umbmark import optiodom (real square runs, OptiOdom June 2020, MIT)"

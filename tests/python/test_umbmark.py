@@ -1,0 +1,207 @@
+"""The Python module against the command line: every function's to_dict()
+equals the command's JSON on the bundled data (numbers to 1e-12, timings
+excepted), errors raise the exception of the exit status with the command's
+message, and trajectories given as arrays calibrate as their CSV does."""
+import csv
+import json
+import math
+
+import pytest
+
+import umbmark
+from conftest import EXAMPLES, SOURCE, assert_same, cli_json, run_cli
+
+ROBOT = EXAMPLES / "robot.toml"
+
+
+def test_every_command_is_a_function():
+    for name in ["calibrate", "evaluate", "fit_noise", "predict", "simulate", "diagnose", "summarize",
+                 "import_optiodom", "import_rosbag2"]:
+        assert name in umbmark.commands and callable(getattr(umbmark, name))
+    assert issubclass(umbmark.QualityGateError, umbmark.Error)
+
+
+def test_calibrate_manifest_refined_equals_cli():
+    r = umbmark.calibrate(EXAMPLES / "calibrate.toml", refine=True)
+    cli = cli_json("calibrate", EXAMPLES / "calibrate.toml", "--refine")
+    assert_same(r.to_dict(), cli)
+    # The contract's keys, read as attributes and items.
+    assert r.refined["parameters"]["wheelbase_m"] == cli["refined"]["parameters"]["wheelbase_m"]
+    assert r["E_d"] == cli["E_d"] and "parameters" in r
+
+
+def test_calibrate_endpoints_with_options_equals_cli():
+    r = umbmark.calibrate(str(EXAMPLES / "endpoints.csv"), robot=ROBOT, side=0.75, estimator="x",
+                          no_heldout=True)
+    assert_same(r.to_dict(), cli_json("calibrate", EXAMPLES / "endpoints.csv", "--robot", ROBOT, "--side", "0.75",
+                                      "--estimator", "x", "--no-heldout"))
+    # Borenstein & Feng's E_d is the ratio of the corrected diameters.
+    p = r.parameters
+    assert math.isclose(r.E_d, p["wheel_diameter_right_m"] / p["wheel_diameter_left_m"], rel_tol=1e-9)
+
+
+def test_fit_noise_equals_cli():
+    r = umbmark.fit_noise(EXAMPLES / "fit-noise.toml")
+    assert_same(r.to_dict(), cli_json("fit-noise", EXAMPLES / "fit-noise.toml"))
+    lo, hi = r.k_L_ci95
+    assert lo < r.k_L < hi
+
+
+def test_predict_equals_cli_and_closed_form():
+    args = dict(robot=ROBOT, kl=1e-3, kr=2e-3, path="line:2")
+    r = umbmark.predict(**args, monte_carlo=2000, seed=7, threads=1)
+    cli = cli_json("predict", "--robot", ROBOT, "--kl", "1e-3", "--kr", "2e-3", "--path", "line:2",
+                   "--monte-carlo", "2000", "--seed", "7", "--threads", "1")
+    assert_same(r.to_dict(), cli)
+    # Straight line of length D: var(theta) = (k_L^2 + k_R^2) D / b^2 (Chong & Kleeman).
+    b = 0.2
+    assert math.isclose(r.covariance[2][2], (1e-6 + 4e-6) * 2 / b**2, rel_tol=1e-9)
+    assert r.monte_carlo["seed"] == 7 and r.monte_carlo["runs"] == 2000
+
+
+def test_diagnose_equals_cli():
+    r = umbmark.diagnose(EXAMPLES / "diagnose.toml", null_sims=40, seed=3, threads=1)
+    cli = cli_json("diagnose", EXAMPLES / "diagnose.toml", "--null-sims", "40", "--seed", "3", "--threads", "1")
+    assert_same(r.to_dict(), cli)
+    assert r.verdict["effect"] == cli["verdict"]["effect"]
+
+
+def test_evaluate_equals_cli():
+    r = umbmark.evaluate(EXAMPLES / "square_ticks.csv", robot=ROBOT)
+    cli = cli_json("evaluate", EXAMPLES / "square_ticks.csv", "--robot", ROBOT)
+    assert_same(r.to_dict(), cli)
+    s = r.summary
+    finals = [run["final_position_error_m"] for run in r.runs]
+    assert math.isclose(s["max_final_position_error_m"], max(finals), rel_tol=1e-12)
+
+
+def test_simulate_writes_a_campaign_and_equals_cli(tmp_path):
+    a, b = tmp_path / "a", tmp_path / "b"
+    r = umbmark.simulate(EXAMPLES / "simulate.toml", out=a, seed=11, square_runs=4)
+    cli = cli_json("simulate", EXAMPLES / "simulate.toml", "--out", b, "--seed", "11", "--square-runs", "4")
+    d = r.to_dict()
+    assert json.dumps(d, sort_keys=True).replace(str(a), "OUT") == json.dumps(cli, sort_keys=True).replace(str(b), "OUT")
+    assert (a / "campaign.toml").exists()
+    # The same seed gives the same files.
+    assert (a / "square.csv").read_text() == (b / "square.csv").read_text()
+
+
+def test_summarize_equals_cli(tmp_path):
+    files = []
+    for i, side in enumerate(["0.75", "0.7", "0.8"]):
+        f = tmp_path / f"robot{i}.json"
+        f.write_text(umbmark.calibrate(EXAMPLES / "endpoints.csv", robot=ROBOT, side=float(side)).json)
+        files.append(f)
+    r = umbmark.summarize(*files)
+    assert_same(r.to_dict(), cli_json("summarize", *files))
+    assert len(r.robots) == 3
+
+
+def test_import_optiodom_equals_cli(tmp_path):
+    src = SOURCE / "data" / "optiodom-2020-06" / "square" / "230620202042"
+    r = umbmark.import_optiodom(src, out=tmp_path / "a")
+    cli = cli_json("import", "optiodom", src, "--out", tmp_path / "b")
+    assert json.dumps(r.to_dict()).replace("/a", "/X") == json.dumps(cli).replace("/b", "/X")
+    assert (tmp_path / "a" / "campaign.toml").read_text() == (tmp_path / "b" / "campaign.toml").read_text()
+
+
+def test_import_rosbag2_list_equals_cli():
+    bag = SOURCE / "tests" / "data" / "rosbag2" / "humble"
+    r = umbmark.import_rosbag2(bag, list=True)
+    assert_same(r.to_dict(), cli_json("import", "rosbag2", bag, "--list"))
+    assert r.bags
+
+
+def test_input_error_has_the_commands_message():
+    bad = SOURCE / "tests" / "data" / "bad" / "ep_nan.csv"
+    status, _, err = run_cli("calibrate", bad, "--robot", ROBOT, "--side", "1")
+    assert status == 1
+    with pytest.raises(umbmark.InputError) as e:
+        umbmark.calibrate(bad, robot=ROBOT, side=1.0)
+    assert str(e.value) == err.strip()
+    assert e.value.exit_status == 1
+
+
+def test_usage_error_has_the_commands_message():
+    status, _, err = run_cli("calibrate", EXAMPLES / "endpoints.csv", "--robot", ROBOT, "--side", "-1")
+    assert status == 2
+    with pytest.raises(umbmark.UsageError) as e:
+        umbmark.calibrate(EXAMPLES / "endpoints.csv", robot=ROBOT, side=-1)
+    assert str(e.value) == err.strip()
+    with pytest.raises(umbmark.UsageError, match="--no-such-option"):
+        umbmark.calibrate(EXAMPLES / "endpoints.csv", no_such_option=1)
+
+
+def test_quality_gate_error_keeps_the_classic_result():
+    # Return errors of squares do not determine the mean wheel diameter.
+    args = ["calibrate", EXAMPLES / "endpoints.csv", "--robot", ROBOT, "--side", "0.75", "--refine", "--free", "scale"]
+    status, out, err = run_cli(*args, "--json", "-")
+    assert status == 3
+    with pytest.raises(umbmark.QualityGateError) as e:
+        umbmark.calibrate(EXAMPLES / "endpoints.csv", robot=ROBOT, side=0.75, refine=True, free="scale")
+    assert e.value.exit_status == 3 and "scale" in str(e.value)
+    assert_same(e.value.result.to_dict(), json.loads(out))
+
+
+def read_runs(path):
+    """The trajectory CSV as a list of dicts of float lists, one per run."""
+    runs = {}
+    with open(path) as f:
+        for row in csv.DictReader(line for line in f if not line.startswith("#")):
+            run = runs.setdefault(row["run"], {"run": row["run"], "direction": row["direction"]})
+            for k, v in row.items():
+                if k not in ("run", "direction"):
+                    run.setdefault(k, []).append(float(v) if v != "" else math.nan)
+    return list(runs.values())
+
+
+def test_calibrate_from_arrays_equals_from_csv():
+    np = pytest.importorskip("numpy")
+    runs = [{k: (np.asarray(v) if isinstance(v, list) else v) for k, v in r.items()}
+            for r in read_runs(EXAMPLES / "square_ticks.csv")]
+    for r in runs:
+        r["ticks_left"] = r["ticks_left"].astype(np.int64)
+    a = umbmark.calibrate(runs=runs, robot=ROBOT, side=1.0).to_dict()
+    b = umbmark.calibrate(EXAMPLES / "square_ticks.csv", robot=ROBOT, side=1.0).to_dict()
+    path = str(EXAMPLES / "square_ticks.csv")
+    assert_same(json.loads(json.dumps(a).replace("<runs>", path)), b)
+
+
+def test_calibrate_from_one_table_with_a_run_column():
+    runs = read_runs(EXAMPLES / "square_ticks.csv")
+    table = {k: [] for k in runs[0]}
+    for r in runs:
+        n = len(r["t_s"])
+        for k in table:
+            table[k] += r[k] if isinstance(r[k], list) else [r[k]] * n
+    a = umbmark.calibrate(runs=table, robot=ROBOT, side=1.0).to_dict()
+    b = umbmark.calibrate(EXAMPLES / "square_ticks.csv", robot=ROBOT, side=1.0).to_dict()
+    assert a["parameters"] == b["parameters"]
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda r: r.pop("x_gt_m"), r"runs\[0\] has no column 'x_gt_m'"),
+    (lambda r: r["t_s"].__setitem__(3, r["t_s"][2]), r"runs\[0\]\['t_s'\]\[3\] = .* does not increase"),
+    (lambda r: r["ticks_left"].__setitem__(2, 0.5), r"runs\[0\]\['ticks_left'\]\[2\] = 0.5 is not a whole tick count"),
+    (lambda r: r["y_gt_m"].__setitem__(-1, math.nan), r"partial ground truth"),
+    (lambda r: r["t_s"].pop(), r"runs\[0\]\['ticks_left'\] has \d+ values, t_s has \d+"),
+])
+def test_bad_arrays_raise_input_error_naming_the_cell(change, message):
+    runs = read_runs(EXAMPLES / "square_ticks.csv")
+    change(runs[0])
+    with pytest.raises(umbmark.InputError, match=message):
+        umbmark.calibrate(runs=runs, robot=ROBOT, side=1.0)
+
+
+def test_evaluate_from_arrays_equals_from_csv():
+    runs = read_runs(EXAMPLES / "square_ticks.csv")
+    a = umbmark.evaluate(runs=runs, robot=ROBOT).to_dict()
+    b = umbmark.evaluate(EXAMPLES / "square_ticks.csv", robot=ROBOT).to_dict()
+    assert_same(json.loads(json.dumps(a).replace("<runs>", str(EXAMPLES / "square_ticks.csv"))), b)
+
+
+def test_numbers_reach_the_command_exactly():
+    # A float's repr round-trips: 0.1 + 0.2 is not 0.3, and the command sees the difference.
+    side = 0.1 + 0.2
+    r = umbmark.calibrate(EXAMPLES / "endpoints.csv", robot=ROBOT, side=side, no_heldout=True)
+    assert r.side_m == side
