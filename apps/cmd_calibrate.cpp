@@ -29,6 +29,7 @@
 #include "report/html_report.hpp"
 #include "formats/data_file.hpp"
 #include "formats/manifest.hpp"
+#include "formats/robot_id.hpp"
 #include "formats/ros2_params.hpp"
 
 namespace umbmark::cli {
@@ -231,12 +232,24 @@ nlohmann::json JsonHeldoutSummary(const HeldoutComparison& h) {
           {"notes", h.notes}};
 }
 
+// The robot's id (formats/robot_id.hpp): from --robot's file, else from the
+// manifest the input came from ("M.toml#k"), else none.
+std::string RobotIdOf(const CalibrateOptions& o, const CalibrateInput& in) {
+  if (!o.robot.robot_file.empty()) return io::ReadRobotId(o.robot.robot_file);
+  std::string path = in.label;
+  if (const auto hash = path.rfind('#'); hash != std::string::npos &&
+      path.find_first_not_of("0123456789", hash + 1) == std::string::npos && hash + 1 < path.size())
+    path.resize(hash);
+  return io::IsManifestPath(path) ? io::ReadRobotId(path) : std::string();
+}
+
 nlohmann::json JsonResult(const CalibrateInput& in, const CalibrateJobResult& r, const CalibrateOptions& o,
                           const HeldoutComparison& h, const ModelCheck& check, const Chosen& chosen,
                           const std::vector<std::string>& warnings) {
   const UmbmarkSummary& s = r.umbmark;
   nlohmann::json j;
   j["input"] = r.label;
+  if (const std::string id = RobotIdOf(o, in); !id.empty()) j["robot_id"] = id;  // for summarize
   j["method"] = "umbmark";
   j["estimator"] = UmbmarkEstimatorToString(s.estimator);
   j["side_m"] = s.side_m;

@@ -2,10 +2,17 @@
 // a fleet of robots from their `calibrate` JSON outputs (a batch output's
 // `results` count one robot each): one row per robot, the fleet's median and
 // robust spread of each parameter, and the robots that stand out (robust
-// z-score, calibration/fleet.hpp) with the reasons in words.
+// z-score, calibration/fleet.hpp) with the reasons in words. Robots are
+// named by their robot id (calibrate JSON `robot_id`, from the robot file) or
+// their file's stem; the --report page is summarize_report.cpp.
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <map>
 #include <memory>
+#include <set>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -17,9 +24,8 @@
 #include "output/atomic_write.hpp"
 #include "formats/file_text.hpp"
 #include "formats/csv_writer.hpp"
-#include "report/html_report.hpp"
 #include "formats/params_json.hpp"
-#include "report/svg_plot.hpp"
+#include "summarize_report.hpp"
 
 namespace umbmark::cli {
 namespace {
@@ -34,6 +40,8 @@ struct SummarizeOptions {
 
 struct Robot {
   FleetRobot fleet;
+  std::string robot_id;  // calibrate JSON `robot_id`, when it has one
+  std::string name;      // robot_id or the file's stem (unique over the fleet)
   nlohmann::json parameters;
   std::string source;  // "refined" or "umbmark"
 };
@@ -63,6 +71,8 @@ Robot RobotFromResult(const nlohmann::json& j, const std::string& file) {
   const bool refined = j.contains("refined") && j["refined"].is_object() && j["refined"].contains("parameters");
   r.parameters = refined ? j["refined"]["parameters"] : j.at("parameters");
   r.source = refined ? "refined" : "umbmark";
+  if (j.contains("robot_id") && j["robot_id"].is_string() && !j["robot_id"].get<std::string>().empty())
+    r.robot_id = j["robot_id"].get<std::string>();
   auto number = [&](const nlohmann::json& obj, const char* key, FleetQuantity q) {
     if (obj.contains(key) && obj[key].is_number()) r.fleet.values[q] = obj[key].get<double>();
   };
@@ -110,18 +120,50 @@ std::vector<Robot> ReadRobots(const std::string& path) {
 /// The inputs with each file once: the same file given twice (a.json and
 /// ./a.json, a symbolic or hard link: same device and inode) would count one
 /// robot twice and pull the fleet's median towards it. A warning names each
-/// repeat. Files that cannot be read are kept for the reader to report.
+/// repeat. Files that cannot be read are kept for the reader to report. One
+/// stat per input (thousands of robots).
 std::vector<std::string> DistinctInputs(const std::vector<std::string>& inputs, std::vector<std::string>& warnings) {
   std::vector<std::string> out;
+  std::map<std::pair<dev_t, ino_t>, std::string> seen;
+  std::map<std::string, std::string> unreadable;  // by the path as given, made lexically normal
   for (const auto& path : inputs) {
-    const auto same = std::find_if(out.begin(), out.end(), [&](const std::string& p) { return io::SameFile(p, path); });
-    if (same == out.end()) {
+    struct stat st {};
+    const std::string* first = nullptr;
+    if (::stat(path.c_str(), &st) == 0) {
+      const auto [it, fresh] = seen.emplace(std::pair{st.st_dev, st.st_ino}, path);
+      if (!fresh) first = &it->second;
+    } else {
+      const std::string key = std::filesystem::path(path).lexically_normal().string();
+      const auto [it, fresh] = unreadable.emplace(key, path);
+      if (!fresh) first = &it->second;
+    }
+    if (first == nullptr) {
       out.push_back(path);
     } else {
-      warnings.push_back(fmt::format("{} is the same file as {} (given twice): counted once", path, *same));
+      warnings.push_back(fmt::format("{} is the same file as {} (given twice): counted once", path, *first));
     }
   }
   return out;
+}
+
+/// Each robot's name for people: its robot id, else its file's stem (a
+/// batch output's results "stem#k"); a name given to several robots gets
+/// " (2)", " (3)", ... in input order.
+void NameRobots(std::vector<Robot>& robots) {
+  std::map<std::string, int> uses;
+  for (auto& r : robots) {
+    std::string name = r.robot_id;
+    if (name.empty()) {
+      const std::string& file = r.fleet.file;
+      const auto hash = file.rfind('#');
+      const bool batch = hash != std::string::npos && file.find('/', hash) == std::string::npos;
+      const std::string path = batch ? file.substr(0, hash) : file;
+      name = std::filesystem::path(path).stem().string() + (batch ? file.substr(hash) : "");
+      if (name.empty()) name = path;
+    }
+    const int k = ++uses[name];
+    r.name = k == 1 ? name : fmt::format("{} ({})", name, k);
+  }
 }
 
 std::string Fmt(double v, FleetQuantity q) {
@@ -134,39 +176,6 @@ std::string Fmt(double v, FleetQuantity q) {
   }
 }
 
-// Robust z-scores of every robot per quantity, outliers marked: a strip
-// chart with the threshold band.
-std::string FleetPlot(const std::vector<Robot>& robots, const FleetSummary& s, double threshold) {
-  std::vector<FleetQuantity> qs;
-  for (FleetQuantity q : kFleetQuantities)
-    if (s.fleet.count(q) && s.fleet.at(q).n >= 3) qs.push_back(q);
-  io::SvgPanel p(90, 40, 760, 360, "Robust z-score of each robot per quantity");
-  double zmax = threshold + 1.0;
-  for (const auto& r : s.robots)
-    for (const auto& [q, z] : r.z) zmax = std::max(zmax, std::abs(z) + 0.5);
-  p.SetExtent(-0.5, static_cast<double>(qs.size()) - 0.5, -zmax, zmax, false);
-  const double right = static_cast<double>(qs.size()) - 0.5;
-  p.Band({{-0.5, -threshold}, {right, -threshold}}, {{-0.5, threshold}, {right, threshold}}, "#888", 0.15);
-  std::vector<io::SvgPoint> normal, outlying;
-  for (std::size_t k = 0; k < qs.size(); ++k) {
-    for (std::size_t i = 0; i < robots.size(); ++i) {
-      const auto it = s.robots[i].z.find(qs[k]);
-      if (it == s.robots[i].z.end()) continue;
-      const double jitter = 0.25 * (static_cast<double>((i * 37) % 17) / 16.0 - 0.5);
-      (std::abs(it->second) > threshold ? outlying : normal).push_back({static_cast<double>(k) + jitter, it->second});
-    }
-    static const char* kShort[] = {"wheelbase", "D left", "D right", "E_d", "E_b", "E_max,syst", "after"};
-    p.Text({static_cast<double>(k) - 0.3, -zmax + (k % 2 == 0 ? 0.25 : 0.8)}, kShort[static_cast<int>(qs[k])], "#111", 11);
-  }
-  p.Axes("quantity (one column each; robots spread sideways)", "robust z = (value - median) / (1.4826 MAD)");
-  p.Points(normal, {"#35608f", "circle", "", 1.5, false}, 3.5);
-  p.Points(outlying, {"#b02020", "triangle", "", 1.5, true}, 5.5);
-  p.Legend({{{"#35608f", "circle", "", 1.5, false}, "robot within the fleet"},
-            {{"#b02020", "triangle", "", 1.5, true}, fmt::format("outlier (|z| > {})", threshold)},
-            {{"#888", "square", "", 1.5, true}, fmt::format("band |z| <= {}", threshold)}});
-  return io::SvgDocument(880, p.Bottom() + 10, {p.Render()});
-}
-
 /// The JSON of the fleet summary.
 nlohmann::json FleetJson(const SummarizeOptions& o, const std::vector<Robot>& robots, const FleetSummary& s,
                          std::size_t n_out, const std::vector<std::string>& warnings) {
@@ -176,6 +185,8 @@ nlohmann::json FleetJson(const SummarizeOptions& o, const std::vector<Robot>& ro
     nlohmann::json z = nlohmann::json::object();
     for (const auto& [q, v] : s.robots[i].z) z[FleetQuantityKey(q)] = v;
     j["robots"].push_back({{"file", robots[i].fleet.file},
+                           {"robot", robots[i].name},
+                           {"robot_id", robots[i].robot_id.empty() ? nlohmann::json(nullptr) : nlohmann::json(robots[i].robot_id)},
                            {"parameters", robots[i].parameters},
                            {"parameters_from", robots[i].source},
                            {"robust_z", z},
@@ -203,7 +214,7 @@ void PrintFleet(const SummarizeOptions& o, const std::vector<Robot>& robots, con
   fmt::print("  {:<40} {:>12} {:>12} {:>12}  {}\n", "robot", "wheelbase_m", "D_left_m", "D_right_m", "outlier");
   for (std::size_t i = 0; i < robots.size(); ++i) {
     const auto& p = robots[i].parameters;
-    fmt::print("  {:<40} {:>12.6f} {:>12.6f} {:>12.6f}  {}\n", robots[i].fleet.file, p["wheelbase_m"].get<double>(),
+    fmt::print("  {:<40} {:>12.6f} {:>12.6f} {:>12.6f}  {}\n", robots[i].name, p["wheelbase_m"].get<double>(),
                p["wheel_diameter_left_m"].get<double>(), p["wheel_diameter_right_m"].get<double>(),
                s.robots[i].outlier ? "OUTLIER" : "-");
     for (const auto& reason : s.robots[i].reasons) fmt::print("      {}\n", reason);
@@ -213,7 +224,7 @@ void PrintFleet(const SummarizeOptions& o, const std::vector<Robot>& robots, con
 
 /// --csv: one row per robot.
 std::string FleetCsv(const std::vector<Robot>& robots, const FleetSummary& s) {
-  std::string csv = "file,wheelbase_m,wheel_diameter_left_m,wheel_diameter_right_m,E_d,E_b,E_max_syst_m,residual_after_m,outlier,reasons\n";
+  std::string csv = "file,wheelbase_m,wheel_diameter_left_m,wheel_diameter_right_m,E_d,E_b,E_max_syst_m,residual_after_m,outlier,reasons,robot\n";
   for (std::size_t i = 0; i < robots.size(); ++i) {
     std::string row = io::CsvField(robots[i].fleet.file);
     for (FleetQuantity q : kFleetQuantities) {
@@ -222,54 +233,10 @@ std::string FleetCsv(const std::vector<Robot>& robots, const FleetSummary& s) {
     }
     std::string reasons;
     for (const auto& r : s.robots[i].reasons) reasons += (reasons.empty() ? "" : "; ") + r;
-    row += fmt::format(",{},{}\n", s.robots[i].outlier ? "true" : "false", io::CsvField(reasons));
+    row += fmt::format(",{},{},{}\n", s.robots[i].outlier ? "true" : "false", io::CsvField(reasons), io::CsvField(robots[i].name));
     csv += row;
   }
   return csv;
-}
-
-/// --report: the fleet page.
-std::string FleetReportHtml(const SummarizeOptions& o, const std::vector<Robot>& robots, const FleetSummary& s,
-                            std::size_t n_out, const std::vector<std::string>& warnings) {
-  io::HtmlReport rep("umbmark summarize: fleet of " + std::to_string(robots.size()) + " robots",
-                     fmt::format("{} calibration file(s)", o.inputs.size()));
-  if (n_out == 0)
-    rep.Headline(fmt::format("No robot stands out of the fleet of {} (robust |z| <= {} in every quantity).",
-                             robots.size(), o.fleet.threshold),
-                 io::HtmlReport::Level::kGood);
-  else
-    rep.Headline(fmt::format("{} of {} robots stand out of the fleet (robust |z| > {}).", n_out, robots.size(),
-                             o.fleet.threshold),
-                 io::HtmlReport::Level::kWarn);
-  std::vector<std::string> steps;
-  if (n_out > 0) {
-    steps.push_back("Inspect the flagged robots for the reason given (wheel wear, wheel mounting, tyre pressure).");
-    steps.push_back("Recalibrate a flagged robot after the repair and summarize again.");
-  } else {
-    steps.push_back("Load each robot's corrected parameters (its calibrate JSON, or the --ros2 snippet).");
-  }
-  rep.NextSteps(steps);
-  rep.Warnings(warnings);
-  rep.Heading("Fleet distribution");
-  std::vector<std::vector<std::string>> rows;
-  for (const auto& [q, st] : s.fleet)
-    rows.push_back({FleetQuantityKey(q), std::to_string(st.n), Fmt(st.median, q), Fmt(st.mad, q)});
-  rep.Table({"quantity", "robots", "median", "robust SD (1.4826 MAD)"}, rows);
-  rep.Heading("Robots");
-  rows.clear();
-  for (std::size_t i = 0; i < robots.size(); ++i) {
-    const auto& p = robots[i].parameters;
-    std::string reasons;
-    for (const auto& r : s.robots[i].reasons) reasons += (reasons.empty() ? "" : " | ") + r;
-    rows.push_back({robots[i].fleet.file, fmt::format("{:.6f}", p["wheelbase_m"].get<double>()),
-                    fmt::format("{:.6f}", p["wheel_diameter_left_m"].get<double>()),
-                    fmt::format("{:.6f}", p["wheel_diameter_right_m"].get<double>()),
-                    s.robots[i].outlier ? "OUTLIER" : "-", reasons});
-  }
-  rep.Table({"robot (file)", "wheelbase [m]", "D left [m]", "D right [m]", "outlier", "why"}, rows);
-  rep.Figure(FleetPlot(robots, s, o.fleet.threshold),
-             "Each robot's robust z-score per quantity; the grey band is the outlier threshold. Triangles: outliers.");
-  return rep.Render();
 }
 
 // Read the fleet, summarise, then text, CSV, report and JSON in turn.
@@ -286,8 +253,9 @@ int RunSummarize(const SummarizeOptions& o) {
   std::vector<Robot> robots;
   for (const auto& path : DistinctInputs(o.inputs, warnings)) {
     auto more = ReadRobots(path);
-    robots.insert(robots.end(), more.begin(), more.end());
+    robots.insert(robots.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
   }
+  NameRobots(robots);
   std::vector<FleetRobot> fr;
   for (const auto& r : robots) fr.push_back(r.fleet);
   const FleetSummary s = SummarizeFleet(fr, o.fleet);
@@ -310,7 +278,9 @@ int RunSummarize(const SummarizeOptions& o) {
     written.push_back(o.csv + " (CSV, one row per robot)");
   }
   if (!o.report.empty()) {
-    outs.Write(o.report, FleetReportHtml(o, robots, s, n_out, warnings));
+    FleetPage page{{}, &fr, &s, o.fleet.threshold, o.inputs.size(), n_out, warnings};
+    for (const auto& r : robots) page.names.push_back(r.name);
+    outs.Write(o.report, FleetReportHtml(page));
     written.push_back(o.report + " (HTML report)");
   }
   o.json.EmitAndListOutputs(j, written);

@@ -189,3 +189,57 @@ TEST_CASE("summarize compares E_b and E_d only between robots with the same reco
     CHECK(s.robots[i].reference.at(FleetQuantity::kEb).median == Approx(i < 3 ? 1.001 : 1.101));
   }
 }
+
+// Issue 31: robots are named by their robot id (robot file -> calibrate JSON
+// -> summarize) or their file's stem, never by path; the report lists the
+// outlier robots only, each by name.
+TEST_CASE("summarize names robots by robot_id or file stem; the report's table holds the outliers only", "[fleet][cli]") {
+  const fs::path dir = TempDir("fleet-names");
+  // A robot file with an id: calibrate copies it into its JSON.
+  std::ofstream(dir / "robot.toml") << Slurp((kEx / "robot.toml").string()) << "robot_id = \"SN-7731\"\n";
+  const fs::path real = dir / "real.json";
+  const auto cal = RunCli("calibrate " + Q(kEx / "endpoints.csv") + " --robot " + Q(dir / "robot.toml") +
+                          " --side 4 --no-heldout --json " + Q(real));
+  INFO(cal.err);
+  REQUIRE(cal.status == 0);
+  CHECK(nlohmann::json::parse(Slurp(real.string()))["robot_id"] == "SN-7731");
+  // The generated fleet: ids on every fifth robot, file stems elsewhere, two files with one stem.
+  std::string args = "summarize";
+  int k = 0;
+  for (auto j : Fleet()) {
+    if (k % 5 == 0) j["robot_id"] = "R-" + std::to_string(k);
+    const fs::path sub = dir / (k == 11 ? "b" : "a");
+    fs::create_directories(sub);
+    const fs::path f = sub / (k == 11 ? "robot10.json" : "robot" + std::to_string(k) + ".json");
+    std::ofstream(f) << j.dump();
+    args += " " + Q(f);
+    ++k;
+  }
+  const auto r = RunCli(args + " " + Q(real) + " --json - --report " + Q(dir / "fleet.html"));
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  CHECK(j["robots"][5]["robot"] == "R-5");
+  CHECK(j["robots"][5]["robot_id"] == "R-5");
+  CHECK(j["robots"][7]["robot"] == "robot7");
+  CHECK(j["robots"][7]["robot_id"].is_null());
+  CHECK(j["robots"][10]["robot"] == "R-10");  // a/robot10.json has the id R-10
+  CHECK(j["robots"][11]["robot"] == "robot10");  // b/robot10.json: its stem, free
+  CHECK(j["robots"][40]["robot"] == "SN-7731");
+  CHECK(j["robots"][7]["file"] == (dir / "a" / "robot7.json").string());  // the path stays in `file`
+  const std::string html = Slurp((dir / "fleet.html").string());
+  const auto table = html.substr(html.find("Outlier robots"), html.find("Fleet distribution") - html.find("Outlier robots"));
+  CHECK(table.find("<td>robot7</td>") != std::string::npos);    // worn left wheel
+  CHECK(table.find("<td>robot23</td>") != std::string::npos);   // mis-assembled
+  CHECK(table.find("<td>robot3</td>") == std::string::npos);    // within the fleet: not in the table
+  CHECK(std::count(table.begin(), table.end(), '\n') == static_cast<long>(j["outliers"].get<int>()) + 3);  // heading, table head, rows, table end
+  CHECK(html.find(dir.string()) == std::string::npos);          // no path anywhere on the page
+  CHECK(html.find("data-title=\"Corrected wheelbase (41 robots)\"") != std::string::npos);
+
+  // A robot id with a control character is refused at its value.
+  std::ofstream(dir / "bad.toml") << "wheelbase_m = 0.2\nwheel_diameter_left_m = 0.084\nwheel_diameter_right_m = 0.084\n"
+                                  << "robot_id = \"R\\u0007\"\n";
+  const auto bad = RunCli("calibrate " + Q(kEx / "endpoints.csv") + " --robot " + Q(dir / "bad.toml") + " --side 4");
+  CHECK(bad.status == 1);
+  CHECK(bad.err.find("bad.toml:4:12: robot_id contains a control character") != std::string::npos);
+}
