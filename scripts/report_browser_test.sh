@@ -3,7 +3,12 @@
 # loads from a file with the network off, the browser logs no console error,
 # the rendered DOM holds the expected elements (headline, tables, inline SVG
 # plots with ticks and legends), and a screenshot is taken (kept in OUTDIR
-# for a person to look at). Usage: report_browser_test.sh UMBMARK_EXE SRC_DIR [OUTDIR]
+# for a person to look at). The fleet page (summarize) is also rendered for a
+# generated fleet of 8 and of 5,000 robots (bench/fleet_gen.sh), and every
+# page must fit a 1280 px window with no horizontal scroll (a copy of the
+# page with a line of script that writes the document's scroll width into
+# it is rendered by --dump-dom; the reports themselves carry no script).
+# Usage: report_browser_test.sh UMBMARK_EXE SRC_DIR [OUTDIR]
 set -euo pipefail
 exe=$1
 src=$2
@@ -21,9 +26,14 @@ ex="$src/data/examples"
 "$exe" diagnose "$ex/diagnose.toml" --null-sims 100 --report "$out/diagnose.html" >/dev/null
 cp "$out/cal.json" "$out/cal2.json"
 "$exe" summarize "$out/cal.json" "$out/cal2.json" "$out/cal.json" --report "$out/summarize.html" >/dev/null
+for n in 8 5000; do
+  rm -rf "$out/fleet$n"
+  bash "$src/bench/fleet_gen.sh" "$n" "$out/fleet$n" >/dev/null
+  "$exe" summarize "$out/fleet$n"/*.json --report "$out/fleet-$n.html" >/dev/null
+done
 
 fail=0
-for page in calibrate evaluate fit-noise diagnose summarize; do
+for page in calibrate evaluate fit-noise diagnose summarize fleet-8 fleet-5000; do
   html="$out/$page.html"
   profile=$(mktemp -d)
   flags=(--headless --no-sandbox --disable-gpu --disable-quic --no-first-run --disable-background-networking
@@ -31,6 +41,11 @@ for page in calibrate evaluate fit-noise diagnose summarize; do
   timeout 120 "$browser" "${flags[@]}" --dump-dom "file://$html" >"$out/$page.dom" 2>"$out/$page.log" || true
   timeout 120 "$browser" "${flags[@]}" --screenshot="$out/$page.png" --window-size=1280,2400 "file://$html" \
     >/dev/null 2>>"$out/$page.log" || true
+  # Width: the page's scroll width in a 1280 px window, from a copy with one line of script.
+  sed 's|</body>|<script>document.body.insertAdjacentHTML("beforeend", "<pre id=\\"scroll-width\\">" + document.documentElement.scrollWidth + " " + window.innerWidth + "</pre>");</script></body>|' \
+    "$html" >"$out/$page.width.html"
+  timeout 120 "$browser" "${flags[@]}" --window-size=1280,900 --dump-dom "file://$out/$page.width.html" \
+    >"$out/$page.width.dom" 2>>"$out/$page.log" || true
   rm -rf "$profile"
   problems=()
   grep -q 'class="headline' "$out/$page.dom" || problems+=("no headline")
@@ -43,6 +58,9 @@ for page in calibrate evaluate fit-noise diagnose summarize; do
   # Console messages of the page (errors of the page itself, not the browser's own start-up noise).
   grep -E 'CONSOLE|Uncaught|Failed to load' "$out/$page.log" && problems+=("console errors")
   [ -s "$out/$page.png" ] || problems+=("no screenshot")
+  read -r scroll_w window_w < <(sed -n 's|.*<pre id="scroll-width">\([0-9]*\) \([0-9]*\)</pre>.*|\1 \2|p' "$out/$page.width.dom") || true
+  if [ -z "${scroll_w:-}" ]; then problems+=("scroll width not measured")
+  elif [ "$scroll_w" -gt "$window_w" ]; then problems+=("horizontal scroll: ${scroll_w} px wide in a ${window_w} px window"); fi
   # Page-specific elements: what each report must show.
   case $page in
     calibrate)
@@ -57,12 +75,17 @@ for page in calibrate evaluate fit-noise diagnose summarize; do
       grep -q 'class="series band"' "$out/$page.dom" || problems+=("no 95% band")
       grep -q 'What to do next' "$out/$page.dom" || problems+=("no next steps")
       grep -q ' mrad (se ' "$out/$page.dom" || problems+=("candidate parameters without units") ;;
+    fleet-8 | fleet-5000)
+      grep -q 'Outlier robots' "$out/$page.dom" || problems+=("no table of the outlier robots")
+      grep -q 'R-00008' "$out/$page.dom" || problems+=("outlier R-00008 not named by its robot id")
+      grep -q "$out/fleet" "$out/$page.dom" && problems+=("a robot named by its path")
+      [ "$(grep -o 'data-title="' "$out/$page.dom" | wc -l)" -ge 7 ] || problems+=("not one distribution plot per quantity") ;;
   esac
   if [ ${#problems[@]} -gt 0 ]; then
     echo "FAIL $page: ${problems[*]}"
     fail=1
   else
-    echo "ok   $page ($(wc -c <"$html") bytes, screenshot $out/$page.png)"
+    echo "ok   $page ($(wc -c <"$html") bytes, ${scroll_w} px wide in ${window_w}, screenshot $out/$page.png)"
   fi
 done
 exit $fail

@@ -58,7 +58,7 @@ h2 { font-size: 1.15em; margin-top: 1.6em; border-bottom: 1px solid #ccc; }
 .headline.good { border-color: #2b7a2b; background: #eef7ee; } .headline.warn { border-color: #b07800; background: #fff7e0; }
 .headline.bad { border-color: #b02020; background: #fdecec; } .headline.info { border-color: #35608f; background: #eef3f9; }
 table.numbers { border-collapse: collapse; margin: 8px 0; font-size: 0.95em; }
-table.numbers th, table.numbers td { border: 1px solid #ccc; padding: 3px 9px; text-align: left; overflow-wrap: anywhere; }
+table.numbers th, table.numbers td { border: 1px solid #ccc; padding: 3px 9px; text-align: left; overflow-wrap: break-word; }
 table.numbers th { background: #f0f0f0; } td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
 .warnings { background: #fff7e0; padding: 4px 12px; }
 figure.plot { margin: 18px 0; overflow-x: auto; } figure.plot svg { max-width: 100%; height: auto; }
