@@ -62,6 +62,7 @@ struct CalibrateOptions {
   std::string use = "recommended";
   bool per_experiment = false;
   bool no_heldout = false;  // --no-heldout: skip the held-out comparison
+  std::optional<double> scan_range_scale;  // --scan-range-scale: a lidar's range calibration (scan ground truth)
 };
 
 // The parameters --ros2 and --plot use: --use classic | refined |
@@ -74,7 +75,46 @@ struct Chosen {
   /// recorded robot: the method's own factors where it has them (exact), else
   /// ratios of the parameters.
   double separation = 1.0, left = 1.0, right = 1.0;
+  /// Where the multipliers' overall scale comes from, for the YAML comment
+  /// and the JSON (`outputs_use.scale_source`): "kept" (the mean wheel
+  /// diameter of the recorded robot, as classic UMBmark), "ground_truth"
+  /// (fitted to the ground truth's distances), "range_scale" (fitted to a
+  /// lidar's distances corrected by --scan-range-scale).
+  std::string scale_source = "ground_truth";
+  std::string scale_note = "";
 };
+
+// Scan ground truth (a lidar's registration) carries the lidar's range
+// scale: from scans alone only the wheels' ratio and the wheelbase relative
+// to them are observable, not their overall scale. The classic estimate
+// keeps the recorded scale; a method fitted to the scans' distances is
+// rescaled by a stated range calibration (--scan-range-scale), else to keep
+// the recorded scale too (mean radius multiplier 1).
+Chosen ScaleForScanGroundTruth(Chosen c, const std::string& ground_truth_source, std::optional<double> range_scale,
+                               const RobotParams& recorded) {
+  const bool classic = c.method.rfind("umbmark_", 0) == 0 || c.method == "recorded";
+  if (classic) {
+    c.scale_source = "kept";
+    c.scale_note = "the overall scale kept: the classic estimate changes only the wheels' ratio and the wheelbase";
+    return c;
+  }
+  if (ground_truth_source != "scan") return c;
+  const double factor = range_scale ? *range_scale : 0.5 * (c.left + c.right);
+  c.separation /= factor;
+  c.left /= factor;
+  c.right /= factor;
+  c.parameters.wheelbase_m = c.separation * recorded.wheelbase_m;
+  c.parameters.wheel_diameter_left_m = c.left * recorded.wheel_diameter_left_m;
+  c.parameters.wheel_diameter_right_m = c.right * recorded.wheel_diameter_right_m;
+  c.scale_source = range_scale ? "range_scale" : "kept";
+  c.scale_note = range_scale
+                     ? fmt::format("the overall scale from the lidar's distances divided by its stated range scale {} "
+                                   "(--scan-range-scale)", *range_scale)
+                     : fmt::format("the overall scale kept (the fit's {:.5f} divided out): its ground truth is a lidar's "
+                                   "scans, whose range scale cannot be told from the wheels' (give --scan-range-scale S "
+                                   "from a range calibration to use the fitted scale)", factor);
+  return c;
+}
 
 Chosen WithRatios(Chosen c, const RobotParams& recorded) {
   c.separation = c.parameters.wheelbase_m / recorded.wheelbase_m;
@@ -293,7 +333,10 @@ nlohmann::json JsonResult(const CalibrateInput& in, const CalibrateJobResult& r,
                                                       {"dof", check.dof},
                                                       {"p_value", check.p_value}}
                                      : nlohmann::json(nullptr);
-  j["outputs_use"] = {{"method", chosen.method}, {"parameters", JsonParams(chosen.parameters)}, {"why", chosen.why}};
+  j["outputs_use"] = {{"method", chosen.method},
+                      {"parameters", JsonParams(chosen.parameters)},
+                      {"why", chosen.why},
+                      {"scale_source", chosen.scale_source}};
   j["warnings"] = warnings;
   if (r.evaluation) {
     const auto& a = *r.evaluation;
@@ -432,6 +475,8 @@ std::string Ros2Parameters(const CalibrateJobResult& r, const Chosen& chosen, co
       controller, m, r.umbmark.recorded,
       {fmt::format("ros2_control diff_drive_controller parameters from umbmark calibrate: {} ({})", chosen.method,
                    r.label),
+       chosen.scale_note.empty() ? std::string("overall scale: fitted to the ground truth's distances")
+                                 : "overall scale: " + chosen.scale_note,
        "Load with: ros2 param load /" + controller + " FILE (or add to the controller's --param-file list)"});
 }
 
@@ -662,11 +707,19 @@ struct UnitAssessment {
   std::vector<std::string> warnings;
 };
 
+// `ground_truth_source`: the manifest's [ground_truth] source ("scan": the
+// overall scale of fitted methods is the lidar's, ScaleForScanGroundTruth).
 UnitAssessment Assess(const CalibrateInput& in, const FittedUnit& f, const CalibrateOptions& o,
-                      const CalibrateJobOptions& jo) {
+                      const CalibrateJobOptions& jo, const std::string& ground_truth_source) {
   const CalibrateJobResult& r = f.result;
   HeldoutComparison heldout = o.no_heldout ? SkippedHeldout() : CompareMethodsHeldout(in, jo, r);
-  Chosen chosen = ChooseParameters(r, heldout, o.use);
+  Chosen chosen =
+      ScaleForScanGroundTruth(ChooseParameters(r, heldout, o.use), ground_truth_source, o.scan_range_scale, r.umbmark.recorded);
+  if (ground_truth_source == "scan") {
+    heldout.notes.push_back("the ground truth is a lidar's scans (manifest [ground_truth] source = \"scan\"): a method "
+                            "fitting the overall wheel scale fits the lidar's range scale; " + chosen.scale_note);
+    if (!chosen.scale_note.empty()) chosen.why += "; " + chosen.scale_note;
+  }
   const ModelCheck check = CheckCentresAgainstModel(in, r.umbmark.runs, r.refined ? r.refined->refined : r.umbmark.corrected,
                                                     jo.refine ? jo.refine->final_turn : true);
   std::vector<std::string> warnings = TrustWarnings(r, heldout, check);
@@ -804,7 +857,7 @@ std::optional<FittedUnit> CalibrateBatch::Fit(const CalibrateInput& in) {
 /// A fitted unit: assessed, its outputs written, printed (or its warnings on
 /// stderr), its JSON and summary row kept.
 void CalibrateBatch::Conclude(const std::string& path, const CalibrateInput& in, bool several, FittedUnit f) {
-  const UnitAssessment a = Assess(in, f, o_, jo_);
+  const UnitAssessment a = Assess(in, f, o_, jo_, io::IsManifestPath(path) ? io::ReadGroundTruthSource(path) : std::string());
   CalibrateJobResult& r = f.result;
   WriteOutputs(in, r, a, UniqueTag(path, in), several);
   if (o_.json.PrintText()) {
@@ -919,6 +972,11 @@ Command SetupCalibrate(CLI::App& parent) {
   app->add_option("--ros2", opts->ros2,
                   "Write a ros2_control diff_drive_controller parameter file (YAML for ros2 param load) of the --use "
                   "calibration");
+  app->add_option("--scan-range-scale", opts->scan_range_scale,
+                  "Scan ground truth (import rosbag2 --scan): the lidar's range scale from a range calibration "
+                  "(measured range / true distance, e.g. 1.01); the --ros2 multipliers' overall scale then comes from "
+                  "the scans' distances divided by it, instead of being kept")
+      ->check(NumberIn(0.5, 2.0));
   app->add_option("--controller", opts->controller, "Controller name at the top of the --ros2 file")
       ->capture_default_str();
   app->add_option("--plot", opts->plot,

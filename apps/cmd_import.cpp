@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <set>
 
 #include <fmt/format.h>
 
@@ -100,7 +101,7 @@ int RunImportOptiOdom(const ImportOptions& o) {
                ds.robot.wheel_diameter_left_m, ds.robot.wheel_diameter_right_m, *ds.robot.ticks_per_rev);
     if (ds.experiment.kind == ExperimentKind::kSquare) fmt::print("  experiment: square, side {} m\n", ds.experiment.side_m);
     for (const auto& r : ds.runs.runs) fmt::print("  run {:>3}  {:<9} {} samples\n", r.run, r.direction, r.size());
-    for (const auto& w : warnings) fmt::print("warning: {}\n", w);
+    for (const auto& w : warnings) fmt::print(stderr, "warning: {}\n", w);
     fmt::print("  wrote {}\n  wrote {}\n", manifest_path, runs_path);
   } else {
     for (const auto& w : warnings) fmt::print(stderr, "warning: {}\n", w);
@@ -162,6 +163,14 @@ void PrintScanSummary(const io::rosbag2::Rosbag2Import& r) {
   for (const auto& rec : r.scan) {
     fmt::print("  lidar {}: {} scans; pose in the robot frame x {:.4f} m, y {:.4f} m, yaw {:.4f} rad ({})\n",
                rec.scan_frame, rec.scans, rec.mount.x, rec.mount.y, rec.mount.theta, rec.mount_source);
+    const auto& me = rec.mount_estimate;
+    if (me.pairs > 0)
+      fmt::print("  mount as the scans and the wheels see it: yaw {:.4f} rad{} ({} stretches, {:.1f} m, {:.1f} rad)\n",
+                 me.yaw_rad, me.position_determined ? fmt::format(", x {:.3f} m, y {:.3f} m", me.x_m, me.y_m) : std::string(),
+                 me.pairs, me.straight_m, me.turned_rad);
+    if (rec.clock_determined)
+      fmt::print("  scan clock: header.stamp minus first ray {:+.3f} s (the scans' range changes follow the wheels with "
+                 "correlation {:.2f})\n", rec.scan_time_offset_s, rec.clock_correlation);
     if (rec.gyro)
       fmt::print("  gyro: bias {:.6f} rad/s (+- {:.1e}, {} still readings), scale {:.5f} (measured / true yaw rate)\n",
                  rec.gyro->bias_rad_s, rec.gyro->bias_sd_rad_s, rec.gyro->still_samples, rec.gyro->scale);
@@ -212,7 +221,17 @@ nlohmann::json ScanJson(const io::rosbag2::Rosbag2Import& r) {
                            {"scans", rec.scans},
                            {"scan_pose", {JsonNumber(rec.mount.x), JsonNumber(rec.mount.y), JsonNumber(rec.mount.theta)}},
                            {"scan_pose_from", rec.mount_source},
+                           {"scan_upside_down", rec.upside_down},
+                           {"scan_time_offset_s", JsonNumber(rec.scan_time_offset_s)},
+                           {"scan_clock_determined", rec.clock_determined},
                            {"runs", runs}};
+    if (rec.mount_estimate.pairs > 0) {
+      const auto& me = rec.mount_estimate;
+      jrec["scan_pose_from_motion"] = {{"yaw_rad", JsonNumber(me.yaw_rad)},
+                                       {"x_m", me.position_determined ? JsonNumber(me.x_m) : nlohmann::json()},
+                                       {"y_m", me.position_determined ? JsonNumber(me.y_m) : nlohmann::json()},
+                                       {"stretches", me.pairs}};
+    }
     if (rec.gyro) {
       jrec["gyro_bias_rad_s"] = JsonNumber(rec.gyro->bias_rad_s);
       jrec["gyro_scale"] = JsonNumber(rec.gyro->scale);
@@ -232,11 +251,20 @@ void PrintListedTopic(const io::rosbag2::TopicListing& l) {
   std::string use;
   if (l.wheels) use = l.topic.type == "sensor_msgs/msg/JointState" ? "--wheels" : "--odometry";
   if (l.ground_truth) use += use.empty() ? "--ground-truth" : ", --ground-truth";
+  if (l.robot_odometry) use += fmt::format(" (frame {}: the robot's own odometry, not ground truth)", l.frame_id);
+  if (l.scan) use = "--scan (the lidar as ground truth)";
+  if (l.scan && l.mount)
+    use += fmt::format("; mount x {:.3f} m, y {:.3f} m, yaw {:.3f} rad{} ({} -> {})", l.mount->pose.x, l.mount->pose.y,
+                       l.mount->pose.theta, l.mount->upside_down ? ", upside down" : "", l.mount->base_frame, l.frame_id);
+  else if (l.scan)
+    use += fmt::format("; frame {} has no static transform: give --scan-pose X,Y,YAW", l.frame_id);
+  if (l.imu) use = "--imu (gyro, with --scan)";
+  if (l.static_transforms) use = "the lidar's mount (--tf-static)";
   if (!l.joints.empty()) use += fmt::format(" (joints: {})", io::rosbag2::TrimmedList(l.joints, 30));
-  if (!l.tf.empty()) use += " with --ground-truth-frame FRAME:";
+  if (!l.tf.empty() && !l.static_transforms) use += " with --ground-truth-frame FRAME:";
   const std::string lag = l.header_minus_receive_s ? fmt::format("{:+.3f}", *l.header_minus_receive_s) : std::string();
-  fmt::print("  {:<28} {:<44} {:>9} {:>9.1f} {:>12}  {}\n", l.topic.name, l.topic.type, l.topic.count, l.topic.RateHz(), lag,
-             use);
+  const std::string topic_rate = l.static_transforms ? std::string("static") : fmt::format("{:.1f}", l.topic.RateHz());
+  fmt::print("  {:<28} {:<44} {:>9} {:>9} {:>12}  {}\n", l.topic.name, l.topic.type, l.topic.count, topic_rate, lag, use);
   for (std::size_t i = 0; i < l.tf.size() && i < kMaxFrames; ++i) {
     const auto& f = l.tf[i];
     const std::string rate = f.edge.is_static ? std::string("static") : fmt::format("{:.1f} Hz", f.edge.RateHz());
@@ -264,6 +292,15 @@ nlohmann::json ListedTopicJson(const io::rosbag2::TopicListing& l) {
           {"rate_hz", JsonNumber(l.topic.RateHz())},
           {"wheels", l.wheels},
           {"ground_truth", l.ground_truth},
+          {"robot_odometry", l.robot_odometry},
+          {"scan", l.scan},
+          {"imu", l.imu},
+          {"static", l.static_transforms},
+          {"scan_pose", l.mount ? nlohmann::json{{"x_m", JsonNumber(l.mount->pose.x)}, {"y_m", JsonNumber(l.mount->pose.y)},
+                                                 {"yaw_rad", JsonNumber(l.mount->pose.theta)},
+                                                 {"upside_down", l.mount->upside_down},
+                                                 {"base_frame", l.mount->base_frame}}
+                                : nlohmann::json()},
           {"joints", l.joints},
           {"child_frames", l.frames},
           {"header_minus_receive_s", l.header_minus_receive_s ? JsonNumber(*l.header_minus_receive_s) : nlohmann::json()},
@@ -291,7 +328,7 @@ int RunRosbag2List(const Rosbag2Options& o) {
     std::size_t usable = 0, other = 0, omitted = 0;
     for (const bool want_usable : {true, false})
       for (const auto& l : listing.topics) {
-        const bool is_usable = l.wheels || l.ground_truth;
+        const bool is_usable = l.wheels || l.ground_truth || l.scan || l.imu || l.static_transforms;
         if (is_usable != want_usable) continue;
         if (is_usable ? usable++ >= kMaxUsable : other++ >= kMaxOther) {
           ++omitted;
@@ -310,7 +347,9 @@ int RunRosbag2List(const Rosbag2Options& o) {
     fmt::print("stamp-recv: header stamp minus receive time of the first message; topics far apart were stamped by "
                "different clocks (--time WHEELS,GROUND_TRUTH)\n");
     fmt::print("Next: umbmark import rosbag2 BAG --out DIR --experiment square --side S --robot R.toml "
-               "--wheels TOPIC [--left-joint J --right-joint J] --ground-truth TOPIC [--ground-truth-frame FRAME]\n");
+               "--wheels TOPIC [--left-joint J --right-joint J] --ground-truth TOPIC [--ground-truth-frame FRAME]\n"
+               "  or, without motion capture: ... --wheels TOPIC --scan TOPIC [--imu TOPIC] [--tf-static TOPIC] "
+               "(docs/ros2.md, \"Recording a calibration bag without motion capture\")\n");
   }
   o.json.Emit({{"bags", bags}, {"warnings", warnings}});
   return 0;
@@ -396,7 +435,7 @@ int RunRosbag2(Rosbag2Options o) {
       fmt::print("  run {:>3}  {:<14} {:>6} samples  t {:8.2f} .. {:8.2f} s  travel L {:7.3f} m  R {:7.3f} m\n", r.run,
                  r.direction, r.size(), r.t_s.front(), r.t_s.back(), r.dist_left_m.back(), r.dist_right_m.back());
     PrintScanSummary(result);
-    for (const auto& w : warnings) fmt::print("warning: {}\n", w);
+    for (const auto& w : warnings) fmt::print(stderr, "warning: {}\n", w);
     fmt::print("  wrote {}\n  wrote {}\nNext: umbmark calibrate {} (squares) or umbmark fit-noise {}\n", manifest_path,
                runs_path, manifest_path, manifest_path);
   }
@@ -410,6 +449,18 @@ int RunRosbag2(Rosbag2Options o) {
   if (!result.scan.empty()) j["ground_truth"] = ScanJson(result);
   o.json.Emit(j);
   return 0;
+}
+
+// --time: header, log, or WHEELS,GROUND_TRUTH of those two (the help shows
+// the choices as written, not CLI11's expansion of a member list).
+CLI::Validator TimeChoice() {
+  return CLI::Validator(
+      [](std::string& v) -> std::string {
+        static const std::set<std::string> ok = {"header", "log", "header,log", "log,header", "header,header", "log,log"};
+        return ok.count(v) > 0 ? std::string()
+                               : fmt::format("--time '{}': expected header, log, or WHEELS,GROUND_TRUTH (e.g. header,log)", v);
+      },
+      "header|log|WHEELS,GROUND_TRUTH");
 }
 
 }  // namespace
@@ -454,6 +505,13 @@ Command SetupImport(CLI::App& parent) {
                               "Ground truth from the robot's lidar instead: sensor_msgs/msg/LaserScan topic (scan registration)");
   rb->add_option("--scan-pose", ro->scan_pose,
                  "The lidar's pose in the robot frame X,Y,YAW [m, m, rad] when /tf_static does not give it")->needs(scan);
+  rb->add_flag("--scan-upside-down", ro->import.scan_upside_down,
+               "The lidar is mounted upside down (its beam angles run mirrored), when /tf_static does not say so")
+      ->needs(scan);
+  rb->add_option("--tf-static", ro->import.tf_static_topic,
+                 "tf2_msgs/msg/TFMessage topic with the lidar's mounting transform (default /tf_static, or the only "
+                 "topic named .../tf_static, e.g. /robot1/tf_static)")
+      ->needs(scan);
   rb->add_option("--imu", ro->import.imu_topic,
                  "sensor_msgs/msg/Imu topic: gyro bias and scale against the scans, a second heading reference")->needs(scan);
   scan->excludes(rb->get_option("--ground-truth"));
@@ -461,7 +519,7 @@ Command SetupImport(CLI::App& parent) {
                  "Time stamps: header (header.stamp) or log (receive time), for both streams; or WHEELS,GROUND_TRUTH "
                  "(e.g. header,log: the wheels by header stamp, the ground truth by receive time)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"header", "log", "header,log", "log,header", "header,header", "log,log"}));
+      ->check(TimeChoice());
   rb->add_option("--integrator", ro->integrator, "Integrator the robot's /odom used (for --odometry)")
       ->capture_default_str()
       ->check(CLI::IsMember({"arc", "midpoint"}));

@@ -98,7 +98,8 @@ Experiment ReadExperiment(const toml::table& t, std::size_t number, const std::f
 void CheckImportedGroundTruthKeys(const toml::table& gt, const std::string& path) {
   for (const char* key : {"source", "scan_pose_from"})
     if (const toml::node* n = gt.get(key)) detail::StringValue(*n, key, path);
-  for (const char* key : {"scan_pose_x_m", "scan_pose_y_m", "scan_pose_yaw_rad", "gyro_bias_rad_s", "gyro_scale"}) {
+  for (const char* key : {"scan_pose_x_m", "scan_pose_y_m", "scan_pose_yaw_rad", "scan_time_offset_s", "gyro_bias_rad_s",
+                          "gyro_scale"}) {
     if (const toml::node* n = gt.get(key)) {
       const double v = detail::NumberValue(*n, key, path);
       if (!std::isfinite(v)) FailAt(path, n->source(), fmt::format("{} = {} must be finite", key, v));
@@ -138,7 +139,8 @@ Manifest ParseManifest(std::string_view text, const std::string& path) {
   if (root.contains("ground_truth")) {
     const toml::table& gt = RequireTable(root, "ground_truth", path);
     detail::RejectUnknownKeys(gt, {"sigma_xy_m", "sigma_theta_rad", "source", "scan_pose_x_m", "scan_pose_y_m",
-                                   "scan_pose_yaw_rad", "scan_pose_from", "gyro_bias_rad_s", "gyro_scale"},
+                                   "scan_pose_yaw_rad", "scan_pose_from", "scan_time_offset_s", "gyro_bias_rad_s",
+                                   "gyro_scale"},
                               "[ground_truth]", path);
     CheckImportedGroundTruthKeys(gt, path);
     GroundTruthNoise noise;
@@ -166,6 +168,13 @@ Manifest ParseManifest(std::string_view text, const std::string& path) {
 }
 
 Manifest ReadManifest(const std::string& path) { return ParseManifest(ReadWholeFile(path), path); }
+
+std::string ReadGroundTruthSource(const std::string& path) {
+  const toml::table root = detail::ParseTomlText(ReadWholeFile(path), path);
+  const toml::table* gt = root.get_as<toml::table>("ground_truth");
+  const toml::node* n = gt ? gt->get("source") : nullptr;
+  return n ? detail::StringValue(*n, "source", path) : std::string();
+}
 
 bool IsManifestPath(const std::string& path) {
   return path.size() >= 5 && path.compare(path.size() - 5, 5, ".toml") == 0;

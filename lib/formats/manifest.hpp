@@ -26,4 +26,9 @@ Manifest ParseManifest(std::string_view text, const std::string& path);
 /// accept either `DATA.csv --robot R.toml` or `MANIFEST.toml`.
 bool IsManifestPath(const std::string& path);
 
+/// [ground_truth] source of a manifest as its importer wrote it ("scan": the
+/// lidar's registration, whose distances carry the lidar's range scale), or
+/// "" when the manifest does not say. Throws InputError as ReadManifest.
+std::string ReadGroundTruthSource(const std::string& path);
+
 }  // namespace umbmark::io

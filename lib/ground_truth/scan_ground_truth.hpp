@@ -10,7 +10,9 @@
 //           grow with the recording's length beyond one pose per scan).
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <map>
 #include <functional>
 #include <optional>
 #include <string>
@@ -20,7 +22,9 @@
 #include "core/runs.hpp"
 #include "formats/campaign_writer.hpp"
 #include "ros2/bag.hpp"
+#include "ros2/messages.hpp"
 #include "scan/gyro_calibration.hpp"
+#include "scan/mount_check.hpp"
 #include "scan/scan_track.hpp"
 
 namespace umbmark::io::rosbag2 {
@@ -29,9 +33,46 @@ struct ScanSourceOptions {
   std::string scan_topic;             ///< sensor_msgs/msg/LaserScan
   std::string imu_topic;              ///< sensor_msgs/msg/Imu (optional)
   std::optional<Pose2> scan_pose;     ///< --scan-pose: the lidar in the robot frame, when /tf_static lacks it
+  /// --tf-static: the static transform topic; empty = /tf_static, else the
+  /// only topic named .../tf_static (a namespaced robot).
+  std::string tf_static_topic;
+  bool upside_down = false;           ///< --scan-upside-down: the lidar is mounted upside down (beams mirrored)
+  std::string left_joint, right_joint;  ///< the wheel joints (for a message about swapped wheels)
   bool log_time = false;              ///< stamps: receive time instead of header.stamp
   std::int64_t origin_ns = 0;         ///< times in messages are given from here (the first wheel sample)
   scan::TrackOptions track;           ///< registration settings (mount is set from the above)
+};
+
+/// The lidar's mount as static transforms give it.
+struct LidarMount {
+  Pose2 pose;                 ///< x, y and the yaw of the scan's x axis in the base frame
+  bool upside_down = false;   ///< the scan's z axis points down (roll or pitch pi): beams mirrored
+  double tilt_rad = 0.0;      ///< angle between the scan plane and the floor
+  std::string base_frame;     ///< where the chain ended (base_link or base_footprint when found)
+};
+
+/// The static transforms of a recording (/tf_static), composed in 3-D so
+/// that a lidar mounted upside down (roll pi) is seen as such.
+class StaticTransforms {
+ public:
+  /// False (nothing added) when the transform is not rigid (quaternion norm
+  /// far from 1, a translation that is not finite).
+  bool Add(const PoseMsg& transform);
+  /// The chain from `frame` up to the first base_link or base_footprint (or
+  /// as far as it goes); nullopt when `frame` has no transform.
+  std::optional<LidarMount> Mount(const std::string& frame) const;
+  /// "parent -> child, ..." for messages.
+  std::string Describe() const;
+  bool empty() const { return tf_.empty(); }
+
+ private:
+  struct Rigid3 {  // unit quaternion (w, x, y, z) and translation
+    std::array<double, 4> q{1.0, 0.0, 0.0, 0.0};
+    std::array<double, 3> t{};
+    std::array<double, 3> Rotate(const std::array<double, 3>& v) const;
+    Rigid3 Then(const Rigid3& o) const;  // this * o
+  };
+  std::map<std::string, std::pair<std::string, Rigid3>> tf_;  // child -> (parent, parent_T_child)
 };
 
 /// Cumulative wheel travel at a time, for the odometry's predictions.
@@ -51,6 +92,15 @@ struct ScanGroundTruth {
   std::vector<ScanRunReport> runs;  ///< per window, in order; track.poses is the run's ground truth
   Pose2 mount;                      ///< the lidar's pose in the robot frame used
   std::string mount_source;         ///< "tf_static base_link -> laser", "--scan-pose", "origin"
+  bool upside_down = false;         ///< the scan plane's z axis points down: beam angles mirrored before use
+  scan::MountEstimate mount_estimate;  ///< the mount as the scans and the wheels see it (mount_check.hpp)
+  /// The scan clock against the wheels (scan_clock.hpp): header.stamp minus
+  /// the time of the first ray, in the wheels' clock (0 when not determined).
+  double scan_time_offset_s = 0.0;
+  double clock_coarse_s = 0.0;     ///< the coarse step's first ray - stamp
+  double clock_correlation = 0.0;  ///< of the scans' range changes with the wheel motion at it
+  bool clock_determined = false;
+  double sweep_s = 0.0;            ///< |time_increment| * (beams - 1) of the first scan (0: not given)
   std::string scan_frame;
   std::size_t scans = 0, imu_messages = 0;
   std::optional<scan::GyroCalibration> gyro;

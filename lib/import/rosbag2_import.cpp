@@ -537,8 +537,11 @@ std::string Rosbag2ImportOptions::Validate() const {
   if (!(max_gt_gap_s > 0.0) || !std::isfinite(max_gt_gap_s)) return fmt::format("max_gt_gap_s = {}: must be > 0", max_gt_gap_s);
   if (!ground_truth_frame.empty() && ground_truth_topic.empty()) return "--ground-truth-frame needs --ground-truth";
   if (!scan_topic.empty() && !ground_truth_topic.empty()) return "--scan and --ground-truth are two ground truths: give one";
-  if (scan_topic.empty() && (!imu_topic.empty() || scan_pose))
-    return fmt::format("{} needs --scan", imu_topic.empty() ? "--scan-pose" : "--imu");
+  if (scan_topic.empty() && (!imu_topic.empty() || scan_pose || !tf_static_topic.empty() || scan_upside_down))
+    return fmt::format("{} needs --scan", !imu_topic.empty() ? "--imu"
+                                          : scan_pose         ? "--scan-pose"
+                                          : scan_upside_down  ? "--scan-upside-down"
+                                                              : "--tf-static");
   if (scan_pose && !(std::isfinite(scan_pose->x) && std::isfinite(scan_pose->y) && std::isfinite(scan_pose->theta)))
     return "scan_pose: --scan-pose X,Y,YAW must be finite";
   return {};
@@ -699,12 +702,31 @@ void CheckAgainstGroundTruth(const std::vector<TrajectoryRun>& runs, const std::
   }
 }
 
+// A square's legs as the wheels measured them: the run's mean wheel travel
+// over four (spot turns add none). A --side that the odometry contradicts
+// (more than 15 % off: a wheel scale is off by 1-3 %, rounded corners by a
+// few %) would scale E_d's and E_b's geometry wrongly; refused.
+void CheckSideAgainstLegs(const std::vector<TrajectoryRun>& runs, const Rosbag2ImportOptions& o, const std::string& path) {
+  if (o.kind != ExperimentKind::kSquare || runs.empty()) return;
+  std::vector<double> legs;
+  for (const auto& r : runs) legs.push_back(0.25 * 0.5 * (std::abs(r.dist_left_m.back()) + std::abs(r.dist_right_m.back())));
+  std::nth_element(legs.begin(), legs.begin() + static_cast<std::ptrdiff_t>(legs.size() / 2), legs.end());
+  const double leg = legs[legs.size() / 2];
+  constexpr double kMaxSideError = 0.15;
+  if (std::abs(leg / o.side_m - 1.0) <= kMaxSideError) return;
+  throw InputError(path, fmt::format("--side {} m, but the wheels drive legs of {:.3f} m (median over {} run(s): the mean "
+                                     "wheel travel of a run over 4): the squares were {:.2f} m, not {} m; give the side "
+                                     "the robot drove (--side {:.2f}), or check the robot file's wheel diameters",
+                                     o.side_m, leg, runs.size(), leg, o.side_m, leg));
+}
+
 // The lidar as the ground-truth source: each run's still stretches (from the
 // first sample of the pause before to the last of the pause after) and the
 // wheel travel for the odometry's predictions go to scan_ground_truth.hpp.
-ScanGroundTruth ScanSource(const Bag& bag, const std::vector<WheelSample>& s,
+ScanGroundTruth ScanSource(const Bag& bag, const RecordingData& d,
                            const std::vector<std::pair<std::size_t, std::size_t>>& spans, std::size_t first_run,
                            const RobotParams& robot, const Rosbag2ImportOptions& o, std::vector<std::string>& warnings) {
+  const std::vector<WheelSample>& s = d.wheels;
   auto still = [&](std::size_t i) {
     return std::abs(s[i].left - s[i - 1].left) < kStillM && std::abs(s[i].right - s[i - 1].right) < kStillM;
   };
@@ -724,6 +746,10 @@ ScanGroundTruth ScanSource(const Bag& bag, const std::vector<WheelSample>& s,
   so.scan_topic = o.scan_topic;
   so.imu_topic = o.imu_topic;
   so.scan_pose = o.scan_pose;
+  so.tf_static_topic = o.tf_static_topic;
+  so.upside_down = o.scan_upside_down;
+  so.left_joint = d.left_joint;
+  so.right_joint = d.right_joint;
   so.log_time = o.GroundTruthTime() == StampSource::kLog;
   so.origin_ns = s.front().t_ns;
   return ReadScanGroundTruth(bag, so, windows, names, travel, robot.wheelbase_m, warnings);
@@ -779,7 +805,7 @@ Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotPar
     const auto gaps = FindGaps(d.wheels);
     GtInterpolator interp{d.gt, static_cast<std::int64_t>(std::llround(o.max_gt_gap_s * 1e9))};
     std::optional<ScanGroundTruth> lidar;  // --scan: each run's ground truth from the lidar
-    if (!o.scan_topic.empty()) lidar = ScanSource(bag, d.wheels, spans, out.runs.runs.size(), robot, o, out.warnings);
+    if (!o.scan_topic.empty()) lidar = ScanSource(bag, d, spans, out.runs.runs.size(), robot, o, out.warnings);
     std::vector<TrajectoryRun> runs;
     std::vector<double> turns;
     for (std::size_t k = 0; k < spans.size(); ++k) {
@@ -824,6 +850,7 @@ Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotPar
       throw InputError(path, fmt::format("every run of {} has a gap in {} (see the warnings above): no run to import", path,
                                          wheel_topic));
     if (choice.gt) CheckAgainstGroundTruth(runs, turns, robot, o, path, d);
+    CheckSideAgainstLegs(runs, o, path);
     rs.runs = runs.size();
     for (auto& r : runs) out.runs.runs.push_back(std::move(r));
     if (lidar) {
@@ -837,10 +864,28 @@ Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotPar
   return out;
 }
 
+namespace {
+
+// A latched static transform topic: /tf_static or a namespaced .../tf_static.
+bool IsStaticTopic(const std::string& name) {
+  return name == "/tf_static" || (name.size() > 10 && name.compare(name.size() - 10, 10, "/tf_static") == 0);
+}
+
+// REP 105's odometry frame (odom, or a namespaced robot1/odom): an Odometry
+// in it is the robot's own dead reckoning, never ground truth.
+bool IsOdometryFrame(const std::string& frame) {
+  const std::string f = Lower(frame);
+  return f == "odom" || (f.size() > 5 && (f.compare(f.size() - 5, 5, "/odom") == 0 || f.compare(f.size() - 5, 5, "_odom") == 0));
+}
+
+}  // namespace
+
 // Joint names from the first message of each JointState topic; the whole
 // of each TFMessage topic (every frame with its parent and rate: a frame
 // may first appear late). Stops as soon as only JointState topics were
-// wanted and each has given its first message.
+// wanted and each has given its first message. Long (about 90 lines) because
+// every listed type (joints, frames, a lidar's frame and mount, an
+// odometry frame) is filled in by the one read callback, in one pass.
 BagListing ListRosbag2(const std::string& path, std::vector<std::string>& warnings) {
   const Bag bag = Bag::Open(path, warnings);
   BagListing out{path, bag.files(), {}};
@@ -853,7 +898,11 @@ BagListing ListRosbag2(const std::string& path, std::vector<std::string>& warnin
     const MessageType t = MessageTypeFromName(l.topic.type);
     l.wheels = t == MessageType::kJointState || t == MessageType::kOdometry;
     l.ground_truth = IsPoseType(t);
-    if ((t == MessageType::kJointState || IsPoseType(t)) && l.topic.count > 0 && l.topic.serialization_format == "cdr") {
+    l.scan = l.topic.type == "sensor_msgs/msg/LaserScan";
+    l.imu = l.topic.type == "sensor_msgs/msg/Imu";
+    l.static_transforms = t == MessageType::kTfMessage && IsStaticTopic(l.topic.name);
+    if ((t == MessageType::kJointState || IsPoseType(t) || l.scan) && l.topic.count > 0 &&
+        l.topic.serialization_format == "cdr") {
       wanted[i] = true;
       ++pending;
       whole = whole || t == MessageType::kTfMessage;
@@ -863,6 +912,7 @@ BagListing ListRosbag2(const std::string& path, std::vector<std::string>& warnin
   if (pending == 0) return out;
   std::vector<bool> done(bag.topics().size(), false);
   std::map<std::size_t, TfTree> trees;  // by topic index, TFMessage topics only
+  StaticTransforms statics;             // every .../tf_static transform, for the lidars' mounts
   JointStateMsg js;
   std::vector<PoseMsg> tf;
   try {
@@ -881,10 +931,19 @@ BagListing ListRosbag2(const std::string& path, std::vector<std::string>& warnin
           lag(js.header.stamp_ns);
         } else if (mt == MessageType::kTfMessage) {
           DecodeTfMessage(r, tf);
-          for (const auto& p : tf) trees[m.topic].Add(p, l.topic.name == "/tf_static");
-          if (!tf.empty() && l.topic.name != "/tf_static") lag(tf.front().header.stamp_ns);
+          for (const auto& p : tf) {
+            trees[m.topic].Add(p, l.static_transforms);
+            if (l.static_transforms) statics.Add(p);
+          }
+          if (!tf.empty() && !l.static_transforms) lag(tf.front().header.stamp_ns);
         } else {
-          lag(ReadHeader(r).stamp_ns);  // every other pose type starts with its std_msgs/Header
+          const Header h = ReadHeader(r);  // LaserScan and every other pose type start with their std_msgs/Header
+          l.frame_id = std::string(h.frame_id);
+          lag(h.stamp_ns);
+          if (mt == MessageType::kOdometry && IsOdometryFrame(l.frame_id)) {
+            l.robot_odometry = true;
+            l.ground_truth = false;
+          }
         }
       } catch (const CdrError& e) {
         if (!done[m.topic])
@@ -897,6 +956,8 @@ BagListing ListRosbag2(const std::string& path, std::vector<std::string>& warnin
     });
   } catch (const StopReading&) {
   }
+  for (auto& l : out.topics)
+    if (l.scan && !l.frame_id.empty()) l.mount = statics.Mount(l.frame_id);
   // Frames of every TFMessage topic; the odometry chain judged over the
   // dynamic and static transforms together.
   TfTree all;

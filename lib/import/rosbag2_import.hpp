@@ -42,6 +42,8 @@ struct Rosbag2ImportOptions {
   /// optional gyro (Imu topic).
   std::string scan_topic, imu_topic;
   std::optional<Pose2> scan_pose;
+  bool scan_upside_down = false;  ///< --scan-upside-down: the lidar is mounted upside down (beams mirrored)
+  std::string tf_static_topic;  ///< --tf-static (scan_ground_truth.hpp); empty: /tf_static or the only .../tf_static
   StampSource time = StampSource::kHeader;
   std::optional<StampSource> ground_truth_time;
   StampSource GroundTruthTime() const { return ground_truth_time.value_or(time); }
@@ -85,7 +87,13 @@ Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotPar
 struct TopicListing {
   TopicInfo topic;
   bool wheels = false;        ///< JointState or Odometry
-  bool ground_truth = false;  ///< a pose type
+  bool ground_truth = false;  ///< a pose type (an Odometry in an odometry frame is not: robot_odometry)
+  bool robot_odometry = false;  ///< Odometry whose header.frame_id is an odometry frame (odom): the robot's own
+  bool scan = false;          ///< LaserScan: --scan
+  bool imu = false;           ///< Imu: --imu
+  bool static_transforms = false;  ///< a .../tf_static topic (latched: its rate means nothing)
+  std::string frame_id;       ///< header.frame_id of the first message (LaserScan, Odometry)
+  std::optional<LidarMount> mount;  ///< LaserScan: its frame's mount from the static transforms
   std::vector<std::string> joints;  ///< JointState: joint names of its first message
   std::vector<std::string> frames;  ///< TFMessage: every child frame of the topic
   /// Header stamp minus receive time of the topic's first message [s]: a

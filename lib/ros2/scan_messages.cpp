@@ -10,8 +10,8 @@ void DecodeLaserScan(CdrReader& r, scan::LaserScan& out, std::string_view& frame
   out.angle_min = r.Read<float>();
   r.Read<float>();  // angle_max: implied by the count
   out.angle_increment = r.Read<float>();
-  r.Read<float>();  // time_increment
-  r.Read<float>();  // scan_time
+  out.time_increment = r.Read<float>();
+  out.scan_time = r.Read<float>();
   out.range_min = r.Read<float>();
   out.range_max = r.Read<float>();
   const std::uint32_t n = r.SequenceLength(4);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -56,6 +57,10 @@ std::string TrackOptions::Validate() const {
   if (!(min_end_overlap >= 0.0 && min_end_overlap <= 1.0)) return fmt::format("min_end_overlap = {}: must be in [0, 1]", min_end_overlap);
   if (!(still_moved_m > 0.0)) return fmt::format("still_moved_m = {}: must be > 0", still_moved_m);
   if (min_pairs < 3) return fmt::format("min_pairs = {}: must be >= 3", min_pairs);
+  if (max_still_scans < 1) return fmt::format("max_still_scans = {}: must be >= 1", max_still_scans);
+  if (still_model_scans < 1) return fmt::format("still_model_scans = {}: must be >= 1", still_model_scans);
+  if (!(still_min_move_m > 0.0)) return fmt::format("still_min_move_m = {}: must be > 0", still_min_move_m);
+  if (!(still_min_turn_rad > 0.0)) return fmt::format("still_min_turn_rad = {}: must be > 0", still_min_turn_rad);
   if (!(max_dilution > 0.0)) return fmt::format("max_dilution = {}: must be > 0", max_dilution);
   if (!std::isfinite(mount.x) || !std::isfinite(mount.y) || !std::isfinite(mount.theta)) return "mount: must be finite";
   return {};
@@ -65,14 +70,15 @@ struct RunTracker::Impl {
   RunWindow w;
   const std::function<Pose2(std::int64_t)>& odometry;
   TrackOptions o;
+  std::deque<LaserScan> before_scans;  // still before the run, nearest it last
+  std::vector<LaserScan> after_scans;   // still after the run, nearest it first
   ScanAverager before, after;
-  std::vector<LaserScan> before_samples, after_samples;  // for the still scatter
-  std::unique_ptr<ScanModel> reference, keyframe_model;   // keyframe_model null: the reference
+  std::unique_ptr<ScanModel> reference, keyframe_model;  // keyframe_model null: the reference
   Pose2 keyframe, prev;
   std::int64_t prev_t = 0;
   std::vector<StampedPose> lidar;  // chained lidar poses relative to the reference
-  std::optional<LaserScan> last_still;
-  bool after_closed = false;
+  double scatter_xy = 0.0, scatter_theta = 0.0;  // sums of squared still-scan deviations (axle frame)
+  std::size_t scatter_n = 0;
   TrackResult out;
 
   Impl(const RunWindow& window, const std::function<Pose2(std::int64_t)>& odo, const TrackOptions& opt)
@@ -102,8 +108,82 @@ struct RunTracker::Impl {
     return LidarFromAxle(o.mount, RelativeTo(odometry(from), odometry(to)));
   }
 
+  // How many of `scans` (nearest the run first) were taken from the pose of
+  // the first: (1) the median range change against the first at most
+  // still_moved_m (a carry: centimetres); (2) registered against the average
+  // of the nearest few, within 4 standard deviations of their registration
+  // (at least 2 mm, 1 mrad; a slow set-down, a nudge). The walk stops at the
+  // first scan that fails, and at one that fails (2) when the next one
+  // outward fails too (a single noisy registration is not a move). The kept
+  // scans' deviations make the still scatter.
+  std::size_t FromOnePose(const std::vector<const LaserScan*>& scans) {
+    std::size_t k = 0;
+    while (k < scans.size() && MedianRangeChange(*scans[k], *scans[0]) <= o.still_moved_m) ++k;
+    if (k < 2) return k;
+    ScanAverager near;
+    for (std::size_t i = 0; i < std::min<std::size_t>(k, o.still_model_scans); ++i) near.Add(*scans[i]);
+    const ScanModel model(near.Mean());
+    std::vector<bool> off(k, false);
+    std::vector<Pose2> dev(k);
+    for (std::size_t i = 0; i < k; ++i) {
+      const MatchResult m = MatchScan(model, ScanPoints(*scans[i]), Pose2{}, o.match);
+      ++out.registrations;
+      const auto c = m.Covariance();
+      const double sd_xy = std::sqrt(std::max(0.0, 0.5 * (c[0] + c[4]))), sd_th = std::sqrt(std::max(0.0, c[8]));
+      dev[i] = AxleFromLidar(o.mount, m.pose);
+      off[i] = m.pairs < o.min_pairs || std::hypot(m.pose.x, m.pose.y) > std::max(o.still_min_move_m, 4.0 * sd_xy) ||
+               std::abs(m.pose.theta) > std::max(o.still_min_turn_rad, 4.0 * sd_th);
+    }
+    std::size_t kept = k;
+    for (std::size_t i = 1; i < k; ++i)
+      if (off[i] && (i + 1 == k || off[i + 1])) {
+        kept = i;
+        break;
+      }
+    for (std::size_t i = 0; i < kept; ++i) {
+      scatter_xy += 0.5 * (dev[i].x * dev[i].x + dev[i].y * dev[i].y);
+      scatter_theta += dev[i].theta * dev[i].theta;
+      ++scatter_n;
+    }
+    return kept;
+  }
+
+  // The still scans before the run from the pose it starts from (walking
+  // back from the scan nearest the run); their average is the reference.
+  void SelectBefore() {
+    if (before_scans.empty()) return;
+    std::vector<const LaserScan*> order;
+    for (auto it = before_scans.rbegin(); it != before_scans.rend(); ++it) order.push_back(&*it);
+    const std::size_t k = FromOnePose(order);
+    if (k < order.size()) {
+      ++out.still_moved;
+      out.moved_before_ns = order[k]->t_ns;
+    }
+    out.still_before_from_ns = order[k - 1]->t_ns;
+    out.still_before_to_ns = order[0]->t_ns;
+    for (std::size_t i = 0; i < k; ++i) before.Add(*order[i]);
+    before_scans.clear();
+  }
+
+  // The still scans after the run from the pose it ends at.
+  void SelectAfter() {
+    if (after_scans.empty()) return;
+    std::vector<const LaserScan*> order;
+    for (const auto& a : after_scans) order.push_back(&a);
+    const std::size_t k = FromOnePose(order);
+    if (k < order.size()) {
+      ++out.still_moved;
+      out.moved_after_ns = order[k]->t_ns;
+    }
+    out.still_after_from_ns = order[0]->t_ns;
+    out.still_after_to_ns = order[k - 1]->t_ns;
+    for (std::size_t i = 0; i < k; ++i) after.Add(*order[i]);
+    after_scans.clear();
+  }
+
   void EnsureReference() {
     if (reference) return;
+    SelectBefore();
     if (before.count() == 0)
       throw RegistrationFailed(w.t_start_ns, fmt::format("no scan while the robot stood still before the run ({:.3f} s "
                                                          "of standstill): no reference to register against; record "
@@ -127,18 +207,6 @@ struct RunTracker::Impl {
       keyframe_model = std::make_unique<ScanModel>(s);
       keyframe = pose;
       ++out.keyframes;
-    }
-  }
-
-  // Scatter of single still scans about the model of their average.
-  void Scatter(const ScanModel& model, const std::vector<LaserScan>& scans, double& ss_xy, double& ss_th, std::size_t& n) {
-    for (const LaserScan& s : scans) {
-      const MatchResult m = MatchScan(model, ScanPoints(s), Pose2{}, o.match);
-      if (m.pairs < o.min_pairs) continue;
-      const Pose2 a = AxleFromLidar(o.mount, m.pose);
-      ss_xy += 0.5 * (a.x * a.x + a.y * a.y);
-      ss_th += a.theta * a.theta;
-      ++n;
     }
   }
 
@@ -177,48 +245,28 @@ RunTracker::RunTracker(RunTracker&&) noexcept = default;
 RunTracker& RunTracker::operator=(RunTracker&&) noexcept = default;
 const RunWindow& RunTracker::window() const { return impl_->w; }
 
-// Median |range difference| over the beams both scans returned: a few mm
-// for two scans from one pose, far more when the robot was moved between them.
-double MedianRangeChange(const LaserScan& a, const LaserScan& b) {
-  if (a.ranges.size() != b.ranges.size()) return std::numeric_limits<double>::infinity();
-  std::vector<double> d;
-  d.reserve(a.ranges.size());
-  for (std::size_t i = 0; i < a.ranges.size(); ++i)
-    if (a.Valid(i) && b.Valid(i)) d.push_back(std::abs(static_cast<double>(a.ranges[i]) - b.ranges[i]));
-  if (d.empty()) return std::numeric_limits<double>::infinity();
-  auto mid = d.begin() + static_cast<long>(d.size() / 2);
-  std::nth_element(d.begin(), mid, d.end());
-  return *mid;
-}
-
-// Still scans: before the run only the last group taken from one pose is
-// kept (the robot may have been carried to the start), after the run only
-// the first; a scan between t_start and t_end is chained.
+// Still scans are kept (before the run the ones nearest it, after it the
+// first ones); the group taken from the run's start pose is chosen when the
+// run begins (SelectBefore), the one from its end pose when it finishes
+// (SelectAfter). A scan between t_start and t_end is chained.
 void RunTracker::Add(const LaserScan& s) {
   Impl& d = *impl_;
   if (s.t_ns < d.w.still_from_ns || s.t_ns > d.w.still_to_ns) return;
-  const bool moved = d.last_still && MedianRangeChange(*d.last_still, s) > d.o.still_moved_m;
-  if (s.t_ns <= d.w.t_start_ns) {
-    if (moved) {
-      d.before = ScanAverager{};
-      d.before_samples.clear();
-      ++d.out.still_moved;
-    }
-    d.before.Add(s);
-    if (d.before_samples.size() < d.o.still_scatter_scans) d.before_samples.push_back(s);
-    d.last_still = s;
+  // A still scan's whole sweep lies before the run starts (its last ray too).
+  const double sweep_s = std::abs(s.time_increment) * static_cast<double>(s.ranges.empty() ? 0 : s.ranges.size() - 1);
+  if (s.t_ns + static_cast<std::int64_t>(std::llround(sweep_s * 1e9)) <= d.w.t_start_ns) {
+    d.before_scans.push_back(s);
+    if (d.before_scans.size() > d.o.max_still_scans) d.before_scans.pop_front();
   } else if (s.t_ns < d.w.t_end_ns) {
-    d.Chain(s);
-    d.last_still.reset();
-  } else if (!d.after_closed) {
-    if (moved && d.after.count() > 0) {
-      d.after_closed = true;
-      ++d.out.still_moved;
-      return;
+    if (d.o.deskew && s.time_increment != 0.0 && s.ranges.size() > 1) {
+      // The sweep as seen from where its first ray was taken (laser_scan.hpp).
+      const auto to = s.t_ns + static_cast<std::int64_t>(std::llround(sweep_s * 1e9));
+      d.Chain(Deskew(s, d.Predict(s.t_ns, to)));
+    } else {
+      d.Chain(s);
     }
-    d.after.Add(s);
-    if (d.after_samples.size() < d.o.still_scatter_scans) d.after_samples.push_back(s);
-    d.last_still = s;
+  } else if (d.after_scans.size() < d.o.max_still_scans) {
+    d.after_scans.push_back(s);
   }
 }
 
@@ -227,22 +275,17 @@ void RunTracker::Add(const LaserScan& s) {
 TrackResult RunTracker::Finish() {
   Impl& d = *impl_;
   d.EnsureReference();
+  d.SelectAfter();
   TrackResult& out = d.out;
   out.still_before = d.before.count();
   out.still_after = d.after.count();
   const Pose2 guess = Compose(d.prev, d.Predict(d.prev_t, d.w.t_end_ns));
   Pose2 end_lidar = guess;
   std::array<double, 9> end_cov{};
-  double ss_xy = 0.0, ss_th = 0.0;
-  std::size_t n = 0;
-  if (d.before_samples.size() > 1) d.Scatter(*d.reference, d.before_samples, ss_xy, ss_th, n);
-  if (d.after.count() > 0) {
-    end_lidar = d.End(guess, end_cov);
-    if (d.after_samples.size() > 1) d.Scatter(ScanModel(d.after.Mean()), d.after_samples, ss_xy, ss_th, n);
-  }
-  if (n > 0) {
-    out.still_sd_xy_m = std::sqrt(ss_xy / static_cast<double>(n));
-    out.still_sd_theta_rad = std::sqrt(ss_th / static_cast<double>(n));
+  if (d.after.count() > 0) end_lidar = d.End(guess, end_cov);
+  if (d.scatter_n > 0) {
+    out.still_sd_xy_m = std::sqrt(d.scatter_xy / static_cast<double>(d.scatter_n));
+    out.still_sd_theta_rad = std::sqrt(d.scatter_theta / static_cast<double>(d.scatter_n));
   }
   out.end = AxleFromLidar(d.o.mount, end_lidar);
   out.end_covariance = AxleCovariance(d.o.mount, end_lidar, end_cov);

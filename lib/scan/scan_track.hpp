@@ -61,11 +61,26 @@ struct TrackOptions {
   double min_end_overlap = 0.5;      ///< the end pairs at least this fraction with the reference, else goes via the keyframe
   std::size_t min_pairs = 30;        ///< fewer pairs: the registration failed
   double max_dilution = 5.0;         ///< UndeterminedDirections threshold
-  std::size_t still_scatter_scans = 10;  ///< single still scans registered to measure their scatter
-  /// Two still scans whose ranges differ by more than this (median over the
-  /// beams) were taken from different poses: the robot was moved while its
-  /// wheels stood still (carried back to the start).
+  /// Still scans (nearest the run) averaged into the model every still scan
+  /// is registered against, to tell a small move from noise.
+  std::size_t still_model_scans = 5;
+  /// A still scan registered farther than this from that model (and than 4
+  /// of its standard deviations) was taken from another pose.
+  double still_min_move_m = 0.002;
+  double still_min_turn_rad = 0.001;
+  /// A still scan whose ranges differ from those of the still scan nearest
+  /// the run by more than this (median over the beams) was taken from
+  /// another pose: the robot was moved while its wheels stood still (carried
+  /// back to the start, nudged). Each still scan is compared with the one
+  /// nearest the run, not with its neighbour, so a slow carry is caught too.
   double still_moved_m = 0.03;
+  /// Moving scans whose time_increment is set are deskewed: each beam moved
+  /// to where the lidar was at the scan's first ray (its time), by the wheel
+  /// odometry's motion over the sweep (laser_scan.hpp, Deskew).
+  bool deskew = true;
+  /// Still scans kept before a run (the ones nearest it): bounds the memory
+  /// of a long standstill.
+  std::size_t max_still_scans = 400;
   /// Empty when valid, else a message naming the bad field.
   std::string Validate() const;
 };
@@ -76,11 +91,19 @@ struct TrackResult {
   std::vector<StampedPose> poses;
   Pose2 end;                              ///< at t_end
   std::array<double, 9> end_covariance{};  ///< of `end` (x, y, heading; row-major)
-  /// Scatter of single still scans about their average (standard deviation
-  /// per axis and of heading), from up to still_scatter_scans of each side.
+  /// Scatter of single still scans about the average of the few nearest the
+  /// run (standard deviation per axis and of heading), over the kept still
+  /// scans of both sides.
   double still_sd_xy_m = 0.0, still_sd_theta_rad = 0.0;
   std::size_t still_before = 0, still_after = 0, keyframes = 1, chained = 0;
   std::size_t still_moved = 0;     ///< times the robot was moved while its wheels stood still
+  /// When it was moved: the first scan from another pose, counted outwards
+  /// from the run (before the run: the last such scan; after: the first).
+  std::int64_t moved_before_ns = 0, moved_after_ns = 0;
+  /// The stretches whose scans were averaged (the robot still by the wheels
+  /// and by the scans): first and last scan time before and after the run
+  /// (after: 0, 0 when no scan came after it).
+  std::int64_t still_before_from_ns = 0, still_before_to_ns = 0, still_after_from_ns = 0, still_after_to_ns = 0;
   bool end_direct = false;         ///< end registered against the reference (not via a keyframe)
   double max_residual_sd_m = 0.0;  ///< worst registration residual of the run
   std::size_t registrations = 0, iterations = 0;  ///< ICP calls and their Gauss-Newton iterations
@@ -110,7 +133,8 @@ class RegistrationFailed : public std::runtime_error {
 };
 
 /// Follows one run scan by scan, in time order (memory: two scan models,
-/// the still averages, a few still scans and one pose per scan).
+/// the still scans before the run (at most max_still_scans), the still
+/// average after it, a few still scans and one pose per scan).
 /// `odometry(t)`: the wheel odometry's axle pose at time t in any fixed frame
 /// (only increments are used, as predictions); it must outlive the tracker.
 class RunTracker {

@@ -110,12 +110,16 @@ const SCENES = {
 };
 
 // Distance along the ray (ox, oy, c, s) to the nearest surface, or Infinity.
+// Glass (scene.glass, segments as walls): a ray returns from it only within
+// 25 deg of its normal, else passes through (the drop-outs of a glass room).
 function castRay(scene, ox, oy, c, s) {
   let best = Infinity;
-  for (const [x1, y1, x2, y2] of scene.walls) {
+  const surfaces = [...scene.walls.map((w) => [w, false]), ...(scene.glass ?? []).map((w) => [w, true])];
+  for (const [[x1, y1, x2, y2], glass] of surfaces) {
     const ex = x2 - x1, ey = y2 - y1;
     const den = c * ey - s * ex;
     if (Math.abs(den) < 1e-12) continue;
+    if (glass && Math.abs(den) / Math.hypot(ex, ey) < Math.cos((25 * Math.PI) / 180)) continue;
     const t = ((x1 - ox) * ey - (y1 - oy) * ex) / den;
     const u = ((x1 - ox) * s - (y1 - oy) * c) / den;
     if (t > 1e-9 && u >= 0 && u <= 1 && t < best) best = t;
@@ -159,6 +163,10 @@ function simulate(robot, start, plan, seed) {
       for (let i = 0; i < Math.round(seg.seconds / dt); ++i) step(0, 0);
       continue;
     }
+    if (seg.kind === "carry") {
+      carry(st, out, seg, start, dt);
+      continue;
+    }
     // Wheel angle per wheel (right, left signs), trapezoidal profile on progress.
     const phi = seg.kind === "leg" ? seg.length / robot.r : (robot.b * Math.PI) / 4 / robot.r;
     const [sl, sr] = seg.kind === "leg" ? [1, 1] : [-seg.sign, seg.sign];
@@ -186,6 +194,33 @@ function simulate(robot, start, plan, seed) {
   return out;
 }
 
+// A person carries the robot back to its start mark while its wheels stand
+// still: a smooth lift-and-place over `seconds` through a point `detour` m to
+// the side of the straight path, set down `miss` (dx, dy, dth) off the mark;
+// `tilt` [rad] pitches the lidar's plane at mid-carry (a lifted robot tilts).
+function carry(st, out, seg, start, dt) {
+  const [x0, y0, th0] = [st.x, st.y, st.th];
+  const [mx, my, mth] = seg.miss ?? [0, 0, 0];
+  const x1 = start[0] + mx, y1 = start[1] + my;
+  const th1 = th0 + Math.atan2(Math.sin(start[2] + mth - th0), Math.cos(start[2] + mth - th0));
+  const len = Math.hypot(x1 - x0, y1 - y0) || 1;
+  const nx = -(y1 - y0) / len, ny = (x1 - x0) / len;
+  const n = Math.round(seg.seconds / dt);
+  for (let i = 1; i <= n; ++i) {
+    const u = 0.5 - 0.5 * Math.cos((Math.PI * i) / n);  // smooth start and stop
+    const side = (seg.detour ?? 0) * Math.sin(Math.PI * u);
+    const th = th0 + u * (th1 - th0);
+    st.w = (th - st.th) / dt;
+    st.x = x0 + u * (x1 - x0) + side * nx;
+    st.y = y0 + u * (y1 - y0) + side * ny;
+    st.th = th;
+    st.tilt = (seg.tilt ?? 0) * Math.sin(Math.PI * u);
+    st.t += dt;
+    out.push({ ...st });
+  }
+  st.tilt = 0;
+}
+
 function squarePlan(directions, side, pause) {
   const plan = [{ kind: "still", seconds: pause }];
   for (const d of directions) {
@@ -208,7 +243,7 @@ function poseStamped(ns, x, y, th) {
 function laserScan(ns, frame, lidar, ranges) {
   return encode("sensor_msgs/msg/LaserScan", { header: { stamp: stamp(ns), frame_id: frame },
     angle_min: lidar.angleMin, angle_max: lidar.angleMin + (lidar.beams - 1) * lidar.inc, angle_increment: lidar.inc,
-    time_increment: 0, scan_time: 0.1, range_min: lidar.rangeMin, range_max: lidar.rangeMax,
+    time_increment: lidar.timeInc ?? 0, scan_time: lidar.scanTime ?? 0.1, range_min: lidar.rangeMin, range_max: lidar.rangeMax,
     ranges: Float32Array.from(ranges), intensities: new Float32Array(0) });
 }
 const zeros9 = new Array(9).fill(0);
@@ -218,20 +253,26 @@ function imu(ns, rate, noRate = false) {
     angular_velocity: { x: 0, y: 0, z: rate }, angular_velocity_covariance: noRate ? [-1, 0, 0, 0, 0, 0, 0, 0, 0] : zeros9,
     linear_acceleration: { x: 0, y: 0, z: 9.81 }, linear_acceleration_covariance: zeros9 });
 }
-function tfStatic(ns, parent, child, [x, y, yaw]) {
+// `roll` pi: the lidar mounted upside down (Rz(yaw) Rx(pi) = (x cos(yaw/2), y sin(yaw/2), z 0, w 0)).
+function tfStatic(ns, parent, child, [x, y, yaw], roll = 0) {
+  const rot = roll ? { x: Math.cos(yaw / 2), y: Math.sin(yaw / 2), z: 0, w: 0 } : quat(yaw);
   return encode("tf2_msgs/msg/TFMessage", { transforms: [
     { header: { stamp: stamp(ns), frame_id: "base_footprint" }, child_frame_id: "base_link",
       transform: { translation: { x: 0, y: 0, z: 0.05 }, rotation: quat(0) } },
     { header: { stamp: stamp(ns), frame_id: parent }, child_frame_id: child,
-      transform: { translation: { x, y, z: 0.2 }, rotation: quat(yaw) } }] });
+      transform: { translation: { x, y, z: 0.2 }, rotation: rot } }] });
 }
 
 // One ray-cast scan from the lidar at world pose (lx, ly, lth).
-function scanRanges(scene, lidar, lx, ly, lth, R) {
+// A lidar pitched by `tilt` sees a vertical wall along a slanted beam: the
+// range grows by 1 / cos(elevation), sin(elevation) = sin(tilt) cos(bearing).
+function scanRanges(scene, lidar, lx, ly, lth, R, tilt = 0) {
   const out = new Array(lidar.beams);
+  const mirror = lidar.mirrored ? -1 : 1;  // upside down: beam i looks at -(its angle) in the robot's frame
   for (let i = 0; i < lidar.beams; ++i) {
-    const a = lth + lidar.angleMin + i * lidar.inc;
-    const d = castRay(scene, lx, ly, Math.cos(a), Math.sin(a));
+    const a = lth + mirror * (lidar.angleMin + i * lidar.inc);
+    const e = Math.sin(tilt) * Math.cos(lidar.angleMin + i * lidar.inc);
+    const d = castRay(scene, lx, ly, Math.cos(a), Math.sin(a)) / Math.sqrt(1 - e * e);
     const noisy = d + lidar.noise * R.n();
     const drop = R.u() < lidar.dropout;
     out[i] = drop ? NaN : d > lidar.rangeMax ? Infinity : Math.round(noisy * 1024) / 1024;
@@ -247,10 +288,12 @@ function recording(cfg) {
   const t0 = BASE_NS + BigInt(cfg.offsetS ?? 0) * 1000000000n;
   const at = (ms) => t0 + BigInt(ms) * 1000000n;
   const [mx, my, mth] = cfg.mount;
-  if (cfg.tfStatic) msgs.push({ topic: "/tf_static", log: at(0), data: tfStatic(at(0), "base_link", cfg.tfChild ?? cfg.frame, cfg.mount) });
+  if (cfg.tfStatic) msgs.push({ topic: cfg.tfTopic ?? "/tf_static", log: at(0),
+    data: tfStatic(at(0), "base_link", cfg.tfChild ?? cfg.frame, cfg.tfMount ?? cfg.mount, cfg.tfRoll ?? 0) });
   states.forEach((s, ms) => {
     if (ms % 50 === 0) {  // 20 Hz wheels and exact ground truth
-      msgs.push({ topic: "/joint_states", log: at(ms) + 1000000n, data: jointState(at(ms), s.phiL, s.phiR) });
+      const [jl, jr] = cfg.swapJoints ? [s.phiR, s.phiL] : [s.phiL, s.phiR];
+      msgs.push({ topic: "/joint_states", log: at(ms) + 1000000n, data: jointState(at(ms), jl, jr) });
       msgs.push({ topic: "/mocap/pose", log: at(ms) + 2000000n, data: poseStamped(at(ms), s.x, s.y, s.th) });
     }
     if (cfg.imu && ms % 20 === 7) {  // 50 Hz gyro: the mean rate over its 20 ms sample (band-limited, as a real one)
@@ -258,10 +301,31 @@ function recording(cfg) {
       const rate = cfg.imu.scale * w + cfg.imu.bias + cfg.imu.noise * R.n();
       msgs.push({ topic: "/imu", log: at(ms) + 500000n, data: imu(at(ms), rate) });
     }
-    if (ms % (cfg.scanEvery ?? 100) === 13) {  // 10 Hz lidar, not in step with the wheels
-      const c = Math.cos(s.th), sn = Math.sin(s.th);
-      const ranges = scanRanges(cfg.scene, cfg.lidar, s.x + c * mx - sn * my, s.y + sn * mx + c * my, s.th + mth, R);
-      msgs.push({ topic: "/scan", log: at(ms) + 3000000n, data: laserScan(at(ms), cfg.frame, cfg.lidar, ranges) });
+    const sweepMs = Math.round((cfg.lidar.timeInc ?? 0) * (cfg.lidar.beams - 1) * 1000);
+    if (ms % (cfg.scanEvery ?? 100) === 13 && ms + sweepMs < states.length) {  // 10 Hz lidar, not in step with the wheels
+      // Beam i taken at the first ray + i time_increment (the sweep, 1 ms
+      // resolution); the range scale of a miscalibrated lidar; the header
+      // stamp at the first ray or the sweep's end, on a clock clockS ahead.
+      const lidarAt = (st) => {
+        const c = Math.cos(st.th), sn = Math.sin(st.th);
+        return [st.x + c * mx - sn * my, st.y + sn * mx + c * my, st.th + mth];
+      };
+      let ranges;
+      if (sweepMs > 0) {
+        ranges = new Array(cfg.lidar.beams);
+        for (let i = 0; i < cfg.lidar.beams; ++i) {
+          const st = states[ms + Math.round(i * cfg.lidar.timeInc * 1000)];
+          const [lx, ly, lth] = lidarAt(st);
+          ranges[i] = scanRanges(cfg.scene, { ...cfg.lidar, beams: 1, angleMin: cfg.lidar.angleMin + i * cfg.lidar.inc }, lx, ly, lth, R,
+            st.tilt ?? 0)[0];
+        }
+      } else {
+        const [lx, ly, lth] = lidarAt(s);
+        ranges = scanRanges(cfg.scene, cfg.lidar, lx, ly, lth, R, s.tilt ?? 0);
+      }
+      if (cfg.rangeScale) ranges = ranges.map((r) => (Number.isFinite(r) ? Math.round(r * cfg.rangeScale * 1024) / 1024 : r));
+      const stampNs = at(ms) + (cfg.stampAtEnd ? BigInt(sweepMs) * 1000000n : 0n) + BigInt(Math.round((cfg.clockS ?? 0) * 1000)) * 1000000n;
+      msgs.push({ topic: "/scan", log: at(ms + sweepMs) + 3000000n, data: laserScan(stampNs, cfg.frame, cfg.lidar, ranges) });
     }
   });
   return msgs.sort((a, b) => (a.log < b.log ? -1 : a.log > b.log ? 1 : 0));
@@ -389,6 +453,72 @@ async function heldout(outDir) {
   }
 }
 
+// The recordings of issue 29 (what a robot gives on its first day without
+// motion capture), each small (5 Hz lidar, a few runs): written to
+// tests/data/rosbag2/scan/ beside the fixtures above.
+//   carry.mcap: carried back to the start mark between runs (slow, quick,
+//   lifted and tilted), gyro with bias 0.004 rad/s.
+async function cases(outDir) {
+  await zstd.isLoaded;
+  fs.mkdirSync(outDir, { recursive: true });
+  const topics = [["/joint_states", "sensor_msgs/msg/JointState"], ["/mocap/pose", "geometry_msgs/msg/PoseStamped"],
+    ["/scan", "sensor_msgs/msg/LaserScan"], ["/tf_static", "tf2_msgs/msg/TFMessage"], ["/imu", "sensor_msgs/msg/Imu"]];
+  const start = [2.6, 2.2, 0.25];
+  const sq = (d) => { const sign = d === "ccw" ? 1 : -1; const p = [];
+    for (let k = 0; k < 4; ++k) p.push({ kind: "leg", length: 1.0 }, { kind: "turn", sign }); return p; };
+  const still = (seconds) => ({ kind: "still", seconds });
+  const carryPlan = [still(3), ...sq("cw"), still(1.5),
+    { kind: "carry", seconds: 3.0, detour: 0.05, miss: [0.01, -0.005, 0.01] }, still(3), ...sq("ccw"), still(1.5),
+    { kind: "carry", seconds: 0.8, detour: 0.3, miss: [-0.008, 0.012, -0.015] }, still(3), ...sq("cw"), still(1.5),
+    { kind: "carry", seconds: 2.5, detour: 0.4, tilt: 0.3, miss: [0.004, 0.009, 0.02] }, still(3), ...sq("ccw"), still(3)];
+  await writeMcap(path.join(outDir, "carry.mcap"), topics, recording({ robot: ROBOT_A, scene: SCENES.roomA, start, seed: 2901,
+    plan: carryPlan, lidar: LIDAR, frame: "laser", mount: [0.12, 0.0, 0.0], tfStatic: true, scanEvery: 200,
+    imu: { bias: 0.004, scale: 1.015, noise: 0.004 } }));
+  // Mounts: a cw and a ccw square of 1 m each, 5 Hz lidar, gyro.
+  const two = [still(3), ...sq("cw"), still(3), ...sq("ccw"), still(3)];
+  const gyro = { bias: 0.004, scale: 1.015, noise: 0.004 };
+  const base = { robot: ROBOT_A, scene: SCENES.roomA, start, plan: two, lidar: LIDAR, frame: "laser", scanEvery: 200, imu: gyro };
+  const noMocap = topics.filter(([t]) => t !== "/mocap/pose");
+  const drop = (msgs) => msgs.filter((m) => m.topic !== "/mocap/pose");
+  const variants = [
+    // upside down, 0.1 m ahead and turned 0.3 rad; /tf_static says so (roll pi): imported right.
+    ["mount_upside_down_tf.mcap", { ...base, seed: 2911, lidar: { ...LIDAR, mirrored: true }, mount: [0.10, 0.0, 0.3],
+      tfStatic: true, tfRoll: Math.PI }, topics],
+    // upside down, /tf_static says upright: refused as upside down (the gyro agrees with the wheels).
+    ["mount_upside_down_untold.mcap", { ...base, seed: 2912, lidar: { ...LIDAR, mirrored: true }, mount: [0.10, 0.0, 0.0],
+      tfStatic: true }, noMocap, drop],
+    // no /tf_static, lidar turned by 180 deg, 0.35 rad, 90 deg: refused naming the mount.
+    ["mount_yaw_pi.mcap", { ...base, seed: 2913, mount: [-0.05, 0.0, Math.PI], tfStatic: false }, noMocap, drop],
+    ["mount_yaw_035.mcap", { ...base, seed: 2914, mount: [0.08, 0.03, 0.35], tfStatic: false }, noMocap, drop],
+    ["mount_yaw_90.mcap", { ...base, seed: 2915, mount: [0.0, 0.1, Math.PI / 2], tfStatic: false }, noMocap, drop],
+    // a namespaced robot: /robot1/tf_static holds a 180 deg mount: imported right.
+    ["namespaced_tf.mcap", { ...base, seed: 2916, mount: [-0.05, 0.0, Math.PI], tfStatic: true, tfTopic: "/robot1/tf_static" },
+      topics.map(([t, ty]) => [t === "/tf_static" ? "/robot1/tf_static" : t, ty])],
+    // the wheel joints swapped (left's position published as right's): refused as swapped, not as a mirrored lidar.
+    ["swapped_joints.mcap", { ...base, seed: 2917, mount: [0.12, 0.0, 0.0], tfStatic: true, swapJoints: true }, noMocap, drop],
+  ];
+  // Item 2 of issue 29 (and the sweep and clock of item 1): a cw and a ccw
+  // square, the exact pose beside the scans.
+  const sweep = { ...LIDAR, timeInc: 0.2 / 360, scanTime: 0.2 };  // 5 Hz, the sweep takes the whole 0.2 s
+  // Room A with its two long walls of glass (the east one and the south one).
+  const glassRoom = { walls: [[6, 5, 3.2, 5], [3.2, 5, 3.2, 5.6], [3.2, 5.6, 2.2, 5.6], [2.2, 5.6, 2.2, 5], [2.2, 5, 0, 5],
+    [0, 5, 0, 0], ...box(4.6, 3.6, 0.8, 0.5)], glass: [[0, 0, 6, 0], [6, 0, 6, 5]], pillars: [[1.0, 4.0, 0.15]] };
+  variants.push(
+    ["sweep_first_ray.mcap", { ...base, seed: 2921, lidar: sweep, mount: [0.12, 0.0, 0.0], tfStatic: true }, topics],
+    ["sweep_end_stamped.mcap", { ...base, seed: 2922, lidar: sweep, mount: [0.12, 0.0, 0.0], tfStatic: true, stampAtEnd: true }, topics],
+    ["clock_plus_0.5.mcap", { ...base, seed: 2923, mount: [0.12, 0.0, 0.0], tfStatic: true, clockS: 0.5 }, topics],
+    ["clock_plus_1.mcap", { ...base, seed: 2924, mount: [0.12, 0.0, 0.0], tfStatic: true, clockS: 1.0 }, topics],
+    ["clock_minus_0.3.mcap", { ...base, seed: 2925, mount: [0.12, 0.0, 0.0], tfStatic: true, clockS: -0.3 }, topics],
+    ["clock_plus_3.mcap", { ...base, seed: 2926, mount: [0.12, 0.0, 0.0], tfStatic: true, clockS: 3.0 }, noMocap, drop],
+    ["range_scale_1.01.mcap", { ...base, seed: 2927, mount: [0.12, 0.0, 0.0], tfStatic: true, rangeScale: 1.01 }, topics],
+    ["glass_room.mcap", { ...base, seed: 2928, scene: glassRoom, mount: [0.12, 0.0, 0.0], tfStatic: true }, topics]);
+  for (const [name, cfg, tops, filter] of variants) {
+    const msgs = recording(cfg);
+    await writeMcap(path.join(outDir, name), tops, filter ? filter(msgs) : msgs);
+  }
+}
+
 if (process.argv[2] === "--heldout") await heldout(process.argv[3]);
+else if (process.argv[2] === "--cases") await cases(process.argv[3] ?? path.resolve(path.dirname(new URL(import.meta.url).pathname), "../scan"));
 else if (process.argv[2] === "--bench") await bench(process.argv[3], Number(process.argv[4] ?? 10));
 else await fixtures(process.argv[2] ?? path.resolve(path.dirname(new URL(import.meta.url).pathname), "../scan"));
