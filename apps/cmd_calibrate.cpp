@@ -269,6 +269,8 @@ nlohmann::json JsonHeldoutSummary(const HeldoutComparison& h) {
           {"runner_up_difference_m", h.runner_up.empty() ? nlohmann::json(nullptr) : JsonNumber(h.runner_up_difference_m)},
           {"runner_up_difference_sem_m",
            h.runner_up.empty() ? nlohmann::json(nullptr) : JsonNumber(h.runner_up_difference_sem_m)},
+          {"checked", h.checked},
+          {"not_checked", h.not_checked},
           {"notes", h.notes}};
 }
 
@@ -389,6 +391,8 @@ void PrintHeldoutTable(const HeldoutComparison& h) {
                m.failed_folds ? fmt::format(", failed on {} folds", m.failed_folds) : "", mark);
   }
   for (const auto& n : h.notes) fmt::print("  note: {}\n", n);
+  for (const auto& c : h.checked) fmt::print("  the held-out runs checked: {}\n", c);
+  for (const auto& c : h.not_checked) fmt::print("  they could not check: {}\n", c);
   if (!h.recommended.empty()) {
     const MethodHeldout* m = h.Find(h.recommended);
     fmt::print("  Put {} on the robot: wheelbase {:.6f} m, left diameter {:.6f} m, right diameter {:.6f} m\n",

@@ -88,6 +88,7 @@ struct Method {
   std::string name;
   int simplicity = 0;
   std::function<RobotParams(const CalibrateInput&)> fit;
+  bool fits_scale = false;  ///< MethodHeldout::fits_scale
 };
 
 /// Step 1: every method the input allows, simplest first (heldout.hpp).
@@ -111,8 +112,12 @@ std::vector<Method> MethodsFor(const CalibrateInput& input, const CalibrateJobOp
   // The full-path fits need ground truth along the path; there they are
   // compared without --refine too.
   const bool paths = input.trajectories && HasInteriorGroundTruth(*input.trajectories);
-  if (paths) methods.push_back({"plain_least_squares", 2, refine_with(PlainLeastSquaresOptions())});
-  if (options.refine || paths) methods.push_back({"refined", 3, refine_with(options.refine.value_or(options.compare_refine))});
+  if (paths) methods.push_back({"plain_least_squares", 2, refine_with(PlainLeastSquaresOptions()), true});
+  if (options.refine || paths) {
+    const RefineOptions ro = options.refine.value_or(options.compare_refine);
+    const bool scale = ro.scale == ScaleMode::kFree || (paths && ro.scale == ScaleMode::kAuto);
+    methods.push_back({"refined", 3, refine_with(ro), scale});
+  }
   return methods;
 }
 
@@ -207,14 +212,11 @@ double ItemError(const CalibrateInput& in, const TestItem& t, const RobotParams&
 }
 
 /// Step 3: every method on every fold group; appends one error per test
-/// (NaN where the method failed) and returns per test whether every method
-/// predicted it. A group where even classic UMBmark cannot calibrate the
+/// (NaN where the method failed). A group where even classic UMBmark cannot calibrate the
 /// training runs (e.g. the only run of a direction left out) is not formed.
-std::vector<bool> RunFolds(const CalibrateInput& input, const CalibrateJobOptions& options,
-                           const std::vector<Method>& methods, const std::vector<FoldGroup>& groups,
-                           bool with_trajectories, HeldoutComparison* out) {
+void RunFolds(const CalibrateInput& input, const CalibrateJobOptions& options, const std::vector<Method>& methods,
+              const std::vector<FoldGroup>& groups, bool with_trajectories, HeldoutComparison* out) {
   const bool final_turn = options.refine ? options.refine->final_turn : true;
-  std::vector<bool> complete;
   ProgressCounter progress(options.progress, static_cast<double>(groups.size()));
   for (const FoldGroup& g : groups) {
     const CalibrateInput train = Subset(input, g.train, with_trajectories);
@@ -238,18 +240,13 @@ std::vector<bool> RunFolds(const CalibrateInput& input, const CalibrateJobOption
         out->notes.push_back(fmt::format("{} cannot be left out (the rest does not calibrate)", g.labels[t]));
         continue;
       }
-      bool all = true;
       for (std::size_t m = 0; m < methods.size(); ++m) {
         out->methods[m].fold_errors_m.push_back(errs[m][t]);
-        out->methods[m].failed_folds += std::isfinite(errs[m][t]) ? 0 : 1;
-        all = all && std::isfinite(errs[m][t]);
       }
       out->left_out.push_back(g.labels[t]);
-      complete.push_back(all);
     }
     progress.Add();
   }
-  return complete;
 }
 
 /// Mean and standard error of `v` over the complete folds.
@@ -304,33 +301,87 @@ void SummariseMethods(const std::vector<bool>& complete, HeldoutComparison* out)
   }
 }
 
+/// Step 5a: the baseline, the simplest well-determined calibration
+/// (heldout.hpp): plain least squares, else another full-path fit that
+/// measures the scale, else the classic estimator asked for.
+const MethodHeldout* Baseline(const CalibrateJobOptions& options, HeldoutComparison* out) {
+  const MethodHeldout* plain = out->Find("plain_least_squares");
+  if (plain && plain->Recommendable()) return plain;
+  const MethodHeldout* scaled = nullptr;
+  for (const auto& h : out->methods) {
+    if (h.fits_scale && h.Recommendable() && (!scaled || h.simplicity < scaled->simplicity)) scaled = &h;
+  }
+  if (scaled) {
+    out->notes.push_back(fmt::format("plain least squares is not well determined here; {} measures the overall scale "
+                                     "too and is the baseline",
+                                     scaled->method));
+    return scaled;
+  }
+  const MethodHeldout* classic = out->Find(fmt::format("umbmark_{}", UmbmarkEstimatorToString(options.umbmark.estimator)));
+  return classic ? classic : out->Find("recorded");
+}
+
+/// Step 5b: what the held-out runs could and could not test (heldout.hpp).
+void DescribeChecks(const HeldoutComparison& h, const MethodHeldout& baseline, std::vector<std::string>* checked,
+                    std::vector<std::string>* not_checked) {
+  const bool other_shapes = h.scheme == "unseen_paths", other_sessions = h.scheme == "leave_one_session_out";
+  if (other_shapes) {
+    checked->push_back("paths of other shapes than the calibration runs, the overall scale (mean wheel diameter) "
+                       "included: they do not close on themselves");
+  } else if (other_sessions) {
+    checked->push_back(fmt::format("other recording sessions ({}) of the same shape: what changes between sessions "
+                                   "(floor, tyres, the ground truth's frame)",
+                                   h.sessions));
+  } else {
+    checked->push_back("the run-to-run scatter of one recording session of one shape (in-distribution)");
+  }
+  if (!other_shapes) {
+    not_checked->push_back(
+        baseline.fits_scale
+            ? "other shapes: squares close on themselves, so the overall scale (mean wheel diameter) hardly shows "
+              "in them and what holding it at the recorded value costs on circles and free paths does not; "
+              "methods that hold it (recorded, classic UMBmark) are therefore not recommended over one that "
+              "measures it"
+            : "the overall scale: no method compared here measures it (a square's return errors do not determine "
+              "it); measure the mean wheel diameter another way, or record the path with ground truth along it");
+  }
+  if (!other_shapes && !other_sessions) {
+    not_checked->push_back("other days or sessions: record squares in another session, or circles or free paths, "
+                           "and give them in a manifest to check the choice on them");
+  }
+  if (other_shapes && h.sessions < 2) {
+    not_checked->push_back("other days, unless the unseen paths were recorded on another day than the squares");
+  }
+}
+
 /// Step 5: the recommendation rule (heldout.hpp).
 void Recommend(const CalibrateJobOptions& options, const std::vector<bool>& complete, HeldoutComparison* out) {
-  const MethodHeldout* baseline = out->Find("plain_least_squares");
-  if (!baseline || !baseline->Recommendable()) {
-    baseline = out->Find(fmt::format("umbmark_{}", UmbmarkEstimatorToString(options.umbmark.estimator)));
-  }
-  if (baseline->method == "plain_least_squares") {
-    out->notes.push_back("the path determines wheelbase, both diameters and so the overall scale: the classic rows "
-                         "(scale held at the recorded value) are shown for reference, not recommended");
-  }
+  const MethodHeldout* baseline = Baseline(options, out);
+  // A comparison that cannot see the overall scale (held-out runs of the
+  // calibration's own shape) must not prefer a method holding it over a
+  // baseline that measures it; one session of one shape is no evidence
+  // that another full-path fit predicts other days better.
+  const bool scale_unchecked = out->scheme != "unseen_paths";
+  const bool held_scale_excluded = baseline->fits_scale && scale_unchecked;
+  const bool in_distribution = out->scheme == "leave_one_run_out" || out->scheme == "k_fold_over_runs";
+  DescribeChecks(*out, *baseline, &out->checked, &out->not_checked);
   out->baseline = baseline->method;
   const MethodHeldout* chosen = baseline;
   const int folds = out->methods.front().folds;
+  // May `h` displace the baseline at all?
+  auto eligible = [&](const MethodHeldout& h) {
+    if (h.method == "recorded") return !held_scale_excluded;
+    return h.Recommendable() && h.simplicity >= baseline->simplicity && (h.fits_scale || !held_scale_excluded);
+  };
   if (folds < 3) {
     out->notes.push_back(fmt::format("only {} folds: too few to compare the methods; the simplest well-determined "
                                      "calibration ({}) is recommended",
                                      folds, baseline->method));
     out->why = "too few folds to compare: the simplest well-determined calibration";
   } else {
-    // Where the path determines all three parameters (the baseline is
-    // plain least squares), the classic rows hold the overall scale at the
-    // recorded value the data contradict: shown, not recommended.
-    const int least = baseline->simplicity;
     const MethodHeldout* best = nullptr;
     for (const auto& h : out->methods) {
-      if (h.method != "recorded" && h.simplicity >= least && h.Recommendable() && (!best || h.mean_m < best->mean_m))
-        best = &h;
+      if (h.method != "recorded" && eligible(h) && (!best || h.mean_m < best->mean_m)) best = &h;
     }
     out->why = fmt::format("the simplest well-determined calibration ({})", baseline->method);
     if (best && best != baseline) {
@@ -339,7 +390,12 @@ void Recommend(const CalibrateJobOptions& options, const std::vector<bool>& comp
         out->why = "lowest held-out error (the simplest well-determined calibration failed)";
       } else {
         const auto [d, se] = PairedDifference(*best, *baseline, complete);
-        if (d > se) {
+        if (in_distribution && baseline->simplicity >= 2) {
+          out->why = fmt::format("the plain, well-determined full-path fit; {} is {:.2f} mm +- {:.2f} (SE) lower on "
+                                 "left-out runs of the same session and shape, which is no evidence for other days "
+                                 "or shapes",
+                                 best->method, d * 1e3, se * 1e3);
+        } else if (d > se) {
           chosen = best;
           out->why = fmt::format("lowest held-out error, {:.2f} mm +- {:.2f} (SE) below {}", d * 1e3, se * 1e3,
                                  baseline->method);
@@ -351,7 +407,7 @@ void Recommend(const CalibrateJobOptions& options, const std::vector<bool>& comp
       }
     }
     const MethodHeldout* rec = out->Find("recorded");
-    if (rec->folds > 0 && (!chosen->Recommendable() || rec->mean_m <= chosen->mean_m)) {
+    if (eligible(*rec) && rec->folds > 0 && (!chosen->Recommendable() || rec->mean_m <= chosen->mean_m)) {
       chosen = rec;
       out->why = "the recorded parameters have the lowest held-out error: no calibration predicts unseen runs better";
     }
@@ -359,11 +415,10 @@ void Recommend(const CalibrateJobOptions& options, const std::vector<bool>& comp
   out->recommended = chosen->method;
   out->expected_error_m = chosen->mean_m;
   out->expected_error_sem_m = chosen->sem_m;
-  // Runner-up: the lowest other method (recorded included) that could be recommended.
+  // Runner-up: the lowest other method that could be recommended.
   const MethodHeldout* second = nullptr;
   for (const auto& h : out->methods) {
-    const bool eligible = h.method == "recorded" || (h.Recommendable() && h.simplicity >= baseline->simplicity);
-    if (&h != chosen && eligible && h.folds > 0 && (!second || h.mean_m < second->mean_m)) second = &h;
+    if (&h != chosen && eligible(h) && h.folds > 0 && (!second || h.mean_m < second->mean_m)) second = &h;
   }
   if (second && chosen->folds > 0) {
     out->runner_up = second->method;
@@ -393,6 +448,7 @@ HeldoutComparison CompareMethodsHeldout(const CalibrateInput& input, const Calib
     MethodHeldout& h = out.methods[m];
     h.method = methods[m].name;
     h.simplicity = methods[m].simplicity;
+    h.fits_scale = methods[m].fits_scale;
     if (h.method == "refined" && full.refined) {
       h.parameters = full.refined->refined;
       continue;
@@ -406,10 +462,26 @@ HeldoutComparison CompareMethodsHeldout(const CalibrateInput& input, const Calib
     }
   }
   const std::vector<FoldGroup> groups = MakeFolds(input, used, &out);
-  const std::vector<bool> complete = RunFolds(input, options, methods, groups, with_trajectories, &out);
-  SummariseMethods(complete, &out);
-  Recommend(options, complete, &out);
+  RunFolds(input, options, methods, groups, with_trajectories, &out);
+  RecommendFromFolds(options, &out);
   return out;
+}
+
+void RecommendFromFolds(const CalibrateJobOptions& options, HeldoutComparison* out) {
+  if (out->methods.empty() || !out->Find("recorded")) throw InvalidOptions("RecommendFromFolds: no recorded method");
+  const std::size_t folds = out->methods.front().fold_errors_m.size();
+  std::vector<bool> complete(folds, true);
+  for (auto& m : out->methods) {
+    if (m.fold_errors_m.size() != folds) throw InvalidOptions("RecommendFromFolds: methods differ in their folds");
+    m.failed_folds = 0;
+    for (std::size_t k = 0; k < folds; ++k) {
+      const bool ok = std::isfinite(m.fold_errors_m[k]);
+      complete[k] = complete[k] && ok;
+      m.failed_folds += ok ? 0 : 1;
+    }
+  }
+  SummariseMethods(complete, out);
+  Recommend(options, complete, out);
 }
 
 ModelCheck CheckCentresAgainstModel(const CalibrateInput& input, const std::vector<RunFlag>& flags,

@@ -31,18 +31,32 @@
 //
 // Recommendation (never empty unless skipped):
 //  - the baseline is the simplest well-determined calibration:
-//    plain_least_squares where the path determines all three parameters,
-//    else the classic estimator asked for (umbmark_<estimator>); a method
-//    whose fit failed on some fold is not well determined and not
-//    recommendable;
-//  - another method, at least as complete as the baseline (with plain least
-//    squares as baseline the classic rows, which hold the overall scale the
-//    path determines, are shown but not recommended: on the OptiOdom
-//    sessions they lose up to 5.6 mm per pair, docs/calibration-comparison.md),
-//    is recommended only when it beats the baseline by more than the
-//    standard error of the paired difference; the lowest such;
-//  - `recorded` is recommended when its mean is the lowest;
+//    plain_least_squares where the path determines all three parameters;
+//    if it is not well determined, the refined full-path fit (it measures
+//    the overall scale too); else the classic estimator asked for
+//    (umbmark_<estimator>). A method whose fit failed on some fold is not
+//    well determined and not recommendable;
+//  - a method that holds the overall scale at the recorded value (recorded,
+//    classic UMBmark, the refined fit of return errors) is never
+//    recommended over a baseline that measures it unless the held-out runs
+//    are of other shapes (unseen_paths): squares close on themselves
+//    whatever the scale, so a comparison on squares cannot see what the
+//    held scale costs on circles and free paths (on the OptiOdom sessions
+//    the classic rows lose up to 5.6 mm per pair,
+//    docs/calibration-comparison.md);
+//  - with a full-path baseline and runs of ONE session and shape
+//    (leave_one_run_out, k_fold_over_runs) the baseline is kept: the
+//    comparison is in-distribution and no evidence that another method
+//    predicts other days or shapes better (the refined fit's margin on such
+//    folds did not carry over to other nights);
+//  - otherwise another method at least as complete as the baseline is
+//    recommended only when it beats the baseline by more than the standard
+//    error of the paired difference; the lowest such;
+//  - `recorded` is recommended when its mean is the lowest (and it is
+//    eligible, above);
 //  - with fewer than 3 folds the baseline (a note says why).
+// `checked` and `not_checked` say in words what the held-out runs could
+// and could not test (shapes, sessions, the overall scale).
 // The recommended method's mean and SE are the expected error on unseen
 // paths (expected_error_m, expected_error_sem_m).
 #pragma once
@@ -68,6 +82,10 @@ struct MethodHeldout {
   std::string failure;   ///< the first failure's message
   /// 0 recorded, 1 classic UMBmark, 2 plain least squares, 3 refined.
   int simplicity = 0;
+  /// The method measures the overall scale (mean wheel diameter): the
+  /// full-path fits with the scale not held. The others keep it at the
+  /// recorded value.
+  bool fits_scale = false;
   bool fitted_all = true;  ///< its fit on all used runs succeeded
   bool Recommendable() const { return fitted_all && failed_folds == 0 && folds > 0 && std::isfinite(mean_m); }
 };
@@ -97,6 +115,10 @@ struct HeldoutComparison {
   /// the simpler one although the runner-up's mean is lower.
   double runner_up_difference_m = 0.0, runner_up_difference_sem_m = 0.0;
   std::string runner_up;
+  /// What the held-out runs could test, and what they could not (one
+  /// sentence each, for the text and JSON `heldout.checked`,
+  /// `heldout.not_checked`).
+  std::vector<std::string> checked, not_checked;
   std::vector<std::string> notes;
 
   const MethodHeldout* Find(const std::string& method) const;
@@ -123,6 +145,14 @@ ModelCheck CheckCentresAgainstModel(const CalibrateInput& input, const std::vect
 /// calibration predicting held-out runs better than the recorded parameters.
 std::vector<std::string> TrustWarnings(const CalibrateJobResult& result, const HeldoutComparison& heldout,
                                        const ModelCheck& check);
+
+/// The recommendation rule alone (above) on methods whose fold errors are
+/// filled (NaN where a method failed; every method the same folds,
+/// `recorded` among them) and `out->scheme`, `sessions` set: computes each
+/// method's mean, SE and rms over the folds every method completed, then
+/// baseline, recommended, why, the expected error, the runner-up, checked,
+/// not_checked and notes. Throws InvalidOptions for inconsistent folds.
+void RecommendFromFolds(const CalibrateJobOptions& options, HeldoutComparison* out);
 
 /// Runs the comparison for `input`, given the job's options and its result
 /// on all runs (`full`). Never throws for a failing fold (recorded in the
