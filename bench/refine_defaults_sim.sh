@@ -25,18 +25,21 @@
 #     squares on the June cross-session pairs (docs/calibration-comparison.md);
 #     among those the lowest mean. If none qualifies, the default stays
 #     what it is but `calibrate` writes plain least squares (heldout.hpp).
-# Usage: bench/refine_defaults_sim.sh [BUILD_DIR [SEED]]   (default build, 3030)
+# Supplement (not part of the rule): FRAME=yaw gives the frame errors a yaw
+# only (origin 0), to test the reading that the yaw trades against E_d.
+# Usage: bench/refine_defaults_sim.sh [BUILD_DIR [SEED [FRAME]]]   (default build, 3030, yaw+origin)
 set -euo pipefail
 BUILD=${1:-build}
 SEED=${2:-3030}
+FRAME=${3:-both}
 GEN="$BUILD/indep_campaign"
 SIM="$BUILD/refine_defaults_sim"
 for exe in "$GEN" "$SIM"; do
   [[ -x "$exe" ]] || { echo "missing $exe (build the indep_campaign and refine_defaults_sim targets)" >&2; exit 2; }
 done
 OUT=$(mktemp -d "${TMPDIR:-/tmp}/umbmark-refine-defaults.XXXXXX")
-echo "seed $SEED; campaigns in $OUT"
-awk -v seed="$SEED" '
+echo "seed $SEED, frame errors $FRAME; campaigns in $OUT"
+awk -v seed="$SEED" -v yawonly="$([[ $FRAME == yaw ]] && echo 1 || echo 0)" '
 function U(a, b) { return a + (b - a) * rand() }
 function S() { return rand() < 0.5 ? -1 : 1 }
 BEGIN {
@@ -48,6 +51,7 @@ BEGIN {
     kl = exp(U(log(3e-4), log(1e-3))); kr = exp(U(log(3e-4), log(1e-3)))
     for (s = 0; s < 3; ++s) {
       yaw = frame ? S() * U(0.010, 0.030) : 0; dx = frame ? U(-0.03, 0.03) : 0; dy = frame ? U(-0.03, 0.03) : 0
+      if (yawonly) { dx = 0; dy = 0 }
       printf "%d %s %d %.8g %.8g --seed %d --side %s --distance %s --kl %.6g --kr %.6g --E-d %.8g --E-b %.8g --effect scale_error:s=-0.003 --effect gt_yaw_misalignment:delta=%.6g --effect gt_offset:dx=%.6g,dy=%.6g\n", \
         n, sides[k], frame, ed, eb, seed * 100 + n * 10 + s, sides[k], sides[k], kl, kr, ed, eb, yaw, dx, dy
     }
