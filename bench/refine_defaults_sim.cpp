@@ -26,8 +26,8 @@
 #include "calibration/calibrate_job.hpp"
 #include "calibration/refine.hpp"
 #include "evaluation/trajectory_eval.hpp"
-#include "io/data_file.hpp"
-#include "io/manifest.hpp"
+#include "formats/data_file.hpp"
+#include "formats/manifest.hpp"
 
 using namespace umbmark;
 
