@@ -26,5 +26,6 @@ Command SetupPredict(CLI::App& parent);
 Command SetupFitNoise(CLI::App& parent);
 Command SetupSummarize(CLI::App& parent);
 Command SetupCalibrateLidar(CLI::App& parent);
+Command SetupPlan(CLI::App& parent);
 
 }  // namespace umbmark::cli

@@ -101,6 +101,7 @@ int main(int argc, char** argv) {
   commands.push_back(cli::SetupFitNoise(app));
   commands.push_back(cli::SetupSummarize(app));
   commands.push_back(cli::SetupCalibrateLidar(app));
+  commands.push_back(cli::SetupPlan(app));
 
   // `umbmark import foo DIR`: name the unknown format instead of CLI11's
   // "A subcommand is required".

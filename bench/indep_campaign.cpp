@@ -29,7 +29,7 @@
 //   [--rate HZ] [--ticks N] [--pause S] [--accel A] [--heading-hold K] [--free N]
 //   [--side M] [--distance M] [--speed V] [--turn-rate W] [--kl K] [--kr K]
 //   [--E-d X] [--E-b X] [--gt-sigma-xy M] [--gt-sigma-theta R]
-//   [--wheelbase M] [--diameter M] [--settle S]
+//   [--wheelbase M] [--diameter M] [--settle S] [--square-runs N] [--fwd-back-runs M]
 // Effects (contract names, same parameters; --effect may be repeated to
 // combine them): scale_error:s, direction_asymmetry:a, castor_kick:kappa,
 // gt_offset:dx,dy, time_offset:tau, bump_outliers:rate,sigma,
@@ -88,6 +88,7 @@ struct Options {
   std::uint64_t seed = 1;
   std::map<std::string, std::map<std::string, double>> effects;
   double rate_hz = 20.0, ticks = 4096.0, pause_s = 1.0, accel = 0.0, heading_hold = 0.0, free_runs = 0.0;
+  double square_runs = 10.0, fwd_back_runs = 20.0;  ///< squares per direction; back-and-forth runs (0: none)
   double settle_s = 0.1;  ///< standstill_motion: how long the robot settles [s]
   double side_m = 3.0, distance_m = 3.0, speed = 0.3, turn_rate = 1.0;
   double k_L = 1e-3, k_R = 1e-3, E_d = 1.0, E_b = 1.0, gt_xy = 3e-4, gt_th = 1e-3;
@@ -365,7 +366,7 @@ Options Parse(int argc, char** argv) {
       {"--kl", &o.k_L},           {"--kr", &o.k_R},            {"--E-d", &o.E_d},
       {"--E-b", &o.E_b},          {"--gt-sigma-xy", &o.gt_xy}, {"--gt-sigma-theta", &o.gt_th},
       {"--wheelbase", &o.wheelbase}, {"--diameter", &o.diameter}, {"--free", &o.free_runs},
-      {"--settle", &o.settle_s}};
+      {"--settle", &o.settle_s}, {"--square-runs", &o.square_runs}, {"--fwd-back-runs", &o.fwd_back_runs}};
   for (int i = 1; i < argc; ++i) {
     const std::string k = argv[i];
     if (i + 1 >= argc) {
@@ -420,10 +421,11 @@ int main(int argc, char** argv) {
   std::mt19937_64 gx(o.seed ^ 0x9E3779B97F4A7C15ULL);
   std::mt19937_64 gs(o.seed ^ 0xC2B2AE3D27D4EB4FULL);
   std::filesystem::create_directories(o.out);
-  // Squares: 10 cw + 10 ccw alternating; each: pause, 4 x (leg, pause, turn, pause).
+  // Squares: N cw + N ccw alternating (--square-runs N, default 10); each:
+  // pause, 4 x (leg, pause, turn, pause).
   std::vector<std::pair<std::string, std::vector<Sample>>> squares, fwd_back;
   const double inner_pause = o.pause_s, end_pause = std::max(o.pause_s, 1.0);
-  for (int r = 0; r < 20; ++r) {
+  for (int r = 0; r < 2 * static_cast<int>(o.square_runs); ++r) {
     const bool cw = r % 2 == 0;
     Robot robot(o, g, gx, gs);
     robot.Pause(end_pause);
@@ -435,8 +437,8 @@ int main(int argc, char** argv) {
     }
     squares.emplace_back(cw ? "cw" : "ccw", robot.Finish());
   }
-  // Back and forth: pause, forward, pause, back, pause.
-  for (int r = 0; r < 20; ++r) {
+  // Back and forth (--fwd-back-runs, default 20): pause, forward, pause, back, pause.
+  for (int r = 0; r < static_cast<int>(o.fwd_back_runs); ++r) {
     Robot robot(o, g, gx, gs);
     robot.Pause(end_pause);
     robot.Leg(o.distance_m, true);
@@ -462,15 +464,17 @@ int main(int argc, char** argv) {
     free_paths.emplace_back("free", robot.Finish());
   }
   WriteRuns(o.out + "/square.csv", squares);
-  WriteRuns(o.out + "/fwd_back.csv", fwd_back);
+  if (!fwd_back.empty()) WriteRuns(o.out + "/fwd_back.csv", fwd_back);
   if (!free_paths.empty()) WriteRuns(o.out + "/free.csv", free_paths);
   std::ofstream m(o.out + "/campaign.toml");
   m << fmt::format(
       "# written by bench/indep_campaign (independent generator)\n[robot]\nwheelbase_m = {}\n"
       "wheel_diameter_left_m = {}\nwheel_diameter_right_m = {}\nticks_per_rev = {}\n\n[ground_truth]\n"
-      "sigma_xy_m = {}\nsigma_theta_rad = {}\n\n[[experiment]]\nkind = \"square\"\nside_m = {}\nfile = \"square.csv\"\n\n"
-      "[[experiment]]\nkind = \"back_and_forth\"\ndistance_m = {}\nfile = \"fwd_back.csv\"\n",
-      o.wheelbase, o.diameter, o.diameter, o.ticks, o.gt_xy, o.gt_th, o.side_m, o.distance_m);
+      "sigma_xy_m = {}\nsigma_theta_rad = {}\n\n[[experiment]]\nkind = \"square\"\nside_m = {}\nfile = \"square.csv\"\n",
+      o.wheelbase, o.diameter, o.diameter, o.ticks, o.gt_xy, o.gt_th, o.side_m);
+  if (!fwd_back.empty())
+    m << fmt::format("\n[[experiment]]\nkind = \"back_and_forth\"\ndistance_m = {}\nfile = \"fwd_back.csv\"\n",
+                     o.distance_m);
   if (!free_paths.empty()) m << "\n[[experiment]]\nkind = \"free\"\nfile = \"free.csv\"\n";
   std::ofstream t(std::filesystem::path(o.out).parent_path() / "truth.json");
   t << fmt::format("{{\"seed\": {}, \"E_d\": {}, \"E_b\": {}, \"k_L\": {}, \"k_R\": {}, \"effects\": {{", o.seed, o.E_d,

@@ -1,0 +1,349 @@
+// `umbmark plan --robot R.toml --kl K --kr K [--noise FIT.json]
+//   [--ground-truth mocap|scan|tape] [--gt-sigma-xy S --gt-sigma-theta S]
+//   [--target-E_d H] [--target-E_b H] [--target-scale H] [--target-k H]
+//   [--max-side M] [--max-time S] [--speed V] [--json FILE] [--motions FILE.json]`:
+// the runs to drive for a target precision (lib/planning, docs/plan.md).
+// `umbmark plan --check MANIFEST.toml [--kl K --kr K | --noise FIT.json]
+//   [--json FILE]`: what a recorded campaign determines, and the smallest
+// addition that separates what it confuses.
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "core/errors.hpp"
+#include "formats/file_text.hpp"
+#include "formats/data_file.hpp"
+#include "formats/manifest.hpp"
+#include "planning/check.hpp"
+#include "planning/plan.hpp"
+
+namespace umbmark::cli {
+namespace {
+
+struct PlanFlags {
+  RobotFlags robot;
+  std::optional<double> k_L, k_R;
+  std::string noise_json;
+  std::string ground_truth = "mocap";
+  std::optional<double> gt_sigma_xy, gt_sigma_theta;
+  std::optional<double> target_E_d, target_E_b, target_scale, target_k;
+  double max_side = 3.0;
+  std::optional<double> max_time;
+  double speed = 0.3, turn_rate = 1.0, pause = 1.0, rate = 20.0;
+  JsonFlag json;
+  std::string motions;
+  std::string check;  ///< --check MANIFEST
+};
+
+/// k_L, k_R of a `fit-noise --json` file.
+WheelNoise NoiseFromJson(const std::string& path) {
+  const std::string text = io::ReadWholeFile(path);
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(path, 0, e.byte, fmt::format("not valid JSON: {}", e.what()));
+  }
+  auto get = [&](const char* key) {
+    if (!j.is_object() || !j.contains(key) || !j[key].is_number())
+      throw InputError(path, fmt::format("no number `{}` (expected the JSON of `umbmark fit-noise --json`)", key));
+    const double v = j[key].get<double>();
+    if (!std::isfinite(v) || v < 0.0) throw InputError(path, fmt::format("`{}` = {} must be a finite number >= 0", key, v));
+    return v;
+  };
+  return {get("k_L"), get("k_R")};
+}
+
+planning::PlanOptions LibraryOptions(const PlanFlags& f) {
+  planning::PlanOptions o;
+  o.robot = f.robot.Resolve();
+  if (!f.noise_json.empty()) {
+    if (f.k_L || f.k_R) throw InvalidOptions("give the wheel noise either as --noise FIT.json or as --kl/--kr, not both");
+    o.noise = NoiseFromJson(f.noise_json);
+  } else {
+    if (!f.k_L || !f.k_R) throw InvalidOptions("the wheel noise is needed: --kl K --kr K, or --noise FIT.json");
+    o.noise = {*f.k_L, *f.k_R};
+  }
+  o.ground_truth = *planning::GroundTruthKindFromString(f.ground_truth);
+  o.gt_sigma_xy_m = f.gt_sigma_xy;
+  o.gt_sigma_theta_rad = f.gt_sigma_theta;
+  o.target_E_d = f.target_E_d;
+  o.target_E_b = f.target_E_b;
+  o.target_scale = f.target_scale;
+  o.target_k = f.target_k;
+  o.max_side_m = f.max_side;
+  o.max_time_s = f.max_time;
+  o.timing.speed_m_s = f.speed;
+  o.timing.turn_rate_rad_s = f.turn_rate;
+  o.timing.pause_s = f.pause;
+  o.rate_hz = f.rate;
+  if (auto e = o.Check(); !e.empty()) throw InvalidOptions(e);
+  return o;
+}
+
+nlohmann::json JsonDesign(const planning::PlanDesign& d) {
+  return {{"square_side_m", d.square_side_m},
+          {"runs_cw", d.runs_cw},
+          {"runs_ccw", d.runs_ccw},
+          {"back_and_forth_runs", d.back_and_forth_runs},
+          {"back_and_forth_length_m", d.back_and_forth_length_m},
+          {"free_paths", d.free_paths},
+          {"pause_s", d.pause_s},
+          {"time_s", d.time_s}};
+}
+
+/// (name, predicted, target) of the five quantities.
+std::vector<std::tuple<const char*, std::optional<double>, std::optional<double>>> Quantities(
+    const planning::HalfWidths& h, const planning::PlanOptions& o) {
+  return {{"E_d", h.E_d, o.target_E_d},
+          {"E_b", h.E_b, o.target_E_b},
+          {"scale", h.scale, o.target_scale},
+          {"k_L", h.k_L, o.target_k},
+          {"k_R", h.k_R, o.target_k}};
+}
+
+nlohmann::json JsonMotions(const std::vector<planning::DesignMotion>& motions) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& dm : motions) {
+    const planning::Motion& m = dm.motion;
+    nlohmann::json j = {{"kind", planning::MotionKindToString(m.kind)}};
+    switch (m.kind) {
+      case planning::Motion::Kind::kLine: j["distance_m"] = m.distance_m; j["speed"] = m.speed; break;
+      case planning::Motion::Kind::kTurn: j["angle_rad"] = m.angle_rad; j["speed"] = m.speed; break;
+      case planning::Motion::Kind::kArc:
+        j["radius_m"] = m.radius_m;
+        j["angle_rad"] = m.angle_rad;
+        j["speed"] = m.speed;
+        break;
+      case planning::Motion::Kind::kPause: j["duration_s"] = m.duration_s; break;
+    }
+    j["run"] = dm.run;
+    j["experiment"] = planning::RunKindToString(dm.kind);
+    out.push_back(j);
+  }
+  return out;
+}
+
+void PrintPlan(const planning::PlanResult& r, const planning::PlanOptions& o) {
+  const planning::GroundTruthModel gt = o.GroundTruth();
+  const planning::PlanDesign& d = r.design;
+  fmt::print("Plan for a robot of wheelbase {:.4f} m, wheel noise k_L = {:.3g}, k_R = {:.3g} m^1/2, ground truth {} "
+             "({}, {:.2f} mm / {:.2f} mrad)\n",
+             o.robot.wheelbase_m, o.noise.k_L, o.noise.k_R, planning::GroundTruthKindToString(o.ground_truth),
+             gt.along_path ? "along the path" : "end points only", gt.sigma_xy_m * 1e3, gt.sigma_theta_rad * 1e3);
+  fmt::print("  calibrate would recommend {} on it\n", r.method);
+  fmt::print("Drive:\n");
+  fmt::print("  squares of {:.2f} m: {} cw + {} ccw runs, alternating\n", d.square_side_m, d.runs_cw, d.runs_ccw);
+  if (d.back_and_forth_runs > 0)
+    fmt::print("  back and forth: {} runs of {:.2f} m out and back\n", d.back_and_forth_runs, d.back_and_forth_length_m);
+  for (const auto& p : d.free_paths) fmt::print("  free path: {}\n", p);
+  fmt::print("  at {:.2f} m/s and {:.2f} rad/s, {:.1f} s pauses between motions, {:.1f} s standing at each run's start "
+             "and end\n",
+             o.timing.speed_m_s, o.timing.turn_rate_rad_s, o.timing.pause_s, o.timing.EndPause());
+  fmt::print("  driving time {:.0f} s ({:.1f} min)\n", d.time_s, d.time_s / 60.0);
+  fmt::print("Predicted 95 % half-widths (the estimate lies this close to the truth in 95 % of campaigns):\n");
+  for (const auto& [name, pred, target] : Quantities(r.predicted, o)) {
+    if (!pred && !target) continue;
+    fmt::print("  {:<6} {:>10}  {}{}\n", name, pred ? fmt::format("{:.3g}", *pred) : "undetermined",
+               target ? fmt::format("target {:.3g}", *target) : "(not targeted)",
+               std::string(name).starts_with(r.binding) && target ? "   <- decides the number of runs" : "");
+  }
+  for (const auto& n : r.notes) fmt::print("  note: {}\n", n);
+  fmt::print("Next: drive it (--motions FILE.json lists the motions), then `umbmark calibrate` and `umbmark plan "
+             "--check` on the recording.\n");
+}
+
+/// Names of the quantities with a half-width in `h`, as JSON.
+nlohmann::json JsonHalfWidths(const planning::HalfWidths& h) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [name, v] : {std::pair{"E_d", h.E_d}, std::pair{"E_b", h.E_b}, std::pair{"scale", h.scale},
+                                std::pair{"k_L", h.k_L}, std::pair{"k_R", h.k_R}})
+    if (v) j[name] = JsonNumber(*v);
+  return j;
+}
+
+void PrintCheck(const std::string& manifest, const planning::CheckResult& r) {
+  fmt::print("What {} determines ({} cw + {} ccw square runs, {} other runs; ground truth {}, {:.2f} mm / {:.2f} "
+             "mrad)\n",
+             manifest, r.square_runs_cw, r.square_runs_ccw, r.other_runs,
+             r.ground_truth.along_path ? "along the path" : "at the end points", r.ground_truth.sigma_xy_m * 1e3,
+             r.ground_truth.sigma_theta_rad * 1e3);
+  fmt::print("  calibrate would recommend {}; wheel noise k_L = {:.3g}, k_R = {:.3g} m^1/2{}\n", r.method, r.noise.k_L,
+             r.noise.k_R, r.noise_fitted ? " (fitted to these runs)" : "");
+  fmt::print("Predicted 95 % half-widths:\n");
+  for (const auto& [name, v] : {std::pair{"E_d", r.predicted.E_d}, std::pair{"E_b", r.predicted.E_b},
+                                std::pair{"scale", r.predicted.scale}, std::pair{"k_L", r.predicted.k_L},
+                                std::pair{"k_R", r.predicted.k_R}})
+    fmt::print("  {:<6} {}\n", name, v ? fmt::format("{:.3g}", *v) : "not determined");
+  if (r.cannot_separate.empty()) {
+    fmt::print("The design separates every parameter and effect checked.\n");
+  } else {
+    fmt::print("Cannot tell apart:\n");
+    for (const auto& c : r.cannot_separate)
+      fmt::print("  {}{}\n    add: {}\n", fmt::join(c.what, " / "),
+                 c.what.size() == 1 ? " (not excited or not determined)" : fmt::format(" (correlation {:.3f})", c.correlation),
+                 c.add);
+  }
+  for (const auto& n : r.notes) fmt::print("  note: {}\n", n);
+}
+
+int RunCheck(const PlanFlags& f) {
+  RegisterInputs({f.check}, &f.robot);
+  if (!f.noise_json.empty()) CommandOutputs().AddInput(f.noise_json);
+  CommandOutputs().AddOutput("--json", f.json.path);
+  CommandOutputs().Check();
+  if (!f.motions.empty()) throw InvalidOptions("--motions writes a planned design; it does not go with --check");
+  if (!io::IsManifestPath(f.check)) throw InvalidOptions(fmt::format("--check {}: expected a campaign manifest (.toml)", f.check));
+  const Manifest m = io::ReadManifest(f.check);
+  const RobotParams robot = f.robot.Resolve(m.robot);
+  planning::CheckOptions o;
+  if (!f.noise_json.empty()) {
+    if (f.k_L || f.k_R) throw InvalidOptions("give the wheel noise either as --noise FIT.json or as --kl/--kr, not both");
+    o.noise = NoiseFromJson(f.noise_json);
+  } else if (f.k_L || f.k_R) {
+    if (!f.k_L || !f.k_R) throw InvalidOptions("--kl and --kr go together");
+    o.noise = WheelNoise{*f.k_L, *f.k_R};
+  }
+  if (m.ground_truth) o.ground_truth = planning::GroundTruthModel{true, m.ground_truth->sigma_xy_m, m.ground_truth->sigma_theta_rad};
+  if (f.gt_sigma_xy || f.gt_sigma_theta) {
+    planning::GroundTruthModel g = o.ground_truth.value_or(planning::GroundTruthModel{});
+    if (f.gt_sigma_xy) g.sigma_xy_m = *f.gt_sigma_xy;
+    if (f.gt_sigma_theta) g.sigma_theta_rad = *f.gt_sigma_theta;
+    o.ground_truth = g;
+  }
+  o.timing.speed_m_s = f.speed;
+  o.timing.turn_rate_rad_s = f.turn_rate;
+  o.timing.pause_s = f.pause;
+  o.rate_hz = f.rate;
+  std::vector<io::RunFile> files;
+  files.reserve(m.experiments.size());
+  std::vector<planning::CheckExperiment> experiments;
+  for (const auto& e : m.experiments) files.push_back(io::ReadRunFile(e.resolved_file));
+  for (std::size_t i = 0; i < m.experiments.size(); ++i) {
+    const auto& e = m.experiments[i];
+    planning::CheckExperiment x{e.kind, e.side_m, e.distance_m, e.resolved_file, nullptr, nullptr};
+    if (auto* t = std::get_if<TrajectoryData>(&files[i])) x.trajectories = t;
+    else x.endpoints = &std::get<EndpointData>(files[i]);
+    experiments.push_back(x);
+  }
+  const planning::CheckResult r = planning::CheckCampaign(robot, experiments, o);
+  nlohmann::json conf = nlohmann::json::array();
+  for (const auto& c : r.cannot_separate) conf.push_back({{"what", c.what}, {"add", c.add}, {"correlation", c.correlation}});
+  nlohmann::json j = {{"input", f.check},
+                      {"predicted_ci95", JsonHalfWidths(r.predicted)},
+                      {"cannot_separate", conf},
+                      {"method", r.method},
+                      {"k_L", r.noise.k_L},
+                      {"k_R", r.noise.k_R},
+                      {"noise_fitted", r.noise_fitted},
+                      {"ground_truth", {{"along_path", r.ground_truth.along_path},
+                                        {"sigma_xy_m", r.ground_truth.sigma_xy_m},
+                                        {"sigma_theta_rad", r.ground_truth.sigma_theta_rad}}},
+                      {"square_runs_cw", r.square_runs_cw},
+                      {"square_runs_ccw", r.square_runs_ccw},
+                      {"other_runs", r.other_runs},
+                      {"notes", r.notes},
+                      {"warnings", nlohmann::json::array()}};
+  if (f.json.PrintText()) PrintCheck(f.check, r);
+  if (!f.json.path.empty()) f.json.EmitAndListOutputs(j, {});
+  return 0;
+}
+
+int RunPlan(const PlanFlags& f) {
+  if (!f.check.empty()) return RunCheck(f);
+  RegisterInputs(f.noise_json.empty() ? std::vector<std::string>{} : std::vector<std::string>{f.noise_json}, &f.robot);
+  CommandOutputs().AddOutput("--json", f.json.path);
+  CommandOutputs().AddOutput("--motions", f.motions);
+  CommandOutputs().Check();
+  const planning::PlanOptions o = LibraryOptions(f);
+  const planning::PlanResult r = planning::Plan(o);
+  if (!r.ok()) throw QualityGateError("umbmark plan: target cannot be met: " + r.unmet);
+  nlohmann::json pred = nlohmann::json::object(), other = nlohmann::json::object(), targets = nlohmann::json::object();
+  for (const auto& [name, p, target] : Quantities(r.predicted, o)) {
+    if (target) {
+      pred[name] = p ? JsonNumber(*p) : nullptr;
+      targets[name] = *target;
+    } else if (p) {
+      other[name] = *p;
+    }
+  }
+  const planning::GroundTruthModel gt = o.GroundTruth();
+  nlohmann::json j = {{"design", JsonDesign(r.design)},
+                      {"predicted_ci95", pred},
+                      {"targets", targets},
+                      {"also_predicted_ci95", other},
+                      {"binding", r.binding},
+                      {"method", r.method},
+                      {"ground_truth", {{"kind", planning::GroundTruthKindToString(o.ground_truth)},
+                                        {"sigma_xy_m", gt.sigma_xy_m},
+                                        {"sigma_theta_rad", gt.sigma_theta_rad}}},
+                      {"k_L", o.noise.k_L},
+                      {"k_R", o.noise.k_R},
+                      {"notes", r.notes},
+                      {"warnings", nlohmann::json::array()}};
+  if (f.json.PrintText()) PrintPlan(r, o);
+  std::vector<std::string> written;
+  if (!f.motions.empty()) {
+    CommandOutputs().Write(f.motions, DumpJson(JsonMotions(planning::DesignMotions(r.design, o))) + "\n");
+    written.push_back(f.motions + " (motions)");
+  }
+  if (!f.json.path.empty()) {
+    f.json.EmitAndListOutputs(j, written);
+  } else {
+    PrintWritten(written, true);
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command SetupPlan(CLI::App& parent) {
+  auto f = std::make_shared<PlanFlags>();
+  auto* app = parent.add_subcommand("plan", "The runs to drive for a target precision of the calibration and noise");
+  f->robot.Bind(*app);
+  app->add_option("--kl", f->k_L, "Left wheel noise k_L [m^1/2] the plan assumes")->check(NonNegative());
+  app->add_option("--kr", f->k_R, "Right wheel noise k_R [m^1/2]")->check(NonNegative());
+  app->add_option("--noise", f->noise_json, "k_L, k_R from a `fit-noise --json` file instead of --kl/--kr");
+  app->add_option("--ground-truth", f->ground_truth,
+                  "Where the ground truth sees the robot: mocap (along the path), scan, tape (end points only)")
+      ->check(CLI::IsMember({"mocap", "scan", "tape"}))
+      ->capture_default_str();
+  app->add_option("--gt-sigma-xy", f->gt_sigma_xy,
+                  "Ground truth noise per axis and pose [m] (default mocap 0.0003, scan 0.005, tape 0.002)")
+      ->check(NonNegative());
+  app->add_option("--gt-sigma-theta", f->gt_sigma_theta,
+                  "Ground truth heading noise per pose [rad] (default mocap 0.001, scan and tape 0.005)")
+      ->check(NonNegative());
+  app->add_option("--target-E_d", f->target_E_d, "95 % half-width wanted for E_d (a fraction, e.g. 0.0005)")
+      ->check(Positive());
+  app->add_option("--target-E_b", f->target_E_b, "95 % half-width wanted for E_b (a fraction)")->check(Positive());
+  app->add_option("--target-scale", f->target_scale, "95 % half-width wanted for the overall scale (a fraction)")
+      ->check(Positive());
+  app->add_option("--target-k", f->target_k, "95 % half-width wanted for k_L and k_R each [m^1/2]")->check(Positive());
+  app->add_option("--max-side", f->max_side, "Free floor space: longest square side and back-and-forth length [m]")
+      ->check(Plausible("side_m"))
+      ->capture_default_str();
+  app->add_option("--max-time", f->max_time, "Driving time allowed [s]")->check(Positive());
+  app->add_option("--speed", f->speed, "Driving speed [m/s]")->check(Positive())->capture_default_str();
+  app->add_option("--turn-rate", f->turn_rate, "Spot-turn rate [rad/s]")->check(Positive())->capture_default_str();
+  app->add_option("--pause", f->pause, "Pause between motions [s]")->check(NonNegative())->capture_default_str();
+  app->add_option("--rate", f->rate, "Logging rate of the recording [Hz]")->check(NumberIn(0.1, 10000.0))->capture_default_str();
+  f->json.Bind(*app);
+  app->add_option("--motions", f->motions, "Write the design as a list of motions (JSON) a robot script can drive");
+  app->add_option("--check", f->check,
+                  "Instead of planning: what the recorded campaign MANIFEST.toml determines, and what it cannot "
+                  "tell apart");
+  return {app, [f] { return RunPlan(*f); }};
+}
+
+}  // namespace umbmark::cli

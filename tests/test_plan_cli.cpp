@@ -1,0 +1,92 @@
+// `umbmark plan` and `plan --check` end to end: the contract's JSON keys,
+// exit 3 naming the target that cannot be met, bad input (exit 1/2, nothing
+// written), the motions list, and --check's predicted intervals against the
+// spread between the four June square sessions.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "support/run_cli.hpp"
+
+using namespace umbmark::testing;
+namespace fs = std::filesystem;
+
+namespace {
+const fs::path kSrc = UMBMARK_SOURCE_DIR;
+const std::string kRobot = Q(kSrc / "data/examples/robot.toml");
+}  // namespace
+
+TEST_CASE("plan --json writes the contract's design and predicted_ci95", "[plan][cli]") {
+  const fs::path dir = TempDir("plan");
+  const auto r = RunCli("plan --robot " + kRobot + " --kl 1e-3 --kr 8e-4 --target-E_d 5e-4 --target-E_b 2e-3 "
+                        "--target-k 2e-4 --max-side 2 --json " + Q(dir / "plan.json") + " --motions " +
+                        Q(dir / "motions.json"));
+  INFO(r.out << r.err);
+  REQUIRE(r.status == 0);
+  const auto j = nlohmann::json::parse(Slurp((dir / "plan.json").string()));
+  for (const char* key : {"square_side_m", "runs_cw", "runs_ccw", "back_and_forth_runs", "back_and_forth_length_m",
+                          "pause_s", "time_s"})
+    CHECK(j.at("design").at(key).is_number());
+  CHECK(j["design"]["free_paths"].is_array());
+  for (const char* key : {"E_d", "E_b", "k_L", "k_R"}) {
+    INFO(key);
+    CHECK(j.at("predicted_ci95").at(key).get<double>() > 0.0);
+    CHECK(j["predicted_ci95"][key].get<double>() <= j["targets"][key].get<double>());
+  }
+  CHECK_FALSE(j["predicted_ci95"].contains("scale"));  // not targeted
+  CHECK(j["design"]["square_side_m"].get<double>() <= 2.0);
+  // The motions: every run's lines and turns, and the time they take equals time_s.
+  const auto m = nlohmann::json::parse(Slurp((dir / "motions.json").string()));
+  REQUIRE(m.is_array());
+  double t = 0.0, turn = 0.0;
+  int runs = 0;
+  for (const auto& x : m) {
+    const std::string kind = x.at("kind");
+    if (kind == "line") t += std::abs(x["distance_m"].get<double>()) / x["speed"].get<double>();
+    if (kind == "turn") {
+      t += std::abs(x["angle_rad"].get<double>()) / x["speed"].get<double>();
+      turn += x["angle_rad"].get<double>();
+    }
+    if (kind == "pause") t += x["duration_s"].get<double>();
+    runs = std::max(runs, x["run"].get<int>());
+  }
+  CHECK(t == Approx(j["design"]["time_s"].get<double>()).epsilon(1e-9));
+  CHECK(runs == j["design"]["runs_cw"].get<int>() + j["design"]["runs_ccw"].get<int>() +
+                    j["design"]["back_and_forth_runs"].get<int>());
+  CHECK(turn == Approx(0.0).margin(1e-9));  // as many cw as ccw squares
+}
+
+TEST_CASE("plan exits 3 naming the target that cannot be met", "[plan][cli]") {
+  const fs::path dir = TempDir("plan3");
+  const auto tape = RunCli("plan --robot " + kRobot + " --kl 1e-3 --kr 1e-3 --ground-truth tape --target-scale 0.01 "
+                           "--json " + Q(dir / "p.json"));
+  CHECK(tape.status == 3);
+  CHECK(tape.err.find("scale") != std::string::npos);
+  CHECK(tape.err.find("never determine the overall scale") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "p.json"));
+  const auto slow = RunCli("plan --robot " + kRobot + " --kl 1e-3 --kr 1e-3 --target-E_b 1e-4 --max-time 60");
+  CHECK(slow.status == 3);
+  CHECK(slow.err.find("E_b") != std::string::npos);
+  CHECK(slow.err.find("--max-time") != std::string::npos);
+}
+
+TEST_CASE("plan: bad input exits 1 or 2 and writes nothing", "[plan][cli]") {
+  const fs::path dir = TempDir("planbad");
+  const std::string out = " --json " + Q(dir / "p.json");
+  CHECK(RunCli("plan --robot " + kRobot + " --kl 1e-3 --kr 1e-3" + out).status == 2);          // no target
+  CHECK(RunCli("plan --robot " + kRobot + " --target-E_d 1e-3" + out).status == 2);            // no noise
+  CHECK(RunCli("plan --robot " + kRobot + " --kl -1 --kr 1e-3 --target-E_d 1e-3" + out).status == 2);
+  CHECK(RunCli("plan --robot " + kRobot + " --kl 1e-3 --kr 1e-3 --target-E_d 0" + out).status == 2);
+  CHECK(RunCli("plan --robot " + kRobot + " --kl 1e-3 --kr 1e-3 --target-E_d 1e-3 --ground-truth laser" + out).status == 2);
+  const auto missing = RunCli("plan --robot " + kRobot + " --noise " + Q(dir / "none.json") + " --target-E_d 1e-3" + out);
+  CHECK(missing.status == 1);
+  std::ofstream((dir / "fit.json").string()) << "{\"k_L\": 0.001}";
+  const auto partial = RunCli("plan --robot " + kRobot + " --noise " + Q(dir / "fit.json") + " --target-E_d 1e-3" + out);
+  CHECK(partial.status == 1);
+  CHECK(partial.err.find("k_R") != std::string::npos);
+  CHECK(RunCli("plan --check " + Q(dir / "nope.toml") + out).status == 1);
+  CHECK_FALSE(fs::exists(dir / "p.json"));
+}
