@@ -47,8 +47,10 @@ PLAN_ARGS=("$@")
 if ((${#PLAN_ARGS[@]} == 0)); then
   PLAN_ARGS=(--target-E_d 4e-4 --target-E_b 1.5e-3 --target-k 1.5e-4 --max-side 2)
 fi
+t0=$(date +%s.%N)
 "$UMBMARK" plan --robot "$OUT/robot.toml" --kl $KL --kr $KR --gt-sigma-xy $GXY --gt-sigma-theta $GTH \
   "${PLAN_ARGS[@]}" --json "$OUT/plan.json" > /dev/null
+t_plan=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.3f", b - a }')
 side=$(jq -r .design.square_side_m "$OUT/plan.json")
 runs=$(jq -r .design.runs_cw "$OUT/plan.json")
 bf=$(jq -r .design.back_and_forth_runs "$OUT/plan.json")
@@ -82,6 +84,13 @@ campaign() {  # seed squares_per_direction fwd_back_runs
   rm -rf "$dir"
 }
 
+# Speed of `plan --check` on one campaign of the plan (a standard campaign).
+"$GEN" --out "$OUT/speed/campaign" --seed "$SEED" --side "$side" --square-runs "$runs" --fwd-back-runs "$bf" \
+  --distance "$( [[ "$len" == 0 ]] && echo 1 || echo "$len")" --kl $KL --kr $KR --E-d $ED --E-b $EB --wheelbase $B --diameter $D
+t0=$(date +%s.%N)
+"$UMBMARK" plan --check "$OUT/speed/campaign/campaign.toml" > /dev/null
+t_check=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.3f", b - a }')
+echo "speed (wall, on a shared machine): plan $t_plan s, plan --check $t_check s (targets < 1 s, < 2 s)"
 reduced_runs=$(awk -v n="$runs" 'BEGIN { r = int(0.7 * n + 0.5); print (r < 2 ? 2 : r) }')
 reduced_bf=$(awk -v n="$bf" 'BEGIN { r = int(0.7 * n + 0.5); print (n == 0 ? 0 : (r < 2 ? 2 : r)) }')
 for i in $(seq 1 "$N"); do campaign $((SEED * 1000 + i)) "$runs" "$bf"; done > "$OUT/full.txt"
