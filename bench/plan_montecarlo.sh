@@ -19,8 +19,8 @@
 #   (default build, 200 campaigns, seed 3001; default plan targets below).
 #   Exit 0 when every target above holds, 1 otherwise. With N < 200 (the
 #   ctest `plan_montecarlo_small`, N = 40) the tolerances are the ones a
-#   sample of N allows: coverage >= 0.85, width ratio within 35 %, and the
-#   reduced design's binding coverage below the plan's.
+#   sample of N allows: coverage >= 0.85, width ratio within 35 %; the
+#   reduced design is left out (40 campaigns cannot tell 90 % from 95 %).
 set -euo pipefail
 BUILD=${1:-build}
 N=${2:-200}
@@ -97,7 +97,12 @@ echo "speed (wall, on a shared machine): plan $t_plan s, plan --check $t_check s
 reduced_runs=$(awk -v n="$runs" 'BEGIN { r = int(0.7 * n + 0.5); print (r < 2 ? 2 : r) }')
 reduced_bf=$(awk -v n="$bf" 'BEGIN { r = int(0.7 * n + 0.5); print (n == 0 ? 0 : (r < 2 ? 2 : r)) }')
 for i in $(seq 1 "$N"); do campaign $((SEED * 1000 + i)) "$runs" "$bf"; done > "$OUT/full.txt"
-for i in $(seq 1 "$N"); do campaign $((SEED * 1000 + 500 + i)) "$reduced_runs" "$reduced_bf"; done > "$OUT/reduced.txt"
+# The reduced design only in the full bench (N >= 200): with fewer campaigns
+# its coverage cannot be told from the plan's.
+: > "$OUT/reduced.txt"
+if ((N >= 200)); then
+  for i in $(seq 1 "$N"); do campaign $((SEED * 1000 + 500 + i)) "$reduced_runs" "$reduced_bf"; done > "$OUT/reduced.txt"
+fi
 echo "30 % fewer runs: $reduced_runs + $reduced_runs squares, $reduced_bf back-and-forth runs"
 
 status=0
@@ -111,7 +116,7 @@ for q in "${QUANT[@]}"; do
   # The Monte Carlo half-width: the 95th percentile of |estimate - truth|.
   mc=$(grep -v fail "$OUT/full.txt" | awk -v c="$c" '{ print ($c < 0 ? -$c : $c) }' | sort -g |
     awk '{ a[NR] = $1 } END { i = int(0.95 * NR + 0.999); if (i < 1) i = 1; printf "%.4g", a[i] }')
-  cov_red=$(grep -v fail "$OUT/reduced.txt" | awk -v c="$c" -v t="$target" '{ e = $c < 0 ? -$c : $c; n++; if (e <= t) hit++ } END { printf "%.4f", hit / n }')
+  cov_red=$(grep -v fail "$OUT/reduced.txt" | awk -v c="$c" -v t="$target" '{ e = $c < 0 ? -$c : $c; n++; if (e <= t) hit++ } END { if (n) printf "%.4f", hit / n; else printf "-" }')
   ratio=$(awk -v p="$pred" -v m="$mc" 'BEGIN { printf "%.3f", p / m }')
   mark=""
   [[ "$binding" == "$q" ]] && mark="  <- binding"
@@ -119,12 +124,8 @@ for q in "${QUANT[@]}"; do
   if ((N >= 200)); then min_cov=0.93 tol=0.15; else min_cov=0.85 tol=0.35; fi
   awk -v c="$cov" -v m="$min_cov" 'BEGIN { exit !(c >= m) }' || { echo "  FAIL: coverage $cov < $min_cov"; status=1; }
   awk -v r="$ratio" -v t="$tol" 'BEGIN { exit !(r >= 1 - t && r <= 1 + t) }' || { echo "  FAIL: ratio $ratio outside 1 +- $tol"; status=1; }
-  if [[ -n "$mark" ]]; then
-    if ((N >= 200)); then
-      awk -v c="$cov_red" 'BEGIN { exit !(c < 0.93) }' || { echo "  FAIL: 30 % fewer runs still cover $cov_red"; status=1; }
-    else
-      awk -v c="$cov_red" -v f="$cov" 'BEGIN { exit !(c < f) }' || { echo "  FAIL: 30 % fewer runs cover as much"; status=1; }
-    fi
+  if [[ -n "$mark" ]] && ((N >= 200)); then
+    awk -v c="$cov_red" 'BEGIN { exit !(c < 0.93) }' || { echo "  FAIL: 30 % fewer runs still cover $cov_red"; status=1; }
   fi
 done
 echo "failed campaigns: $(grep -c fail "$OUT/full.txt" || true) + $(grep -c fail "$OUT/reduced.txt" || true)"
