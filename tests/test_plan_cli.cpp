@@ -67,10 +67,15 @@ TEST_CASE("plan exits 3 naming the target that cannot be met", "[plan][cli]") {
   CHECK(tape.err.find("scale") != std::string::npos);
   CHECK(tape.err.find("never determine the overall scale") != std::string::npos);
   CHECK_FALSE(fs::exists(dir / "p.json"));
-  const auto slow = RunCli("plan --robot " + kRobot + " --kl 1e-3 --kr 1e-3 --target-E_b 1e-4 --max-time 60");
+  const auto slow = RunCli("plan --robot " + kRobot + " --kl 1e-3 --kr 1e-3 --target-E_b 1e-3 --max-time 60");
   CHECK(slow.status == 3);
   CHECK(slow.err.find("E_b") != std::string::npos);
-  CHECK(slow.err.find("--max-time") != std::string::npos);
+  CHECK(slow.err.find("--max-time allows 60 s") != std::string::npos);
+  // Out of reach within 200 runs per direction at the largest side: says how many it would take.
+  const auto far = RunCli("plan --robot " + kRobot + " --kl 1e-3 --kr 1e-3 --target-E_b 1e-4");
+  CHECK(far.status == 3);
+  CHECK(far.err.find("E_b half-width") != std::string::npos);
+  CHECK(far.err.find("the target needs about") != std::string::npos);
 }
 
 TEST_CASE("plan: bad input exits 1 or 2 and writes nothing", "[plan][cli]") {
