@@ -112,11 +112,11 @@ for q in "${QUANT[@]}"; do
   c=$(col "$q")
   target=$(jq -r ".targets.$q" "$OUT/plan.json")
   pred=$(jq -r ".predicted_ci95.$q" "$OUT/plan.json")
-  cov=$(grep -v fail "$OUT/full.txt" | awk -v c="$c" -v t="$target" '{ e = $c < 0 ? -$c : $c; n++; if (e <= t) hit++ } END { printf "%.4f", hit / n }')
+  cov=$({ grep -v fail "$OUT/full.txt" || true; } | awk -v c="$c" -v t="$target" '{ e = $c < 0 ? -$c : $c; n++; if (e <= t) hit++ } END { printf "%.4f", hit / n }')
   # The Monte Carlo half-width: the 95th percentile of |estimate - truth|.
-  mc=$(grep -v fail "$OUT/full.txt" | awk -v c="$c" '{ print ($c < 0 ? -$c : $c) }' | sort -g |
+  mc=$({ grep -v fail "$OUT/full.txt" || true; } | awk -v c="$c" '{ print ($c < 0 ? -$c : $c) }' | sort -g |
     awk '{ a[NR] = $1 } END { i = int(0.95 * NR + 0.999); if (i < 1) i = 1; printf "%.4g", a[i] }')
-  cov_red=$(grep -v fail "$OUT/reduced.txt" | awk -v c="$c" -v t="$target" '{ e = $c < 0 ? -$c : $c; n++; if (e <= t) hit++ } END { if (n) printf "%.4f", hit / n; else printf "-" }')
+  cov_red=$({ grep -v fail "$OUT/reduced.txt" || true; } | awk -v c="$c" -v t="$target" '{ e = $c < 0 ? -$c : $c; n++; if (e <= t) hit++ } END { if (n) printf "%.4f", hit / n; else printf "-" }')
   ratio=$(awk -v p="$pred" -v m="$mc" 'BEGIN { printf "%.3f", p / m }')
   mark=""
   [[ "$binding" == "$q" ]] && mark="  <- binding"

@@ -116,7 +116,7 @@ TEST_CASE("plain least squares: the sandwich matches a simulation of the noise i
   }
 }
 
-TEST_CASE("plan: tape cannot give the scale; mocap can; tighter targets need more runs", "[plan]") {
+TEST_CASE("plan: tape cannot give the scale, mocap can, tighter targets need more runs", "[plan]") {
   PlanOptions o;
   o.robot = Robot();
   o.noise = {1e-3, 1e-3};
