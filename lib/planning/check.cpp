@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <tuple>
 
 #include <Eigen/Dense>
 #include <fmt/format.h>
@@ -502,8 +503,17 @@ CheckResult CheckCampaign(const RobotParams& robot, const std::vector<CheckExper
   }
   for (const auto& nr : g.noise_runs) cm.noise_runs.push_back({nr.group, nr.basis, nr.measurement, 1.0});
   const Eigen::Vector2d k = NoiseHalfWidths(NoiseInformation(cm.noise_runs, r.noise), r.noise);
-  if (std::isfinite(k(0))) r.predicted.k_L = k(0);
-  if (std::isfinite(k(1))) r.predicted.k_R = k(1);
+  // A k the fit put at its boundary 0 has no interval the information can give.
+  const double k_floor = 1e-3 * std::max(r.noise.k_L, r.noise.k_R);
+  for (const auto& [value, width, name] : {std::tuple{r.noise.k_L, k(0), "k_L"}, std::tuple{r.noise.k_R, k(1), "k_R"}}) {
+    if (!(value > k_floor)) {
+      r.notes.push_back(fmt::format("{} = {:.2g} m^1/2 is at its boundary 0: this campaign does not determine it "
+                                    "(its half-width is left out)",
+                                    name, value));
+      continue;
+    }
+    if (std::isfinite(width)) (std::string(name) == "k_L" ? r.predicted.k_L : r.predicted.k_R) = width;
+  }
   r.cannot_separate = Confusions(cm, Candidates(side, b, g.along_path, r.ground_truth, r.noise, o), r, o);
   return r;
 }
