@@ -246,7 +246,7 @@ Candidate BestAtSide(double side, const std::vector<double>& lengths, const std:
   if (n0 > o.max_runs) {
     const CalibrationWidths at_max = SquareWidths(cw, ccw, o.max_runs, o.max_runs, side, o);
     const double w = binding == "E_d" ? at_max.E_d : binding == "E_b" ? at_max.E_b : at_max.scale;
-    *why_not = std::isfinite(w) ? fmt::format("{} runs per direction of a {:.2f} m square give a {} half-width of {:.3g}; "
+    *why_not = std::isfinite(w) ? fmt::format("{} runs per direction of a {:.2f} m square give the {} half-width {:.3g}; "
                                               "the target needs about {} runs",
                                               o.max_runs, side, binding, w, n0)
                                 : fmt::format("a {:.2f} m square does not determine {}", side, binding);
