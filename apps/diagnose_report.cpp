@@ -394,6 +394,22 @@ void TopPiecesTable(io::HtmlReport& rep, const nlohmann::json& j) {
   rep.Table({"#", "experiment", "run", "piece", "starts after", "component", "residual [SE]"}, rows, 4);
 }
 
+/// Faulty runs (contract `run_faults`), left out of every fit: which run,
+/// what is wrong with it and what to do, then the test.
+void RunFaultTable(io::HtmlReport& rep, const nlohmann::json& j) {
+  const auto faults = j.value("run_faults", nlohmann::json::array());
+  if (faults.empty()) return;
+  rep.Heading("Faulty runs (left out of every fit below)");
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& f : faults) {
+    const auto& run = f.at("run");
+    rows.push_back({fmt::format("{}", f.value("experiment", 0)), run.is_string() ? run.get<std::string>() : run.dump(),
+                    f.value("what", "")});
+  }
+  rep.Table({"experiment", "run", "what is wrong, what to do"}, rows);
+  rep.Paragraph("Test: " + j.value("run_fault_test", std::string()) + ".");
+}
+
 }  // namespace
 
 // The page: verdict and next steps first (from the diagnosis' own
@@ -420,6 +436,7 @@ std::string DiagnoseReportHtml(const nlohmann::json& j, const std::string& manif
   for (const auto& s : j.value("next_steps", nlohmann::json::array()))
     if (s.is_string()) steps.push_back(s.get<std::string>());
   rep.NextSteps(steps);
+  RunFaultTable(rep, j);
   std::vector<std::string> warnings;
   for (const auto& w : j.value("warnings", nlohmann::json::array())) warnings.push_back(w.get<std::string>());
   for (const auto& w : j.value("notes", nlohmann::json::array()))

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -51,6 +52,7 @@ std::string DiagnoseOptions::Check() const {
       return "effect wheel_noise_error needs the given model's wheel noise (--kl, --kr)";
   }
   if (auto e = pieces.Check(); !e.empty()) return "pieces: " + e;
+  if (auto e = run_faults.Check(); !e.empty()) return "run_faults: " + e;
   if (!(gap.threshold_se >= 0.0)) return fmt::format("gap.threshold_se = {} must be >= 0", gap.threshold_se);
   return {};
 }
@@ -274,13 +276,87 @@ void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit
         out.notes.push_back(std::move(n));
 }
 
-}  // namespace
+/// The ground-truth noise of the baseline (fitted, or the manifest's)
+/// against the standstill scatter (standstill_noise.hpp): a warning when
+/// either sd is more than twice or less than half the scatter (beyond the
+/// scatter's own sampling error of about 20 % at its fewest 30 differences).
+std::string StandstillDisagreement(const BaselineSummary& b) {
+  const StandstillNoise& s = b.standstill;
+  if (!s.measured) return {};
+  auto off = [](double a, double ref) { return ref > 0.0 && (a > 2.0 * ref || a < 0.5 * ref); };
+  const bool xy = off(b.sigma_xy_m, s.sigma_xy_m), th = off(b.sigma_theta_rad, s.sigma_theta_rad);
+  if (!xy && !th) return {};
+  return fmt::format(
+      "the ground truth's noise {} ({:.3g} mm, {:.3g} mrad) is {:.2g} x / {:.2g} x the scatter measured inside the "
+      "standstills ({:.3g} mm, {:.3g} mrad, from {} sample-to-sample differences at least {:.1f} s after a stop): {}",
+      b.ground_truth_estimated ? "fitted to the pieces" : "stated in the manifest", 1e3 * b.sigma_xy_m,
+      1e3 * b.sigma_theta_rad, b.sigma_xy_m / s.sigma_xy_m, b.sigma_theta_rad / s.sigma_theta_rad,
+      1e3 * s.sigma_xy_m, 1e3 * s.sigma_theta_rad, s.differences, StandstillNoiseOptions{}.settle_s,
+      b.ground_truth_estimated
+          ? "the fit takes in something that is not measurement noise (an effect at the stops or along the pieces), "
+            "which the gap test then cannot see; state the motion capture's noise in the manifest ([ground_truth] "
+            "sigma_xy_m, sigma_theta_rad) and diagnose again"
+          : "check the manifest's [ground_truth] values");
+}
+
+/// Stage 1b: faults of single runs (run_faults.hpp) under the baseline of
+/// all runs. Returns the campaign without the faulty runs when there are
+/// any (and at least two runs with pieces stay), else nothing; the faults
+/// and the test go into `out` either way.
+std::optional<CampaignData> ScanRunFaults(const CampaignData& recorded, const CampaignData& c, const MeanModel& model,
+                                          const BaselineFit& base, const DiagnoseOptions& options,
+                                          DiagnoseSummary& out) {
+  RunFaultOptions ro = options.run_faults;
+  ro.seed = options.seed;
+  RunFaultScan scan = FindRunFaults(c, model, base, ro);
+  out.run_fault_test = std::move(scan.test);
+  out.run_faults = std::move(scan.faults);
+  if (out.run_faults.empty() || out.run_faults.size() + 2 > c.runs.size()) return std::nullopt;
+  std::vector<int> drop;
+  for (const RunFault& f : out.run_faults) drop.push_back(f.run);
+  CampaignData rest = WithoutRuns(recorded, drop);
+  if (rest.pieces.empty()) return std::nullopt;
+  return rest;
+}
+
+DiagnoseSummary DiagnoseCampaign(const CampaignData& recorded, const DiagnoseOptions& options, bool scan_faults);
+
+/// The diagnosis of the campaign without its faulty runs, carrying the
+/// faults found on all runs.
+DiagnoseSummary WithoutFaultyRuns(const CampaignData& rest, const DiagnoseOptions& options, DiagnoseSummary& first,
+                                  StageTimer& timer) {
+  timer.Lap("run faults");
+  DiagnoseSummary out = DiagnoseCampaign(rest, options, false);
+  std::vector<std::string> names;
+  for (const RunFault& f : first.run_faults) names.push_back(fmt::format("experiment {} run {}", f.experiment + 1, f.run_id));
+  out.notes.insert(out.notes.begin(), fmt::format("{} faulty run{} left out of every fit below: {}",
+                                                  first.run_faults.size(), first.run_faults.size() == 1 ? "" : "s",
+                                                  fmt::join(names, ", ")));
+  std::vector<std::string> steps;
+  for (const RunFault& f : first.run_faults)
+    steps.push_back(fmt::format("Experiment {} run {} is faulty, not the robot: {}. It is left out of everything else "
+                                "in this diagnosis.",
+                                f.experiment + 1, f.run_id, f.what));
+  out.next_steps.insert(out.next_steps.begin(), steps.begin(), steps.end());
+  out.run_faults = std::move(first.run_faults);
+  out.run_fault_test = std::move(first.run_fault_test);
+  std::vector<std::pair<std::string, double>> t = timer.Finish();
+  t.pop_back();  // the first pass' total
+  for (auto& [k, v] : t) k = "first pass (all runs): " + k;
+  const double total = out.timings.back().second + [&] {
+    double s = 0.0;
+    for (const auto& [k, v] : t) s += v;
+    return s;
+  }();
+  out.timings.insert(out.timings.begin(), t.begin(), t.end());
+  out.timings.back().second = total;
+  return out;
+}
 
 // The diagnosis as its numbered stages, each a call into its own file. About
-// 85 lines because each stage's options are filled from DiagnoseOptions here,
+// 95 lines because each stage's options are filled from DiagnoseOptions here,
 // in place, so that every route of a user's option is visible in one place.
-DiagnoseSummary Diagnose(const CampaignData& recorded, const DiagnoseOptions& options) {
-  if (auto e = options.Check(); !e.empty()) throw InvalidOptions("diagnose: " + e);
+DiagnoseSummary DiagnoseCampaign(const CampaignData& recorded, const DiagnoseOptions& options, bool scan_faults) {
   DiagnoseSummary out;
   out.alpha = options.alpha;
   out.seed = options.seed;
@@ -309,10 +385,17 @@ DiagnoseSummary Diagnose(const CampaignData& recorded, const DiagnoseOptions& op
     out.notes.push_back(fmt::format("encoder stops: {} (log-likelihood {:+.1f} against the other reading)",
                                     StopModelToString(c.stop_model), stops.loglik_margin));
   timer.Lap("baseline fit and stop reading");
+  if (scan_faults) {
+    if (std::optional<CampaignData> rest = ScanRunFaults(recorded, c, model, base, options, out))
+      return WithoutFaultyRuns(*rest, options, out, timer);
+    timer.Lap("run faults");
+  }
   out.notes.insert(out.notes.end(), base.notes.begin(), base.notes.end());
   const ReturnCheck returns = CheckReturns(c, model, base);
   out.baseline = Summarise(c, start, base, returns);
   out.baseline.given = options.given;
+  out.baseline.standstill = MeasureStandstillNoise(c);
+  if (std::string w = StandstillDisagreement(out.baseline); !w.empty()) out.warnings.push_back(std::move(w));
   timer.Lap("baseline predictions");
 
   // 2. Where, and the gap's null distribution.
@@ -365,6 +448,13 @@ DiagnoseSummary Diagnose(const CampaignData& recorded, const DiagnoseOptions& op
   out.next_steps = AdviseNextSteps(c, out);
   out.timings = timer.Finish();
   return out;
+}
+
+}  // namespace
+
+DiagnoseSummary Diagnose(const CampaignData& recorded, const DiagnoseOptions& options) {
+  if (auto e = options.Check(); !e.empty()) throw InvalidOptions("diagnose: " + e);
+  return DiagnoseCampaign(recorded, options, options.find_run_faults);
 }
 
 }  // namespace umbmark::diag

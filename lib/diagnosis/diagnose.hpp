@@ -65,6 +65,8 @@
 #include "diagnosis/piece_residuals.hpp"
 #include "diagnosis/pieces.hpp"
 #include "diagnosis/return_check.hpp"
+#include "diagnosis/run_faults.hpp"
+#include "diagnosis/standstill_noise.hpp"
 #include "diagnosis/where.hpp"
 #include "simulation/effects.hpp"
 
@@ -111,6 +113,11 @@ struct DiagnoseOptions {
   /// runs. Only with it are wheelbase_error, diameter_ratio_error and
   /// wheel_noise_error candidates.
   std::optional<GivenModel> given;
+  /// Look for faults of single runs (run_faults.hpp) and fit the effects
+  /// without them. Default true.
+  bool find_run_faults = true;
+  /// The run-fault test's options (its seed is `seed`'s).
+  RunFaultOptions run_faults;
   PieceOptions pieces;
   GapOptions gap;
   /// Progress of the whole diagnosis (core/progress.hpp), in thousandths:
@@ -127,6 +134,9 @@ struct BaselineSummary {
   double k_L = 0.0, k_R = 0.0;
   double sigma_xy_m = 0.0, sigma_theta_rad = 0.0;
   bool ground_truth_estimated = false;
+  /// The ground truth's noise measured inside standstills, where no
+  /// candidate effect reaches it (standstill_noise.hpp).
+  StandstillNoise standstill;
   std::string start;  ///< where E_d, E_b started (refine or nominal)
   std::vector<ReturnPrediction> returns;
   std::vector<GrowthRow> growth;
@@ -180,6 +190,15 @@ struct DiagnoseSummary {
   /// With a given model: what to change in the user's simulation, for every
   /// parameter error the verdict names.
   std::vector<ParameterCorrection> corrections;
+  /// Faults of single runs (run_faults.hpp; contract `run_faults`): these
+  /// runs were left out, and everything else in this summary (baseline,
+  /// candidates, verdict) is fitted without them.
+  std::vector<RunFault> run_faults;
+  /// The run-fault test in one sentence (empty when it did not run).
+  std::string run_fault_test;
+  /// What a person must know before trusting the numbers (JSON `warnings`):
+  /// e.g. a fitted ground-truth noise the standstills contradict.
+  std::vector<std::string> warnings;
   std::vector<std::pair<std::string, double>> timings;  ///< stage, seconds
   std::vector<std::string> experiment_labels;
   std::vector<std::string> notes;

@@ -115,9 +115,18 @@ GapSummary ComputeGap(const CampaignData& campaign, const std::vector<Scores>& s
     std::vector<std::array<double, 6>> per_run;  // sum[3], count[3] by run index in experiment
   };
   std::vector<Acc> acc(S);
+  // Run indices as the runs carry them: a campaign without its faulty runs
+  // (run_faults.hpp) keeps every other run's index, so there are gaps.
+  std::vector<std::size_t> runs_in(campaign.experiments.size(), 0);
+  std::size_t runs_all = 0;
+  for (const DiagRun& r : campaign.runs) {
+    auto& n = runs_in[static_cast<std::size_t>(r.experiment)];
+    n = std::max(n, static_cast<std::size_t>(r.index_in_experiment) + 1);
+    runs_all = std::max(runs_all, static_cast<std::size_t>(r.campaign_index) + 1);
+  }
   for (std::size_t s = 0; s < S; ++s) {
     const int e = campaign.subsets[s].experiment;
-    acc[s].per_run.assign(e >= 0 ? campaign.experiments[e].runs : campaign.runs.size(), {0, 0, 0, 0, 0, 0});
+    acc[s].per_run.assign(e >= 0 ? runs_in[static_cast<std::size_t>(e)] : runs_all, {0, 0, 0, 0, 0, 0});
   }
   static const int pa[3] = {0, 0, 1}, pb[3] = {1, 2, 2};
   for (std::size_t j = 0; j < campaign.pieces.size(); ++j) {

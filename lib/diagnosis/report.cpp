@@ -1,5 +1,6 @@
 // Output of the diagnosis: contract JSON, readable report, gap bar chart
 // (see diagnose.hpp).
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -125,6 +126,28 @@ nlohmann::json CandidatesJson(const DiagnoseSummary& s) {
   return cands;
 }
 
+/// A run id as in the file: a number when it is one.
+nlohmann::json RunId(const std::string& id) {
+  if (!id.empty() && id.size() < 16 && std::all_of(id.begin(), id.end(), [](char ch) { return ch >= '0' && ch <= '9'; }))
+    return std::stoll(id);
+  return id;
+}
+
+nlohmann::json RunFaultsJson(const DiagnoseSummary& s) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const RunFault& f : s.run_faults)
+    out.push_back({{"experiment", f.experiment + 1},
+                   {"run", RunId(f.run_id)},
+                   {"what", f.what},
+                   {"statistic", f.statistic},
+                   {"z", Num(f.z)},
+                   {"threshold", Num(f.threshold)},
+                   {"tau_s", Num(f.tau_s)},
+                   {"dx_m", Num(f.dx_m)},
+                   {"dy_m", Num(f.dy_m)}});
+  return out;
+}
+
 nlohmann::json BaselineJson(const BaselineSummary& b) {
   nlohmann::json returns = nlohmann::json::array();
   for (const auto& r : b.returns) {
@@ -151,6 +174,12 @@ nlohmann::json BaselineJson(const BaselineSummary& b) {
           {"sigma_xy_m", Num(b.sigma_xy_m)},
           {"sigma_theta_rad", Num(b.sigma_theta_rad)},
           {"ground_truth_noise_estimated", b.ground_truth_estimated},
+          {"standstill_scatter",
+           b.standstill.measured ? nlohmann::json{{"sigma_xy_m", Num(b.standstill.sigma_xy_m)},
+                                                  {"sigma_theta_rad", Num(b.standstill.sigma_theta_rad)},
+                                                  {"differences", b.standstill.differences},
+                                                  {"standstills", b.standstill.standstills}}
+                                 : nlohmann::json(nullptr)},
           {"start", b.start},
           {"return_error_noise_fit",
            b.return_fit ? nlohmann::json{{"k_L", Num(b.return_k_L)},
@@ -170,16 +199,33 @@ struct TextReport {
   void line(const std::string& t) { text += t + "\n"; }
 };
 
+void RunFaultSection(TextReport& o, const DiagnoseSummary& s) {
+  if (s.run_faults.empty()) {
+    if (!s.run_fault_test.empty()) o.line("Faulty runs: none (" + s.run_fault_test + ")");
+    o.line("");
+    return;
+  }
+  o.line(fmt::format("Faulty runs: {} (left out; everything below is fitted without {}):", s.run_faults.size(),
+                     s.run_faults.size() == 1 ? "it" : "them"));
+  for (const RunFault& f : s.run_faults)
+    o.line(fmt::format("  experiment {} run {}: {}", f.experiment + 1, f.run_id, f.what));
+  o.line("  test: " + s.run_fault_test);
+  o.line("");
+}
+
 void BaselineSection(TextReport& o, const DiagnoseSummary& s) {
   const BaselineSummary& b = s.baseline;
-  o.line("Diagnosis of the sim-to-real gap");
-  for (const auto& l : s.experiment_labels) o.line("  experiment " + l);
-  o.line("");
   o.line("1. Baseline (E_d, E_b, k_L, k_R; ground-truth noise " +
          std::string(b.ground_truth_estimated ? "estimated" : "as stated in the manifest") + ")");
   o.line(fmt::format("  E_d = {:.6f}   E_b = {:.6f}   k_L = {:.3g} m^1/2   k_R = {:.3g} m^1/2", b.E_d, b.E_b, b.k_L, b.k_R));
   o.line(fmt::format("  ground truth: sigma_xy = {:.3g} mm, sigma_theta = {:.3g} mrad; start: {}", 1e3 * b.sigma_xy_m,
                      1e3 * b.sigma_theta_rad, b.start));
+  if (b.standstill.measured)
+    o.line(fmt::format("  ground truth's scatter inside standstills: sigma_xy = {:.3g} mm, sigma_theta = {:.3g} mrad ({} "
+                       "sample-to-sample differences in {} standstills)",
+                       1e3 * b.standstill.sigma_xy_m, 1e3 * b.standstill.sigma_theta_rad, b.standstill.differences,
+                       b.standstill.standstills));
+  for (const auto& w : s.warnings) o.line("  WARNING: " + w);
   o.line(fmt::format("  {} runs, {} pieces", b.runs, b.pieces));
   if (b.return_fit)
     o.line(fmt::format("  cross-check, fit-noise on the runs' return errors: k_L = {:.3g} [{:.3g}, {:.3g}], k_R = {:.3g} "
@@ -334,6 +380,9 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
             {"unexplained_fraction", Num(s.unexplained_fraction)},
             {"reason", s.verdict_reason},
             {"negligible_threshold", Num(s.negligible_threshold)}}},
+          {"run_faults", RunFaultsJson(s)},
+          {"warnings", s.warnings},
+          {"run_fault_test", s.run_fault_test},
           {"indistinguishable", s.indistinguishable},
           {"baseline", BaselineJson(s.baseline)},
           {"experiments", s.experiment_labels},
@@ -347,6 +396,10 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
 
 std::string DiagnoseReport(const DiagnoseSummary& s) {
   TextReport o;
+  o.line("Diagnosis of the sim-to-real gap");
+  for (const auto& l : s.experiment_labels) o.line("  experiment " + l);
+  o.line("");
+  RunFaultSection(o, s);
   BaselineSection(o, s);
   WhereSection(o, s);
   CandidatesSection(o, s);
