@@ -1,6 +1,7 @@
 // Reading a diagnosis for a person (see advice.hpp).
 #include "diagnosis/advice.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -100,6 +101,80 @@ std::vector<std::string> MissingDesign(const CampaignData& c) {
   return out;
 }
 
+
+/// The concrete change for one named effect, in the numbers the explanation
+/// fitted (the same values as its table, the JSON and the simulate command):
+/// what to set on the robot, in the motion capture or in the simulation.
+std::string ConcreteChange(const ExplanationStep& step, const CampaignData& c, const DiagnoseSummary& s) {
+  const auto p = [&](const char* k) {
+    const auto it = step.params.find(k);
+    return it == step.params.end() ? 0.0 : it->second;
+  };
+  const RobotParams& robot = c.robot;
+  // The baseline's E_d, E_b turned into wheel diameters (contract: c_L =
+  // 2 / (E_d + 1), c_R = 2 / (1 / E_d + 1)) and the wheelbase E_b b.
+  const double cl = 2.0 / (s.baseline.E_d + 1.0), cr = 2.0 / (1.0 / s.baseline.E_d + 1.0);
+  switch (step.effect) {
+    case sim::EffectKind::kScaleError: {
+      const double f = 1.0 + p("s");
+      return fmt::format(
+          "Wheel diameters: both wheels are {:.2f}% {} than the model's. Set wheel_diameter_left_m = {:.5f} and "
+          "wheel_diameter_right_m = {:.5f} (the diameters x (1 + s) = x {:.5f}, with the fitted ratio E_d = {:.5f}; "
+          "now {:.5f} / {:.5f}), wheelbase_m = {:.5f} (E_b = {:.5f}); or re-measure the wheels on a tape-measured "
+          "straight run.",
+          100.0 * std::abs(p("s")), p("s") >= 0.0 ? "larger" : "smaller", cl * robot.wheel_diameter_left_m * f,
+          cr * robot.wheel_diameter_right_m * f, f, s.baseline.E_d, robot.wheel_diameter_left_m,
+          robot.wheel_diameter_right_m, s.baseline.E_b * robot.wheelbase_m, s.baseline.E_b);
+    }
+    case sim::EffectKind::kGtOffset:
+      return fmt::format(
+          "Motion capture: the tracked point is at (dx, dy) = ({:+.1f}, {:+.1f}) mm from the axle midpoint in the "
+          "robot frame (x forward, y left). Enter that offset as the marker's position in the rigid body (move the "
+          "rigid body's origin by ({:+.1f}, {:+.1f}) mm, onto the axle midpoint), or subtract it from the recorded "
+          "poses.",
+          1e3 * p("dx"), 1e3 * p("dy"), -1e3 * p("dx"), -1e3 * p("dy"));
+    case sim::EffectKind::kTimeOffset:
+      return fmt::format(
+          "Clock: the ground truth {} the encoders by {:.1f} ms (a sample stamped t shows the pose at t {} {:.1f} ms). "
+          "Shift the ground-truth timestamps by {:+.1f} ms (or the encoders' by {:+.1f} ms), or synchronise the two "
+          "clocks.",
+          p("tau") >= 0.0 ? "lags" : "leads", 1e3 * std::abs(p("tau")), p("tau") >= 0.0 ? "-" : "+",
+          1e3 * std::abs(p("tau")), -1e3 * p("tau"), 1e3 * p("tau"));
+    case sim::EffectKind::kRunTimeOffset:
+      return fmt::format(
+          "Clock per run: each run's ground truth is offset from its encoders by a different amount (sd {:.0f} ms "
+          "over the runs). Synchronise the clocks at the start of every recording (e.g. align on the first motion).",
+          1e3 * p("tau_sd"));
+    case sim::EffectKind::kTurnScrub:
+      return fmt::format(
+          "Spot turns turn {:.1f}% less than the wheels say (k = {:.4f}): the wheels scrub. For spot turns the "
+          "effective wheelbase is {:.5f} m (wheelbase / (1 - k)); model it as turn_scrub in the simulation, or "
+          "turn while driving.",
+          100.0 * p("k"), p("k"), s.baseline.E_b * robot.wheelbase_m / (1.0 - p("k")));
+    case sim::EffectKind::kDirectionAsymmetry:
+      return fmt::format("Driving backward the wheels travel {:.2f}% {} per turn than forward: calibrate the backward "
+                         "direction separately (or check for backlash in the gears).",
+                         100.0 * std::abs(p("a")), p("a") >= 0.0 ? "more" : "less");
+    case sim::EffectKind::kCastorKick:
+      return fmt::format("Castor: the heading jumps by {:.1f} mrad at every start from standstill (sign with the drive "
+                         "direction). Check the castor's swivel and play, or start more gently.",
+                         1e3 * p("kappa"));
+    case sim::EffectKind::kCastorSwivel:
+      return fmt::format("Swivel castor: after a spot turn the heading jumps by {:.1f} mrad (with the turn's sign) at "
+                         "the next start. A castor with less trail or play, or a short straight creep after turns.",
+                         1e3 * p("kappa"));
+    case sim::EffectKind::kParameterDrift:
+      return fmt::format("The right wheel's diameter drifts by {:.3g}% per run ({:.2g}% over the {} runs): tyre wear, "
+                         "pressure or temperature. Re-calibrate between sessions, or let the wheels warm up first.",
+                         100.0 * p("r"), 100.0 * p("r") * std::max(0, s.baseline.runs - 1), s.baseline.runs);
+    case sim::EffectKind::kStopSlide:
+      return fmt::format("Stops: the chassis slides on after the wheels stop (d = {:.3g} s^2/m: {:.1f} mm at 0.5 m/s). "
+                         "Ramp the speed down before stops, or add grip.",
+                         p("d"), 1e3 * p("d") * 0.25);
+    default:
+      return {};
+  }
+}
 }  // namespace
 
 // The steps follow the verdict. For `unexplained` they start from the data
@@ -126,8 +201,17 @@ std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSu
     if (const std::string why = UnphysicalFit(name, cand.params, s.baseline.runs, cand.param_se); !why.empty())
       symptoms.push_back(fmt::format("{} ({})", name, why));
   }
+  // For every named effect, the concrete change with the fitted numbers
+  // (for `unexplained`, after the discrepancy to look at first).
+  std::vector<std::string> changes;
+  for (const ExplanationStep& step : s.explanation) {
+    const std::string name = sim::EffectToString(step.effect);
+    if (std::find(s.verdict_effects.begin(), s.verdict_effects.end(), name) == s.verdict_effects.end()) continue;
+    if (std::string change = ConcreteChange(step, c, s); !change.empty()) changes.push_back(std::move(change));
+  }
   if (s.verdict != "unexplained") {
-    out.push_back(fmt::format("Model or fix {} (fitted values in the candidate table), then diagnose again: the gap "
+    out.insert(out.end(), changes.begin(), changes.end());
+    out.push_back(fmt::format("Model or fix {} (fitted values in the explanation table), then diagnose again: the gap "
                               "should be gone.", fmt::join(s.verdict_effects.empty() ? std::vector<std::string>{s.verdict}
                                                                                      : s.verdict_effects, " and ")));
     std::vector<std::string> specs;
@@ -158,6 +242,7 @@ std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSu
                               "and check the ground truth there (marker swaps, dropped samples, timing).",
                               exp, w.subset, StatKindToString(w.statistic), w.component, w.z));
   }
+  out.insert(out.end(), changes.begin(), changes.end());
   if (!symptoms.empty())
     out.push_back("These effects fitted impossible values, so the gap is something else that they try to imitate: " +
                   fmt::format("{}", fmt::join(symptoms, "; ")) + ".");
