@@ -197,7 +197,7 @@ TEST_CASE("A namespaced /robot1/tf_static is found, or named with --tf-static", 
   CHECK_THAT(ImportError("namespaced_tf.mcap", o), Contains("--tf-static topic /robot2/tf_static is not in the recording"));
 }
 
-TEST_CASE("--side contradicted by the odometry's legs is refused", "[scan][rosbag2][issue29]") {
+TEST_CASE("A --side contradicted by the odometry's legs is refused", "[scan][rosbag2][issue29]") {
   // room_b.db3: 1.2 m squares; 1.5 m given.
   const RobotParams robot = io::ReadRobotToml((kScan / "robot_b.toml").string());
   Rosbag2ImportOptions o = Options(1.5);
