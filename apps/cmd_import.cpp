@@ -393,7 +393,7 @@ int RunRosbag2(Rosbag2Options o) {
                                                         opt.wheels_topic.empty() ? opt.odometry_topic : opt.wheels_topic,
                                                         opt.scan_topic, opt.imu_topic.empty() ? "" : ", gyro " + opt.imu_topic, o.time);
   WriteImportedCampaign(robot, result.experiment, result.runs, o.out, comment, o.force, result.ground_truth,
-                        io::rosbag2::ScanManifestKeys(result.scan));
+                        result.ground_truth_keys);
 
   nlohmann::json recordings = nlohmann::json::array();
   for (const auto& r : result.recordings)

@@ -6,27 +6,25 @@
 #include <cctype>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <set>
 
 #include <fmt/format.h>
 
 #include "core/angles.hpp"
 #include "core/errors.hpp"
-#include "ros2/messages.hpp"
-#include "ground_truth/scan_ground_truth.hpp"
-#include "ros2/tf_tree.hpp"
+#include "ground_truth/pose_stream.hpp"
+#include "ground_truth/source.hpp"
 #include "import/wheel_checks.hpp"
+#include "ros2/bag_text.hpp"
+#include "ros2/messages.hpp"
+#include "ros2/tf_tree.hpp"
 
 namespace umbmark::io::rosbag2 {
 
 namespace {
 
 constexpr double kStillM = 1e-6;  // a wheel is still when its travel changes less than this
-
-struct GtSample {
-  std::int64_t t_ns;
-  double x, y, yaw;  // yaw unwrapped after reading
-};
 
 std::string Lower(std::string_view s) {
   std::string o(s);
@@ -100,33 +98,6 @@ class JointPicker {
   std::size_t li_ = 0, ri_ = 0;
 };
 
-std::string Where(const BagMessage& m, const TopicInfo& t, std::size_t index) {
-  if (m.compressed_chunk)
-    return fmt::format("topic {} ({}), message {} (record at byte {} of the decompressed chunk at byte {})", t.name, t.type,
-                       index, m.chunk_byte, m.offset);
-  return m.offset > 0 ? fmt::format("topic {} ({}), message {} (record at byte {})", t.name, t.type, index, m.offset)
-                      : fmt::format("topic {} ({}), message {}", t.name, t.type, index);
-}
-
-const char* StampName(StampSource s) { return s == StampSource::kHeader ? "header" : "receive"; }
-
-// A stamp that does not increase: refused with what to try. (Equal stamps
-// with equal values are dropped by the caller before this.)
-[[noreturn]] void StampGoesBack(std::int64_t prev, std::int64_t t, const BagMessage& m, const TopicInfo& topic,
-                                std::size_t index, StampSource time, bool equal_values) {
-  std::string hint;
-  if (time == StampSource::kHeader)
-    hint = t == prev && !equal_values
-               ? "two messages with one header stamp but different values; try --time log (receive time; --time "
-                 "WHEELS,GROUND_TRUTH sets each stream)"
-               : "try --time log (receive time; --time WHEELS,GROUND_TRUTH sets each stream)";
-  else
-    hint = "receive times go back: the storage files are out of order (metadata.yaml's relative_file_paths, or the "
-           "BAGs given in the wrong order) or the recording machine's clock jumped; try --time header";
-  throw InputError(*m.file, fmt::format("{}: {} stamp {} s does not increase (previous {} s); {}", Where(m, topic, index),
-                                        StampName(time), StampText(t), StampText(prev), hint));
-}
-
 // Turns the Odometry poses (x, y in left/right, yaw) into cumulative wheel
 // travel: the inverse of DiffDriveStep (diff_drive.hpp). Per step, with
 // dtheta = wrap(yaw_k - yaw_k-1) and the displacement projected on the
@@ -186,19 +157,24 @@ std::vector<std::pair<std::size_t, std::size_t>> SplitRuns(const std::vector<Whe
 }
 
 // Linear interpolation of ground truth at time t (x, y, unwrapped yaw), or
-// NaN when no sample lies within max_gap on both sides.
+// NaN when no sample lies within max_gap on both sides. `j` may start
+// anywhere (the result does not depend on it): Start puts it at t.
 struct GtInterpolator {
-  const std::vector<GtSample>& gt;
+  const std::vector<GroundTruthSample>& gt;
   std::int64_t max_gap_ns;
   std::size_t j = 0;
+  void Start(std::int64_t t) {
+    const auto it = std::upper_bound(gt.begin(), gt.end(), t, [](std::int64_t v, const GroundTruthSample& g) { return v < g.t_ns; });
+    j = it == gt.begin() ? 0 : static_cast<std::size_t>(it - gt.begin()) - 1;
+  }
   Pose2 At(std::int64_t t) {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     if (gt.empty() || t < gt.front().t_ns || t > gt.back().t_ns) return {nan, nan, nan};
     while (j + 1 < gt.size() && gt[j + 1].t_ns <= t) ++j;
     while (j > 0 && gt[j].t_ns > t) --j;
-    const GtSample& a = gt[j];
+    const GroundTruthSample& a = gt[j];
     if (a.t_ns == t) return {a.x, a.y, a.yaw};
-    const GtSample& b = gt[j + 1];
+    const GroundTruthSample& b = gt[j + 1];
     if (t - a.t_ns > max_gap_ns || b.t_ns - t > max_gap_ns) return {nan, nan, nan};
     const double u = static_cast<double>(t - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);
     return {a.x + u * (b.x - a.x), a.y + u * (b.y - a.y), a.yaw + u * (b.yaw - a.yaw)};
@@ -207,24 +183,10 @@ struct GtInterpolator {
 
 struct TopicChoice {
   std::size_t wheels = 0;
-  std::optional<std::size_t> gt;
-  MessageType gt_type = MessageType::kOther;
-  std::optional<std::size_t> tf_static;  ///< /tf_static, read with a TFMessage ground truth
+  std::vector<bool> source_topics;  ///< the topics the ground-truth source decodes in the pass
 };
 
-std::size_t RequireTopic(const Bag& bag, const std::string& name, const char* flag) {
-  const auto idx = bag.FindTopic(name);
-  if (!idx)
-    throw InputError(bag.path(), fmt::format("{} topic {} is not in the recording; its topics are:\n{}", flag, name,
-                                             DescribeTopics(bag)));
-  const TopicInfo& t = bag.topics()[*idx];
-  if (t.serialization_format != "cdr")
-    throw InputError(bag.path(), fmt::format("topic {} is serialized as '{}', only cdr is supported", name,
-                                             t.serialization_format));
-  return *idx;
-}
-
-TopicChoice ChooseTopics(const Bag& bag, const Rosbag2ImportOptions& o) {
+TopicChoice ChooseTopics(const Bag& bag, const Rosbag2ImportOptions& o, GroundTruthSource* source) {
   TopicChoice c;
   const bool joints = !o.wheels_topic.empty();
   c.wheels = RequireTopic(bag, joints ? o.wheels_topic : o.odometry_topic, joints ? "--wheels" : "--odometry");
@@ -236,78 +198,47 @@ TopicChoice ChooseTopics(const Bag& bag, const Rosbag2ImportOptions& o) {
   if (!joints && wt != MessageType::kOdometry)
     throw InputError(bag.path(), fmt::format("--odometry topic {} has type {}; it must be nav_msgs/msg/Odometry{}", w.name,
                                              w.type, wt == MessageType::kJointState ? " (use --wheels for JointState)" : ""));
-  if (!o.ground_truth_topic.empty()) {
-    c.gt = RequireTopic(bag, o.ground_truth_topic, "--ground-truth");
-    const TopicInfo& g = bag.topics()[*c.gt];
-    c.gt_type = MessageTypeFromName(g.type);
-    if (!IsPoseType(c.gt_type))
-      throw InputError(bag.path(), fmt::format("--ground-truth topic {} has type {}, which holds no pose; ground truth must be "
-                                               "geometry_msgs/msg/PoseStamped, geometry_msgs/msg/PoseWithCovarianceStamped, "
-                                               "nav_msgs/msg/Odometry or tf2_msgs/msg/TFMessage", g.name, g.type));
-    if (*c.gt == c.wheels) throw InputError(bag.path(), fmt::format("topic {} is both the wheel source and the ground truth", g.name));
-    if (c.gt_type == MessageType::kTfMessage) {
-      const auto st = bag.FindTopic("/tf_static");
-      if (st && *st != *c.gt && MessageTypeFromName(bag.topics()[*st].type) == MessageType::kTfMessage &&
-          bag.topics()[*st].serialization_format == "cdr")
-        c.tf_static = st;
-    }
-  }
+  c.source_topics.assign(bag.topics().size(), false);
+  if (source)
+    for (std::size_t t : source->Open(bag, c.wheels)) c.source_topics[t] = true;
   return c;
-}
-
-void CheckFinite(const PoseMsg& p, const BagMessage& m, const TopicInfo& t, std::size_t index) {
-  for (double v : {p.x, p.y, p.qx, p.qy, p.qz, p.qw})
-    if (!std::isfinite(v)) throw InputError(*m.file, fmt::format("{}: pose is not finite (NaN or infinite)", Where(m, t, index)));
-  if (p.qx * p.qx + p.qy * p.qy + p.qz * p.qz + p.qw * p.qw < 1e-12)
-    throw InputError(*m.file, fmt::format("{}: orientation quaternion is zero", Where(m, t, index)));
 }
 
 struct RecordingData {
   std::vector<WheelSample> wheels;
-  std::vector<GtSample> gt;
   std::string left_joint, right_joint;
-  /// header stamp minus receive time [s] of every wheel / ground-truth message
-  std::vector<double> wheel_lag_s, gt_lag_s;
-  std::size_t wheel_duplicates = 0, gt_duplicates = 0;
-  TfTree tf;                    ///< the ground-truth TFMessage topic and /tf_static
+  /// header stamp minus receive time [s] of every wheel message
+  std::vector<double> wheel_lag_s;
+  std::size_t wheel_duplicates = 0;
   std::string odom_frame;       ///< --odometry: its header.frame_id
-  std::string gt_frame_used;    ///< TFMessage: the frame whose transforms were read
-  std::optional<Pose2> gt_offset;  ///< TFMessage: /tf_static offset gt_frame_used_T_requested
 };
 
-// One streaming pass over the recording: decodes the wheel and ground-truth
-// topics into time-stamped samples (the only per-message state kept), and
-// for a TFMessage ground truth the transform tree.
+// One streaming pass over the recording: decodes the wheel topic into
+// time-stamped samples (the only per-message state kept) and hands the
+// ground-truth source's topics to it.
 class RecordingReader {
  public:
-  RecordingReader(const Bag& bag, const TopicChoice& c, const Rosbag2ImportOptions& o, RecordingData& d)
-      : bag_(bag), c_(c), o_(o), d_(d), picker_(o.left_joint, o.right_joint) {}
+  RecordingReader(const Bag& bag, const TopicChoice& c, const Rosbag2ImportOptions& o, RecordingData& d,
+                  GroundTruthSource* source)
+      : bag_(bag), c_(c), o_(o), d_(d), source_(source), picker_(o.left_joint, o.right_joint) {}
 
-  // `frame`: the TFMessage child frame to take (the requested one, or its
-  // /tf_static anchor on a second pass with only the ground truth wanted).
-  void Read(const std::string& frame, bool ground_truth_only) {
-    frame_ = frame;
-    std::vector<bool> wanted(bag_.topics().size(), false);
-    if (!ground_truth_only) wanted[c_.wheels] = true;
-    if (c_.gt) wanted[*c_.gt] = true;
-    if (c_.tf_static && !ground_truth_only) wanted[*c_.tf_static] = true;
-    wheel_index_ = gt_index_ = 0;
+  void Read() {
+    std::vector<bool> wanted = c_.source_topics;
+    wanted[c_.wheels] = true;
     bag_.Read(wanted, [&](const BagMessage& m) {
       const TopicInfo& topic = bag_.topics()[m.topic];
       const std::size_t index = m.topic == c_.wheels ? ++wheel_index_ : ++gt_index_;
       try {
         CdrReader r(m.data, m.size);
         if (m.topic == c_.wheels) OnWheels(r, m, topic, index);
-        else if (c_.tf_static && m.topic == *c_.tf_static) OnStatic(r);
-        else OnGroundTruth(r, m, topic, index);
+        else source_->OnMessage(r, m, topic, index);
       } catch (const CdrError& e) {
-        throw InputError(*m.file, fmt::format("{}: cannot decode: {}", Where(m, topic, index), e.what()));
+        throw InputError(*m.file, fmt::format("{}: cannot decode: {}", WhereInBag(m, topic, index), e.what()));
       }
     });
     d_.left_joint = picker_.left();
     d_.right_joint = picker_.right();
   }
-  std::size_t tf_matches() const { return tf_matches_; }
 
  private:
   void OnWheels(CdrReader& r, const BagMessage& m, const TopicInfo& topic, std::size_t index) {
@@ -318,24 +249,24 @@ class RecordingReader {
       DecodeJointState(r, js_);
       std::size_t li = 0, ri = 0;
       std::string why;
-      if (!picker_.Pick(js_, li, ri, why)) throw InputError(*m.file, fmt::format("{}: {}", Where(m, topic, index), why));
+      if (!picker_.Pick(js_, li, ri, why)) throw InputError(*m.file, fmt::format("{}: {}", WhereInBag(m, topic, index), why));
       if (js_.position.empty() && js_.velocity_count > 0)
         throw InputError(*m.file, fmt::format(
             "{}: this JointState carries velocity[] but no position[], so the wheel travel is not in it (integrating "
             "velocities would add their noise and latency to the calibration); give the robot's nav_msgs/msg/Odometry "
             "topic with --odometry TOPIC instead (--list shows it), or record the joint positions",
-            Where(m, topic, index)));
+            WhereInBag(m, topic, index)));
       if (js_.position.size() != js_.name.size())
-        throw InputError(*m.file, fmt::format("{}: {} joint names but {} positions", Where(m, topic, index),
+        throw InputError(*m.file, fmt::format("{}: {} joint names but {} positions", WhereInBag(m, topic, index),
                                               js_.name.size(), js_.position.size()));
       s.left = js_.position[li];  // radians until SanitizeJointPositions
       s.right = js_.position[ri];
       if (!std::isfinite(s.left) || !std::isfinite(s.right))
-        throw InputError(*m.file, fmt::format("{}: wheel position is not finite", Where(m, topic, index)));
+        throw InputError(*m.file, fmt::format("{}: wheel position is not finite", WhereInBag(m, topic, index)));
       stamp = js_.header.stamp_ns;
     } else {
       const PoseMsg p = DecodeOdometry(r);
-      CheckFinite(p, m, topic, index);
+      CheckPoseFinite(p, m, topic, index);
       s.left = p.x;
       s.right = p.y;
       s.yaw = p.Yaw();
@@ -346,7 +277,7 @@ class RecordingReader {
     if (!d_.wheels.empty() && s.t_ns <= d_.wheels.back().t_ns) {
       const WheelSample& b = d_.wheels.back();
       const bool same = b.left == s.left && b.right == s.right && b.yaw == s.yaw;
-      if (s.t_ns < b.t_ns || !same) StampGoesBack(b.t_ns, s.t_ns, m, topic, index, o_.time, same);
+      if (s.t_ns < b.t_ns || !same) StampGoesBack(b.t_ns, s.t_ns, m, topic, index, o_.time == StampSource::kLog, same);
       ++d_.wheel_duplicates;  // a repeated message: harmless, dropped
       return;
     }
@@ -354,54 +285,14 @@ class RecordingReader {
     d_.wheels.push_back(s);
   }
 
-  void OnStatic(CdrReader& r) {
-    DecodeTfMessage(r, tf_);
-    for (const auto& p : tf_) d_.tf.Add(p, true);
-  }
-
-  void AddGt(const PoseMsg& p, const BagMessage& m, const TopicInfo& topic, std::size_t index) {
-    CheckFinite(p, m, topic, index);
-    const StampSource time = o_.GroundTruthTime();
-    const std::int64_t t = time == StampSource::kHeader ? p.header.stamp_ns : m.log_time_ns;
-    if (!d_.gt.empty() && t <= d_.gt.back().t_ns) {
-      const GtSample& b = d_.gt.back();
-      const bool same = b.x == p.x && b.y == p.y && b.yaw == p.Yaw();
-      if (t < b.t_ns || !same) StampGoesBack(b.t_ns, t, m, topic, index, time, same);
-      ++d_.gt_duplicates;
-      return;
-    }
-    d_.gt_lag_s.push_back(static_cast<double>(p.header.stamp_ns - m.log_time_ns) * 1e-9);
-    d_.gt.push_back({t, p.x, p.y, p.Yaw()});
-  }
-
-  void OnGroundTruth(CdrReader& r, const BagMessage& m, const TopicInfo& topic, std::size_t index) {
-    switch (c_.gt_type) {
-      case MessageType::kPoseStamped: AddGt(DecodePoseStamped(r), m, topic, index); break;
-      case MessageType::kPoseWithCovarianceStamped: AddGt(DecodePoseWithCovarianceStamped(r), m, topic, index); break;
-      case MessageType::kOdometry: AddGt(DecodeOdometry(r), m, topic, index); break;
-      case MessageType::kTfMessage:
-        DecodeTfMessage(r, tf_);
-        for (const auto& p : tf_) {
-          d_.tf.Add(p, false);
-          if (p.child_frame_id == frame_) {
-            ++tf_matches_;
-            AddGt(p, m, topic, index);
-          }
-        }
-        break;
-      default: break;
-    }
-  }
-
   const Bag& bag_;
   const TopicChoice& c_;
   const Rosbag2ImportOptions& o_;
   RecordingData& d_;
+  GroundTruthSource* source_;
   JointPicker picker_;
   JointStateMsg js_;
-  std::vector<PoseMsg> tf_;
-  std::string frame_;
-  std::size_t wheel_index_ = 0, gt_index_ = 0, tf_matches_ = 0;
+  std::size_t wheel_index_ = 0, gt_index_ = 0;
 };
 
 double Median(std::vector<double> v) {
@@ -413,15 +304,17 @@ double Median(std::vector<double> v) {
 // The two streams' clocks, compared through the recording's receive times:
 // a motion-capture PC whose clock is off shows as header stamps far from
 // the receive times on one topic only.
-void CheckClockOffset(const Bag& bag, const TopicChoice& c, const Rosbag2ImportOptions& o, const RecordingData& d) {
-  if (!c.gt || d.gt.empty()) return;
-  const double wheel_lag = Median(d.wheel_lag_s), gt_lag = Median(d.gt_lag_s);
+void CheckClockOffset(const Bag& bag, const TopicChoice& c, const Rosbag2ImportOptions& o, const RecordingData& d,
+                      const GroundTruthSource* source) {
+  const std::optional<StampLag> lag = source ? source->Lag() : std::nullopt;
+  if (!lag) return;
+  const double wheel_lag = Median(d.wheel_lag_s), gt_lag = lag->median_s;
   const double ow = o.time == StampSource::kHeader ? wheel_lag : 0.0;
   const double og = o.GroundTruthTime() == StampSource::kHeader ? gt_lag : 0.0;
   const double offset = og - ow;
   if (std::abs(offset) <= 0.5) return;
   const std::string& wt = bag.topics()[c.wheels].name;
-  const std::string& gt = bag.topics()[*c.gt].name;
+  const std::string& gt = lag->topic;
   throw InputError(bag.path(), fmt::format(
       "the ground truth's clock is {:.3f} s {} the wheels' (--time {},{}): header stamps minus receive times are {:.3f} s "
       "on {} and {:.3f} s on {} (median), so the two topics were stamped by clocks {:.1f} s apart (a motion-capture "
@@ -432,73 +325,23 @@ void CheckClockOffset(const Bag& bag, const TopicChoice& c, const Rosbag2ImportO
       std::abs(gt_lag) > std::abs(wheel_lag) ? "header,log" : "log,header"));
 }
 
-// Ground truth from a TFMessage: the requested frame's own transforms, or
-// those of the frame it is fixed to by /tf_static (composed afterwards);
-// never a frame whose chain runs through the odometry frame.
-void ResolveTfGroundTruth(const Bag& bag, const Rosbag2ImportOptions& o, RecordingData& d,
-                          RecordingReader& reader) {
-  const std::string& frame = o.ground_truth_frame;
-  std::vector<std::string> odom_frames;
-  if (!d.odom_frame.empty()) odom_frames.push_back(d.odom_frame);
-  auto describe = [&] {
-    std::vector<std::string> lines;
-    for (const auto& e : d.tf.edges()) lines.push_back(fmt::format("{} (parent {}{})", e.child, e.parent, e.is_static ? ", static" : ""));
-    return TrimmedList(lines, 30);
-  };
-  if (reader.tf_matches() == 0) {
-    const auto anchor = frame.empty() ? std::nullopt : d.tf.StaticAnchor(frame);
-    if (!anchor)
-      throw InputError(bag.path(), fmt::format("--ground-truth {}: no transform with child_frame_id '{}'{}; frames seen: {}",
-                                               o.ground_truth_topic, frame, frame.empty() ? " (set --ground-truth-frame)" : "",
-                                               describe()));
-    d.gt.clear();
-    d.gt_lag_s.clear();
-    reader.Read(anchor->first, true);
-    d.gt_frame_used = anchor->first;
-    d.gt_offset = anchor->second;
-  } else {
-    d.gt_frame_used = frame;
-  }
-  if (const auto odom = d.tf.OdometryFrameAbove(frame, odom_frames)) {
-    const auto chain = d.tf.Chain(frame);
-    std::vector<std::string> rev(chain.rbegin(), chain.rend());
-    throw InputError(bag.path(), fmt::format(
-        "--ground-truth {} --ground-truth-frame {}: the frame's chain {} runs through the odometry frame '{}' (REP 105: "
-        "odom -> base_link is the robot's own wheel odometry), so this would compare the odometry with itself; choose "
-        "the motion-capture frame (--list shows every frame with its parent)",
-        o.ground_truth_topic, frame, fmt::join(rev, " -> "), *odom));
-  }
-  if (d.gt_offset) {
-    for (auto& g : d.gt) {
-      const Pose2 p = Compose(Pose2{g.x, g.y, g.yaw}, *d.gt_offset);
-      g = {g.t_ns, p.x, p.y, p.theta};
-    }
-  }
-}
-
 // Reads the recording, then the checks that need all of it: clocks, the
 // transform tree, the wheel positions (unwrap, resets, jumps, stuck or
 // shared joints), and converts the wheel source to travel in metres.
 RecordingData ReadRecording(const Bag& bag, const TopicChoice& c, const RobotParams& robot, const Rosbag2ImportOptions& o,
-                            std::vector<std::string>& warnings) {
+                            GroundTruthSource* source, std::vector<std::string>& warnings) {
   RecordingData d;
   const TopicInfo& wt = bag.topics()[c.wheels];
   const bool joints = !o.wheels_topic.empty();
-  RecordingReader reader(bag, c, o, d);
-  reader.Read(o.ground_truth_frame, false);
-  if (c.gt && c.gt_type == MessageType::kTfMessage) ResolveTfGroundTruth(bag, o, d, reader);
+  RecordingReader reader(bag, c, o, d, source);
+  reader.Read();
   if (d.wheels.size() < 2)
     throw InputError(bag.path(), fmt::format("wheel topic {} has {} message(s); at least two are needed", wt.name, d.wheels.size()));
-  if (c.gt && d.gt.empty())
-    throw InputError(bag.path(), fmt::format("--ground-truth topic {} has no messages", o.ground_truth_topic));
-  for (const auto& [n, topic] : {std::pair{d.wheel_duplicates, wt.name},
-                                 std::pair{d.gt_duplicates, c.gt ? bag.topics()[*c.gt].name : std::string()}})
-    if (n > 0)
-      warnings.push_back(fmt::format("{}: topic {}: {} message(s) repeat the previous message's stamp and values; dropped",
-                                     bag.path(), topic, n));
-  CheckClockOffset(bag, c, o, d);
-  // Unwrap the ground-truth heading so that interpolation and total rotation are continuous.
-  for (std::size_t i = 1; i < d.gt.size(); ++i) d.gt[i].yaw = d.gt[i - 1].yaw + WrapAngle(d.gt[i].yaw - d.gt[i - 1].yaw);
+  if (d.wheel_duplicates > 0)
+    warnings.push_back(fmt::format("{}: topic {}: {} message(s) repeat the previous message's stamp and values; dropped",
+                                   bag.path(), wt.name, d.wheel_duplicates));
+  if (source) source->EndOfPass(bag, d.odom_frame, warnings);
+  CheckClockOffset(bag, c, o, d, source);
   const WheelContext ctx{bag.path(), wt.name, joints ? d.left_joint : "left wheel", joints ? d.right_joint : "right wheel",
                          !joints};
   if (joints) {
@@ -547,32 +390,17 @@ std::string Rosbag2ImportOptions::Validate() const {
   return {};
 }
 
-std::string DescribeTopics(const Bag& bag) {
-  // The ones that can serve as a source first; at most 40 lines whatever
-  // the recording holds.
-  constexpr std::size_t kMax = 40;
-  std::string out;
-  std::size_t shown = 0;
-  for (const bool usable : {true, false})
-    for (const auto& t : bag.topics()) {
-      const MessageType mt = MessageTypeFromName(t.type);
-      if ((mt != MessageType::kOther) != usable) continue;
-      if (shown++ < kMax) out += fmt::format("  {}  {}  ({} messages)\n", t.name, t.type, t.count);
-    }
-  if (shown > kMax) out += fmt::format("  ... and {} more topics (umbmark import rosbag2 BAG --list)\n", shown - kMax);
-  if (bag.topics().empty()) out = "  (none)\n";
-  out.pop_back();
-  return out;
-}
-
 namespace {
 
 // One run from samples a..b: travel relative to its first sample, ground
 // truth re-expressed in the frame of its first ground-truth sample, and
 // `turn` the ground truth's total rotation (NaN without ground truth).
-TrajectoryRun BuildRun(const RecordingData& d, std::size_t a, std::size_t b, bool has_gt, GtInterpolator& interp,
-                       double& turn) {
+TrajectoryRun BuildRun(const RecordingData& d, std::size_t a, std::size_t b, const RunGroundTruth* gt, double& turn) {
   TrajectoryRun run;
+  const bool has_gt = gt != nullptr;
+  static const std::vector<GroundTruthSample> kNone;
+  GtInterpolator interp{gt ? *gt->samples : kNone, gt ? gt->max_gap_ns : 0};
+  interp.Start(d.wheels[a].t_ns);
   std::optional<Pose2> origin;
   double gt_first_yaw = 0.0, gt_last_yaw = 0.0;
   const std::int64_t t0 = d.wheels.front().t_ns;
@@ -669,7 +497,7 @@ OdometryMatch CompareWithOdometry(const TrajectoryRun& run, const RobotParams& r
 // joints swapped), and ground truth that is the wheel odometry itself.
 void CheckAgainstGroundTruth(const std::vector<TrajectoryRun>& runs, const std::vector<double>& turns,
                              const RobotParams& robot, const Rosbag2ImportOptions& o, const std::string& path,
-                             const RecordingData& d) {
+                             const RecordingData& d, const GroundTruthSource& source) {
   std::size_t mirrored = 0, compared = 0, matching = 0;
   std::string example;
   double worst = 0.0, path_m = 0.0;
@@ -695,10 +523,10 @@ void CheckAgainstGroundTruth(const std::vector<TrajectoryRun>& runs, const std::
   }
   if (compared > 0 && matching == compared) {
     throw InputError(path, fmt::format(
-        "--ground-truth {} follows the wheel odometry to within {:.2g} m / rad, or its own noise, over {} run(s) and "
+        "{} follows the wheel odometry to within {:.2g} m / rad, or its own noise, over {} run(s) and "
         "{:.1f} m: it is the robot's own odometry (an odom frame, or an odometry topic), not an independent measurement, and would only "
         "compare the odometry with itself; choose the motion-capture topic or frame (--list)",
-        o.ground_truth_topic, worst, compared, path_m));
+        source.Name(), worst, compared, path_m));
   }
 }
 
@@ -720,59 +548,34 @@ void CheckSideAgainstLegs(const std::vector<TrajectoryRun>& runs, const Rosbag2I
                                      o.side_m, leg, runs.size(), leg, o.side_m, leg));
 }
 
-// The lidar as the ground-truth source: each run's still stretches (from the
-// first sample of the pause before to the last of the pause after) and the
-// wheel travel for the odometry's predictions go to scan_ground_truth.hpp.
-ScanGroundTruth ScanSource(const Bag& bag, const RecordingData& d,
-                           const std::vector<std::pair<std::size_t, std::size_t>>& spans, std::size_t first_run,
-                           const RobotParams& robot, const Rosbag2ImportOptions& o, std::vector<std::string>& warnings) {
-  const std::vector<WheelSample>& s = d.wheels;
-  auto still = [&](std::size_t i) {
-    return std::abs(s[i].left - s[i - 1].left) < kStillM && std::abs(s[i].right - s[i - 1].right) < kStillM;
-  };
-  std::vector<scan::RunWindow> windows;
-  std::vector<std::string> names;
-  for (const auto& [a, b] : spans) {
-    std::size_t from = a, to = b;
-    while (from > 0 && still(from)) --from;
-    while (to + 1 < s.size() && still(to + 1)) ++to;
-    windows.push_back({s[from].t_ns, s[a].t_ns, s[b].t_ns, s[to].t_ns});
-    names.push_back(std::to_string(first_run + names.size() + 1));
-  }
-  std::vector<WheelTravel> travel;
-  travel.reserve(s.size());
-  for (const auto& w : s) travel.push_back({w.t_ns, w.left, w.right});
-  ScanSourceOptions so;
-  so.scan_topic = o.scan_topic;
-  so.imu_topic = o.imu_topic;
-  so.scan_pose = o.scan_pose;
-  so.tf_static_topic = o.tf_static_topic;
-  so.upside_down = o.scan_upside_down;
-  so.left_joint = d.left_joint;
-  so.right_joint = d.right_joint;
-  so.log_time = o.GroundTruthTime() == StampSource::kLog;
-  so.origin_ns = s.front().t_ns;
-  return ReadScanGroundTruth(bag, so, windows, names, travel, robot.wheelbase_m, warnings);
+// The ground-truth source's options from the import's.
+GroundTruthOptions GroundTruthOptionsOf(const Rosbag2ImportOptions& o) {
+  GroundTruthOptions g;
+  g.source = o.ground_truth_source;
+  g.topic = o.ground_truth_topic;
+  g.frame = o.ground_truth_frame;
+  g.scan_topic = o.scan_topic;
+  g.imu_topic = o.imu_topic;
+  g.scan_pose = o.scan_pose;
+  g.tf_static_topic = o.tf_static_topic;
+  g.scan_upside_down = o.scan_upside_down;
+  g.log_time = o.GroundTruthTime() == StampSource::kLog;
+  g.max_gap_s = o.max_gt_gap_s;
+  return g;
 }
 
-// A run's scan poses as ground-truth samples, and the gap they need.
-std::vector<GtSample> ScanRunSamples(const scan::TrackResult& t, double& gap_s) {
-  std::vector<GtSample> out;
-  gap_s = 0.0;
-  for (const auto& p : t.poses) {
-    if (!out.empty()) gap_s = std::max(gap_s, static_cast<double>(p.t_ns - out.back().t_ns) * 1e-9);
-    out.push_back({p.t_ns, p.pose.x, p.pose.y, p.pose.theta});
-  }
-  return out;
-}
-
-// BuildRun on one run's scan poses: the lidar as the ground truth.
-TrajectoryRun BuildScanRun(const RecordingData& d, std::size_t a, std::size_t b, const scan::TrackResult& track,
-                           double max_gt_gap_s, double& turn) {
-  double gap_s = 0.0;
-  const std::vector<GtSample> samples = ScanRunSamples(track, gap_s);
-  GtInterpolator interp{samples, static_cast<std::int64_t>(std::llround(std::max(max_gt_gap_s, gap_s) * 1e9)) + 1};
-  return BuildRun(d, a, b, true, interp, turn);
+// The recording's runs as a ground-truth source sees them.
+RecordingRuns RunsOf(const RecordingData& d, const std::vector<std::pair<std::size_t, std::size_t>>& spans,
+                     std::size_t first_run, const RobotParams& robot) {
+  RecordingRuns r;
+  r.wheels.reserve(d.wheels.size());
+  for (const auto& w : d.wheels) r.wheels.push_back({w.t_ns, w.left, w.right});
+  r.spans = spans;
+  r.first_run = first_run;
+  r.wheelbase_m = robot.wheelbase_m;
+  r.left_joint = d.left_joint;
+  r.right_joint = d.right_joint;
+  return r;
 }
 
 }  // namespace
@@ -790,12 +593,14 @@ Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotPar
   out.experiment.distance_m = o.kind == ExperimentKind::kBackAndForth ? o.distance_m : 0.0;
   out.experiment.file = "runs.csv";
   out.runs.path = "runs.csv";
+  // The ground truth, whichever source gives it (ground_truth/source.hpp).
+  const std::unique_ptr<GroundTruthSource> source = MakeGroundTruthSource(GroundTruthOptionsOf(o));
   for (const auto& path : bags) {
     const Bag bag = Bag::Open(path, out.warnings);
-    const TopicChoice choice = ChooseTopics(bag, o);
-    const RecordingData d = ReadRecording(bag, choice, robot, o, out.warnings);
+    const TopicChoice choice = ChooseTopics(bag, o, source.get());
+    const RecordingData d = ReadRecording(bag, choice, robot, o, source.get(), out.warnings);
     const std::string& wheel_topic = bag.topics()[choice.wheels].name;
-    RecordingSummary rs{path, d.wheels.size(), d.gt.size(), 0, 0, d.left_joint, d.right_joint,
+    RecordingSummary rs{path, d.wheels.size(), 0, 0, 0, d.left_joint, d.right_joint,
                         static_cast<double>(d.wheels.back().t_ns - d.wheels.front().t_ns) * 1e-9};
     rs.first_stamp_ns = d.wheels.front().t_ns;
     const auto spans = SplitRuns(d.wheels, o.pause_s);
@@ -803,9 +608,7 @@ Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotPar
       throw InputError(path, fmt::format("the wheels never move on {} ({} samples): no run to import", wheel_topic,
                                          d.wheels.size()));
     const auto gaps = FindGaps(d.wheels);
-    GtInterpolator interp{d.gt, static_cast<std::int64_t>(std::llround(o.max_gt_gap_s * 1e9))};
-    std::optional<ScanGroundTruth> lidar;  // --scan: each run's ground truth from the lidar
-    if (!o.scan_topic.empty()) lidar = ScanSource(bag, d, spans, out.runs.runs.size(), robot, o, out.warnings);
+    if (source) source->ReadRuns(bag, RunsOf(d, spans, out.runs.runs.size(), robot), out.warnings);
     std::vector<TrajectoryRun> runs;
     std::vector<double> turns;
     for (std::size_t k = 0; k < spans.size(); ++k) {
@@ -822,11 +625,11 @@ Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotPar
         continue;
       }
       double turn = NAN;
-      TrajectoryRun run = lidar ? BuildScanRun(d, a, b, lidar->runs[k].track, o.max_gt_gap_s, turn)
-                                : BuildRun(d, a, b, choice.gt.has_value(), interp, turn);
+      const std::optional<RunGroundTruth> gt = source ? std::optional(source->Run(k)) : std::nullopt;
+      TrajectoryRun run = BuildRun(d, a, b, gt ? &*gt : nullptr, turn);
       run.run = std::to_string(out.runs.runs.size() + runs.size() + 1);
       CheckWheelsForward(run, o, path, d);
-      if ((choice.gt || lidar) && !run.HasGroundTruth(0))
+      if (source && !run.HasGroundTruth(0))
         out.warnings.push_back(fmt::format("{}: run {} has no ground truth within {} s of its first sample; its ground truth "
                                            "is relative to its first measured pose", path, run.run, o.max_gt_gap_s));
       if (o.kind == ExperimentKind::kSquare) {
@@ -849,18 +652,22 @@ Rosbag2Import ImportRosbag2(const std::vector<std::string>& bags, const RobotPar
     if (runs.empty())
       throw InputError(path, fmt::format("every run of {} has a gap in {} (see the warnings above): no run to import", path,
                                          wheel_topic));
-    if (choice.gt) CheckAgainstGroundTruth(runs, turns, robot, o, path, d);
+    if (source && source->CheckAgainstOdometry()) CheckAgainstGroundTruth(runs, turns, robot, o, path, d, *source);
     CheckSideAgainstLegs(runs, o, path);
     rs.runs = runs.size();
     for (auto& r : runs) out.runs.runs.push_back(std::move(r));
-    if (lidar) {
-      rs.ground_truth_messages = lidar->scans;
-      for (auto& r : lidar->runs) r.track.poses = {};  // now in out.runs
-      out.scan.push_back(std::move(*lidar));
+    if (source) {
+      rs.ground_truth_messages = source->Messages();
+      source->EndRecording();
     }
     out.recordings.push_back(rs);
   }
-  if (!out.scan.empty()) out.ground_truth = ScanGroundTruthNoise(out.scan);
+  if (source) {
+    GroundTruthExtras x = source->Finish();
+    out.ground_truth = x.noise;
+    out.ground_truth_keys = std::move(x.manifest_keys);
+    out.scan = std::move(x.scan);
+  }
   return out;
 }
 

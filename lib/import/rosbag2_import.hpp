@@ -2,8 +2,9 @@
 // (robot + one experiment + trajectory runs with cumulative wheel travel and
 // ground truth), as fixed by the contract's section "ROS 2 recordings":
 // wheel travel from JointState positions times the wheel radius, or from an
-// Odometry topic inverted with the wheelbase; ground truth from a pose
-// topic interpolated at the wheel samples; runs split at pauses; each run
+// Odometry topic inverted with the wheelbase; ground truth from one source
+// (ground_truth/source.hpp: a pose topic, a /tf frame, the lidar)
+// interpolated at the wheel samples; runs split at pauses; each run
 // re-expressed relative to its first sample.
 #pragma once
 
@@ -14,9 +15,11 @@
 #include "core/pose2.hpp"
 #include "core/robot.hpp"
 #include "core/runs.hpp"
-#include "ros2/bag.hpp"
-#include "ros2/tf_tree.hpp"
+#include "formats/campaign_writer.hpp"
 #include "ground_truth/scan_ground_truth.hpp"
+#include "ros2/bag.hpp"
+#include "ros2/bag_text.hpp"
+#include "ros2/tf_tree.hpp"
 #include "kinematics/diff_drive.hpp"
 
 namespace umbmark::io::rosbag2 {
@@ -44,6 +47,10 @@ struct Rosbag2ImportOptions {
   std::optional<Pose2> scan_pose;
   bool scan_upside_down = false;  ///< --scan-upside-down: the lidar is mounted upside down (beams mirrored)
   std::string tf_static_topic;  ///< --tf-static (scan_ground_truth.hpp); empty: /tf_static or the only .../tf_static
+  /// A ground-truth source by its registered name (ground_truth/source.hpp:
+  /// RegisterGroundTruthSource); empty (the default): the one the topics
+  /// above name ("scan" with scan_topic, "topic" with ground_truth_topic).
+  std::string ground_truth_source;
   StampSource time = StampSource::kHeader;
   std::optional<StampSource> ground_truth_time;
   StampSource GroundTruthTime() const { return ground_truth_time.value_or(time); }
@@ -72,6 +79,9 @@ struct Rosbag2Import {
   /// poses moved into `runs`), and the registration's noise for the manifest.
   std::vector<ScanGroundTruth> scan;
   std::optional<GroundTruthNoise> ground_truth;
+  /// The manifest's further [ground_truth] keys from the source (the lidar's
+  /// source = "scan", its pose and gyro; none for a pose topic).
+  std::vector<ManifestKey> ground_truth_keys;
   std::vector<std::string> warnings;
 };
 
@@ -115,8 +125,5 @@ struct BagListing {
   std::vector<TopicListing> topics;
 };
 BagListing ListRosbag2(const std::string& bag, std::vector<std::string>& warnings);
-
-/// "  /topic  type  (N messages)" lines of every topic, for error messages.
-std::string DescribeTopics(const Bag& bag);
 
 }  // namespace umbmark::io::rosbag2

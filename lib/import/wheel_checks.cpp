@@ -137,22 +137,6 @@ class JointSeries {
 
 }  // namespace
 
-std::string StampText(std::int64_t ns) {
-  const std::int64_t sec = ns / 1000000000, rem = ns % 1000000000;
-  return fmt::format("{}{}.{:09d}", ns < 0 && sec == 0 ? "-" : "", sec, rem < 0 ? -rem : rem);
-}
-
-template <typename S>
-static std::string Trimmed(const std::vector<S>& items, std::size_t max) {
-  if (items.empty()) return "none";
-  std::string out;
-  for (std::size_t i = 0; i < items.size() && i < max; ++i) out += fmt::format("{}{}", i ? ", " : "", items[i]);
-  if (items.size() > max) out += fmt::format(", ... and {} more", items.size() - max);
-  return out;
-}
-std::string TrimmedList(const std::vector<std::string>& items, std::size_t max) { return Trimmed(items, max); }
-std::string TrimmedList(const std::vector<std::string_view>& items, std::size_t max) { return Trimmed(items, max); }
-
 void SanitizeJointPositions(std::vector<WheelSample>& s, const WheelContext& c, std::vector<std::string>& warnings) {
   if (s.size() < 2) return;
   bool identical = true, moves = false;

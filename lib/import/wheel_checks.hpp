@@ -16,6 +16,8 @@
 #include <string_view>
 #include <vector>
 
+#include "ros2/bag_text.hpp"  // StampText, TrimmedList
+
 namespace umbmark::io::rosbag2 {
 
 /// One wheel-topic sample: cumulative travel of each wheel (JointState:
@@ -58,13 +60,5 @@ struct WheelGap {
 /// Gaps longer than max(1 s, 10 x the median spacing) across which either
 /// wheel moved (travel in metres).
 std::vector<WheelGap> FindGaps(const std::vector<WheelSample>& s);
-
-/// "1700000012.350000000" (seconds.nanoseconds of a ROS stamp).
-std::string StampText(std::int64_t ns);
-
-/// "a, b, c, ... and 999997 more": at most `max` items, for messages that
-/// must stay one readable line whatever the recording holds.
-std::string TrimmedList(const std::vector<std::string>& items, std::size_t max = 20);
-std::string TrimmedList(const std::vector<std::string_view>& items, std::size_t max = 20);
 
 }  // namespace umbmark::io::rosbag2
