@@ -15,7 +15,7 @@
 #include "commands.hpp"
 #include "diagnosis/design_check.hpp"
 #include "formats/manifest.hpp"
-#include "diagnose_report.hpp"
+#include "api/diagnose_report.hpp"
 #include "progress.hpp"
 #include "common.hpp"
 #include "core/errors.hpp"
@@ -172,11 +172,11 @@ int RunDiagnose(DiagnoseCliOptions o) {
   j["manifest"] = o.manifest;
   std::vector<std::string> written;
   if (!o.plot.empty()) {
-    outs.Write(o.plot, DiagnosePlotsSvg(j));
+    outs.Write(o.plot, api::DiagnosePlotsSvg(j));
     written.push_back(o.plot + " (plot)");
   }
   if (!o.report.empty()) {
-    outs.Write(o.report, DiagnoseReportHtml(j, o.manifest));
+    outs.Write(o.report, api::DiagnoseReportHtml(j, o.manifest));
     written.push_back(o.report + " (HTML report)");
   }
   o.json.EmitAndListOutputs(j, written);

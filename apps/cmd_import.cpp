@@ -10,13 +10,11 @@
 
 #include <fmt/format.h>
 
+#include "api/import.hpp"
 #include "commands.hpp"
 #include "common.hpp"
 #include "core/angles.hpp"
 #include "core/errors.hpp"
-#include "evaluation/data_warnings.hpp"
-#include "output/atomic_write.hpp"
-#include "formats/campaign_writer.hpp"
 #include "import/optiodom.hpp"
 #include "import/rosbag2_import.hpp"
 #include "import/wheel_checks.hpp"
@@ -57,63 +55,27 @@ CampaignPaths CheckImportOutputs(const std::vector<std::string>& inputs, const s
   return p;
 }
 
-// The imported campaign as the folder `out`, written into a staging folder
-// and renamed into place as a whole (io::WriteCampaign): a reader or an
-// interrupted import sees the complete old folder or the complete new one,
-// and with --force no file of the previous campaign stays beside the new ones.
-void WriteImportedCampaign(const RobotParams& robot, const Experiment& experiment, TrajectoryData runs,
-                           const std::string& out, const std::vector<std::string>& comment, bool force,
-                           const std::optional<GroundTruthNoise>& ground_truth = std::nullopt,
-                           const std::vector<io::ManifestKey>& ground_truth_keys = {}) {
-  Manifest m;
-  m.robot = robot;
-  m.experiments.push_back(experiment);
-  m.ground_truth = ground_truth;
-  io::WriteCampaign(m, {ExperimentData(std::move(runs))}, out, comment, {}, force, ground_truth_keys);
-}
-
 int RunImportOptiOdom(const ImportOptions& o) {
-  namespace fs = std::filesystem;
-  std::optional<std::string> category;
-  if (!o.category.empty()) category = o.category;
   // The output folder must not hold the dataset; the two files it gets must
   // not be other outputs.
   const auto [runs_path, manifest_path] = CheckImportOutputs({o.dir}, o.out, o.json, o.force);
-  const io::OptiOdomDataset ds = io::ImportOptiOdom(o.dir, category);
-
-  const std::string source = fmt::format("OptiOdom dataset {} ({}), imported by umbmark import optiodom", ds.id,
-                                         ds.category);
-  WriteImportedCampaign(ds.robot, ds.experiment, ds.runs, o.out, {source}, o.force);
-
-  std::size_t samples = 0;
-  nlohmann::json runs = nlohmann::json::array();
-  TrajectoryDataCheck check(ds.robot);
-  for (const auto& r : ds.runs.runs) {
-    check.Add(r);
-    samples += r.size();
-    runs.push_back({{"run", r.run}, {"direction", r.direction}, {"samples", r.size()}});
-  }
-  const std::vector<std::string> warnings = check.Warnings(runs_path);
+  const api::ImportOptiOdomResult r = api::ImportOptiOdom({o.dir, o.category, o.out, o.force});
+  const io::OptiOdomDataset& ds = r.imported;
   if (o.json.PrintText()) {
+    std::size_t samples = 0;
+    for (const auto& run : ds.runs.runs) samples += run.size();
     fmt::print("Imported OptiOdom dataset {} ({}): {} runs, {} samples\n", ds.id, ds.category, ds.runs.runs.size(),
                samples);
     fmt::print("  robot: wheelbase {} m, D_L {} m, D_R {} m, {} ticks/rev\n", ds.robot.wheelbase_m,
                ds.robot.wheel_diameter_left_m, ds.robot.wheel_diameter_right_m, *ds.robot.ticks_per_rev);
     if (ds.experiment.kind == ExperimentKind::kSquare) fmt::print("  experiment: square, side {} m\n", ds.experiment.side_m);
-    for (const auto& r : ds.runs.runs) fmt::print("  run {:>3}  {:<9} {} samples\n", r.run, r.direction, r.size());
-    for (const auto& w : warnings) fmt::print(stderr, "warning: {}\n", w);
+    for (const auto& run : ds.runs.runs) fmt::print("  run {:>3}  {:<9} {} samples\n", run.run, run.direction, run.size());
+    for (const auto& w : r.warnings) fmt::print(stderr, "warning: {}\n", w);
     fmt::print("  wrote {}\n  wrote {}\n", manifest_path, runs_path);
   } else {
-    for (const auto& w : warnings) fmt::print(stderr, "warning: {}\n", w);
+    for (const auto& w : r.warnings) fmt::print(stderr, "warning: {}\n", w);
   }
-  o.json.Emit({{"dataset", ds.id},
-               {"category", ds.category},
-               {"manifest", manifest_path},
-               {"runs_csv", runs_path},
-               {"robot", JsonParams(ds.robot)},
-               {"experiment", {{"kind", ExperimentKindToString(ds.experiment.kind)}, {"side_m", ds.experiment.side_m}}},
-               {"runs", runs},
-               {"warnings", warnings}});
+  o.json.Emit(api::ToJson(r));
   return 0;
 }
 
@@ -189,60 +151,6 @@ void PrintScanSummary(const io::rosbag2::Rosbag2Import& r) {
              1e3 * g.sigma_xy_m, 1e3 * g.sigma_theta_rad);
 }
 
-nlohmann::json ScanJson(const io::rosbag2::Rosbag2Import& r) {
-  const GroundTruthNoise& g = *r.ground_truth;
-  nlohmann::json j = {{"sigma_xy_m", JsonNumber(g.sigma_xy_m)}, {"sigma_theta_rad", JsonNumber(g.sigma_theta_rad)}};
-  for (const auto& k : io::rosbag2::ScanManifestKeys(r.scan)) {
-    if (const double* v = std::get_if<double>(&k.value)) j[k.key] = JsonNumber(*v);
-    else j[k.key] = std::get<std::string>(k.value);
-  }
-  nlohmann::json recs = nlohmann::json::array();
-  for (const auto& rec : r.scan) {
-    nlohmann::json runs = nlohmann::json::array();
-    for (const auto& run : rec.runs) {
-      const auto& t = run.track;
-      nlohmann::json jr = {{"run", run.run},
-                           {"still_scans_before", t.still_before},
-                           {"still_scans_after", t.still_after},
-                           {"chained_scans", t.chained},
-                           {"keyframes", t.keyframes},
-                           {"end_registered_on_start", t.end_direct},
-                           {"end", {JsonNumber(t.end.x), JsonNumber(t.end.y), JsonNumber(t.end.theta)}},
-                           {"end_sd", {JsonNumber(std::sqrt(t.end_covariance[0])), JsonNumber(std::sqrt(t.end_covariance[4])),
-                                       JsonNumber(std::sqrt(t.end_covariance[8]))}},
-                           {"still_scan_sd_xy_m", JsonNumber(t.still_sd_xy_m)},
-                           {"still_scan_sd_theta_rad", JsonNumber(t.still_sd_theta_rad)},
-                           {"moved_while_still", t.still_moved},
-                           {"max_residual_sd_m", JsonNumber(t.max_residual_sd_m)}};
-      if (!std::isnan(run.gyro_heading_change_rad)) jr["gyro_heading_change_rad"] = JsonNumber(run.gyro_heading_change_rad);
-      runs.push_back(jr);
-    }
-    nlohmann::json jrec = {{"scan_frame", rec.scan_frame},
-                           {"scans", rec.scans},
-                           {"scan_pose", {JsonNumber(rec.mount.x), JsonNumber(rec.mount.y), JsonNumber(rec.mount.theta)}},
-                           {"scan_pose_from", rec.mount_source},
-                           {"scan_upside_down", rec.upside_down},
-                           {"scan_time_offset_s", JsonNumber(rec.scan_time_offset_s)},
-                           {"scan_clock_determined", rec.clock_determined},
-                           {"runs", runs}};
-    if (rec.mount_estimate.pairs > 0) {
-      const auto& me = rec.mount_estimate;
-      jrec["scan_pose_from_motion"] = {{"yaw_rad", JsonNumber(me.yaw_rad)},
-                                       {"x_m", me.position_determined ? JsonNumber(me.x_m) : nlohmann::json()},
-                                       {"y_m", me.position_determined ? JsonNumber(me.y_m) : nlohmann::json()},
-                                       {"stretches", me.pairs}};
-    }
-    if (rec.gyro) {
-      jrec["gyro_bias_rad_s"] = JsonNumber(rec.gyro->bias_rad_s);
-      jrec["gyro_scale"] = JsonNumber(rec.gyro->scale);
-      jrec["imu_messages"] = rec.imu_messages;
-    }
-    recs.push_back(jrec);
-  }
-  j["recordings"] = recs;
-  return j;
-}
-
 // One topic row of --list, and below a TFMessage topic its frames (parent,
 // rate, whether the odometry frame is in its chain): enough to choose every
 // flag of the import from the listing alone.
@@ -277,36 +185,6 @@ void PrintListedTopic(const io::rosbag2::TopicListing& l) {
   if (l.tf.size() > kMaxFrames) fmt::print("      ... and {} more frames (--json lists them all)\n", l.tf.size() - kMaxFrames);
 }
 
-nlohmann::json ListedTopicJson(const io::rosbag2::TopicListing& l) {
-  nlohmann::json frames = nlohmann::json::array();
-  for (const auto& f : l.tf)
-    frames.push_back({{"frame", f.edge.child},
-                      {"parent", f.edge.parent},
-                      {"static", f.edge.is_static},
-                      {"messages", f.edge.count},
-                      {"rate_hz", JsonNumber(f.edge.RateHz())},
-                      {"through_odometry", f.through_odometry}});
-  return {{"name", l.topic.name},
-          {"type", l.topic.type},
-          {"messages", l.topic.count},
-          {"rate_hz", JsonNumber(l.topic.RateHz())},
-          {"wheels", l.wheels},
-          {"ground_truth", l.ground_truth},
-          {"robot_odometry", l.robot_odometry},
-          {"scan", l.scan},
-          {"imu", l.imu},
-          {"static", l.static_transforms},
-          {"scan_pose", l.mount ? nlohmann::json{{"x_m", JsonNumber(l.mount->pose.x)}, {"y_m", JsonNumber(l.mount->pose.y)},
-                                                 {"yaw_rad", JsonNumber(l.mount->pose.theta)},
-                                                 {"upside_down", l.mount->upside_down},
-                                                 {"base_frame", l.mount->base_frame}}
-                                : nlohmann::json()},
-          {"joints", l.joints},
-          {"child_frames", l.frames},
-          {"header_minus_receive_s", l.header_minus_receive_s ? JsonNumber(*l.header_minus_receive_s) : nlohmann::json()},
-          {"frames", frames}};
-}
-
 // Usable topics first (at most 200), then the others (at most 40), so
 // that 200,000 camera topics do not bury the wheel and ground-truth ones.
 int RunRosbag2List(const Rosbag2Options& o) {
@@ -335,7 +213,7 @@ int RunRosbag2List(const Rosbag2Options& o) {
           continue;
         }
         if (o.json.PrintText()) PrintListedTopic(l);
-        topics.push_back(ListedTopicJson(l));
+        topics.push_back(api::ToJson(l));
       }
     if (omitted > 0 && o.json.PrintText())
       fmt::print("  ... and {} more topics not listed ({} usable as wheels or ground truth)\n", omitted,
@@ -358,7 +236,6 @@ int RunRosbag2List(const Rosbag2Options& o) {
 // Options to the library's, output checks, import, write, then the text and
 // JSON summaries of what was read (long only because of the printing).
 int RunRosbag2(Rosbag2Options o) {
-  namespace fs = std::filesystem;
   if (o.list) return RunRosbag2List(o);
   if (o.out.empty()) throw InvalidOptions("--out OUTDIR is required (or --list to see the topics)");
   if (o.experiment.empty()) throw InvalidOptions("--experiment square|back_and_forth|free is required");
@@ -381,50 +258,8 @@ int RunRosbag2(Rosbag2Options o) {
   // The recordings (and every file of a bag folder) are inputs; the two
   // files written must not be one of them or another output.
   const auto [runs_path, manifest_path] = CheckImportOutputs(o.bags, o.out, o.json, o.force);
-  const auto result = io::rosbag2::ImportRosbag2(o.bags, robot, opt);
-
-  std::vector<std::string> comment = {
-      fmt::format("ROS 2 recording(s) {}, imported by umbmark import rosbag2", fmt::join(o.bags, ", ")),
-      fmt::format("wheels: {} {}; ground truth: {}; time: {}", opt.wheels_topic.empty() ? "--odometry" : "--wheels",
-                  opt.wheels_topic.empty() ? opt.odometry_topic : opt.wheels_topic,
-                  opt.ground_truth_topic.empty() ? "none" : opt.ground_truth_topic, o.time)};
-  if (!opt.scan_topic.empty()) comment[1] = fmt::format("wheels: {} {}; ground truth: lidar {} (scan registration){}; time: {}",
-                                                        opt.wheels_topic.empty() ? "--odometry" : "--wheels",
-                                                        opt.wheels_topic.empty() ? opt.odometry_topic : opt.wheels_topic,
-                                                        opt.scan_topic, opt.imu_topic.empty() ? "" : ", gyro " + opt.imu_topic, o.time);
-  WriteImportedCampaign(robot, result.experiment, result.runs, o.out, comment, o.force, result.ground_truth,
-                        result.ground_truth_keys);
-
-  nlohmann::json recordings = nlohmann::json::array();
-  for (const auto& r : result.recordings)
-    recordings.push_back({{"path", r.path},
-                          {"runs_dropped", r.runs_dropped},
-                          {"wheel_messages", r.wheel_messages},
-                          {"ground_truth_messages", r.ground_truth_messages},
-                          {"runs", r.runs},
-                          {"left_joint", r.left_joint},
-                          {"right_joint", r.right_joint},
-                          {"duration_s", JsonNumber(r.duration_s)}});
-  // Degenerate data (evaluation/data_warnings.hpp) join the importer's own warnings.
-  std::vector<std::string> warnings = result.warnings;
-  {
-    TrajectoryDataCheck check(robot);
-    for (const auto& r : result.runs.runs) check.Add(r);
-    for (auto& w : check.Warnings(runs_path)) warnings.push_back(std::move(w));
-  }
-  nlohmann::json runs = nlohmann::json::array();
-  for (const auto& r : result.runs.runs) {
-    std::size_t with_gt = 0;
-    for (std::size_t i = 0; i < r.size(); ++i) with_gt += r.HasGroundTruth(i) ? 1 : 0;
-    runs.push_back({{"run", r.run},
-                    {"direction", r.direction},
-                    {"samples", r.size()},
-                    {"ground_truth_samples", with_gt},
-                    {"t_start_s", JsonNumber(r.t_s.front())},
-                    {"t_end_s", JsonNumber(r.t_s.back())},
-                    {"dist_left_m", JsonNumber(r.dist_left_m.back())},
-                    {"dist_right_m", JsonNumber(r.dist_right_m.back())}});
-  }
+  const api::ImportRosbag2Result imported = api::ImportRosbag2({o.bags, opt, robot, o.out, o.force});
+  const io::rosbag2::Rosbag2Import& result = imported.imported;
   if (o.json.PrintText()) {
     for (const auto& r : result.recordings) {
       fmt::print("{}: {} wheel messages, {} ground-truth poses, {:.1f} s, {} run(s){}\n", r.path, r.wheel_messages,
@@ -435,19 +270,11 @@ int RunRosbag2(Rosbag2Options o) {
       fmt::print("  run {:>3}  {:<14} {:>6} samples  t {:8.2f} .. {:8.2f} s  travel L {:7.3f} m  R {:7.3f} m\n", r.run,
                  r.direction, r.size(), r.t_s.front(), r.t_s.back(), r.dist_left_m.back(), r.dist_right_m.back());
     PrintScanSummary(result);
-    for (const auto& w : warnings) fmt::print(stderr, "warning: {}\n", w);
+    for (const auto& w : imported.warnings) fmt::print(stderr, "warning: {}\n", w);
     fmt::print("  wrote {}\n  wrote {}\nNext: umbmark calibrate {} (squares) or umbmark fit-noise {}\n", manifest_path,
                runs_path, manifest_path, manifest_path);
   }
-  nlohmann::json j = {{"manifest", manifest_path},
-                      {"runs_csv", runs_path},
-                      {"robot", JsonParams(robot)},
-                      {"experiment", o.experiment},
-                      {"recordings", recordings},
-                      {"runs", runs},
-                      {"warnings", warnings}};
-  if (!result.scan.empty()) j["ground_truth"] = ScanJson(result);
-  o.json.Emit(j);
+  o.json.Emit(api::ToJson(imported));
   return 0;
 }
 

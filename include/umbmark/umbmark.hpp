@@ -1,5 +1,5 @@
-// umbmark's public API in one include: calibrate, refine, fit-noise,
-// predict, simulate, diagnose, io. Link umbmark::umbmark (CMake:
+// umbmark's public API in one include: calibrate, refine, evaluate,
+// fit-noise, import, predict, simulate, diagnose, summarize, io. Link umbmark::umbmark (CMake:
 // find_package(umbmark)) or `pkg-config --cflags --libs umbmark`.
 // Only the declarations these headers name are the API; the headers under
 // umbmark/detail/ they pull in are internals and may change.
@@ -7,9 +7,12 @@
 
 #include "umbmark/calibrate.hpp"
 #include "umbmark/diagnose.hpp"
+#include "umbmark/evaluate.hpp"
 #include "umbmark/fit_noise.hpp"
+#include "umbmark/import.hpp"
 #include "umbmark/io.hpp"
 #include "umbmark/predict.hpp"
 #include "umbmark/refine.hpp"
 #include "umbmark/simulate.hpp"
+#include "umbmark/summarize.hpp"
 #include "umbmark/version.hpp"

@@ -11,7 +11,7 @@
 
 #include "calibration/fleet.hpp"
 
-namespace umbmark::cli {
+namespace umbmark::api {
 
 struct FleetPage {
   std::vector<std::string> names;   ///< per robot (input order): robot id or file stem, unique
@@ -26,4 +26,4 @@ struct FleetPage {
 /// The page (self-contained HTML, io::HtmlReport).
 std::string FleetReportHtml(const FleetPage& page);
 
-}  // namespace umbmark::cli
+}  // namespace umbmark::api

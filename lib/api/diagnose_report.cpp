@@ -1,5 +1,5 @@
 // Plots and report page of a diagnosis (see diagnose_report.hpp).
-#include "diagnose_report.hpp"
+#include "api/diagnose_report.hpp"
 
 #include <algorithm>
 #include <array>
@@ -12,7 +12,7 @@
 #include "report/html_report.hpp"
 #include "report/svg_plot.hpp"
 
-namespace umbmark::cli {
+namespace umbmark::api {
 
 namespace {
 
@@ -464,4 +464,4 @@ std::string DiagnoseReportHtml(const nlohmann::json& j, const std::string& manif
   return rep.Render();
 }
 
-}  // namespace umbmark::cli
+}  // namespace umbmark::api

@@ -1,5 +1,5 @@
 // The fleet page of `umbmark summarize --report` (see summarize_report.hpp).
-#include "summarize_report.hpp"
+#include "api/summarize_report.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include "report/html_report.hpp"
 #include "report/svg_plot.hpp"
 
-namespace umbmark::cli {
+namespace umbmark::api {
 namespace {
 
 constexpr std::size_t kMaxOutlierRows = 200;  // the table; the JSON and CSV list every robot
@@ -224,4 +224,4 @@ std::string FleetReportHtml(const FleetPage& page) {
   return rep.Render();
 }
 
-}  // namespace umbmark::cli
+}  // namespace umbmark::api

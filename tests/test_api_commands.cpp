@@ -1,0 +1,160 @@
+// The library API of the commands (lib/api, installed as include/umbmark/):
+// evaluate, fit-noise, import and summarize called as functions give the
+// command line's JSON key for key and number for number (the JSON of a
+// separate `umbmark` process), their options name the bad field, and the
+// numbers they return agree with what follows from them (a summary is the
+// mean and maximum of its runs).
+#include <catch2/catch.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+
+#include "api/evaluate.hpp"
+#include "api/fit_noise.hpp"
+#include "api/import.hpp"
+#include "api/summarize.hpp"
+#include "core/errors.hpp"
+#include "formats/robot_toml.hpp"
+#include "support/run_cli.hpp"
+
+using namespace umbmark;
+using umbmark::testing::Q;
+using umbmark::testing::RunCli;
+using umbmark::testing::Slurp;
+using umbmark::testing::TempDir;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kSrc = UMBMARK_SOURCE_DIR;
+const fs::path kEx = kSrc / "data/examples";
+const fs::path kBags = kSrc / "tests/data/rosbag2";
+
+nlohmann::json Cli(const std::string& args) {
+  const auto r = RunCli(args + " --json -");
+  REQUIRE(r.status == 0);
+  return nlohmann::json::parse(r.out);
+}
+
+// What the command line writes: the result's JSON as text and back (the
+// same doubles: both print shortest round-trip decimals).
+nlohmann::json RoundTrip(const nlohmann::json& j) { return nlohmann::json::parse(j.dump()); }
+
+}  // namespace
+
+TEST_CASE("api::Evaluate gives evaluate's JSON; its summary is the mean and maximum of its runs", "[api]") {
+  api::EvaluateOptions o;
+  o.inputs = {(kEx / "square_ticks.csv").string()};
+  o.robot.robot_file = (kEx / "robot.toml").string();
+  const api::EvaluateResult r = api::Evaluate(o);
+  CHECK(RoundTrip(api::ToJson(r)) ==
+        Cli("evaluate " + Q(kEx / "square_ticks.csv") + " --robot " + Q(kEx / "robot.toml")));
+  REQUIRE(r.summary.runs.size() >= 4);
+  double sum = 0.0, worst = 0.0;
+  for (const auto& run : r.summary.runs) {
+    sum += run.final_position_error_m;
+    worst = std::max(worst, run.max_position_error_m);
+  }
+  CHECK(r.summary.mean_final_position_error_m == Approx(sum / static_cast<double>(r.summary.runs.size())).epsilon(1e-14));
+  CHECK(r.summary.max_max_position_error_m == worst);
+  CHECK_FALSE(r.recorded);
+  CHECK(r.parameters.wheelbase_m == io::ReadRobotToml(o.robot.robot_file).wheelbase_m);
+
+  api::EvaluateOptions bad;
+  CHECK_THAT(bad.Check(), Catch::StartsWith("inputs:"));
+  bad = o;
+  bad.robot.wheelbase_m = -0.2;
+  CHECK_THAT(bad.Check(), Catch::StartsWith("--wheelbase"));
+  CHECK_THROWS_AS(api::Evaluate(bad), InvalidOptions);
+}
+
+TEST_CASE("api::FitNoise gives fit-noise's JSON; its options name the bad field", "[api]") {
+  api::FitNoiseOptions o;
+  o.inputs = {(kEx / "fit-noise.toml").string()};
+  const api::FitNoiseResult r = api::FitNoise(o);
+  CHECK(RoundTrip(api::ToJson(r)) == Cli("fit-noise " + Q(kEx / "fit-noise.toml")));
+  CHECK(r.inputs == std::vector<std::string>{(kEx / "fwd_back_travel.csv").string()});
+  CHECK(r.fit.runs == static_cast<int>(r.fit.group_of_run.size()));
+  CHECK(r.restricted);
+  CHECK(r.second_order);
+  CHECK_FALSE(r.ros2);
+
+  api::FitNoiseOptions bad = o;
+  bad.meas_sigma = {0.001, 0.002, 0.003};
+  CHECK_THAT(bad.Check(), Catch::StartsWith("--meas-sigma"));
+  bad = o;
+  bad.systematic = "guess";
+  CHECK_THAT(bad.Check(), Catch::Contains("systematic = 'guess'"));
+  bad = o;
+  bad.ros2_file = "cov.yaml";
+  bad.covariance.rate_hz = 0.0;
+  CHECK_THAT(bad.Check(), Catch::StartsWith("rate_hz"));
+}
+
+TEST_CASE("api::ImportRosbag2 writes the campaign the command writes and gives its JSON", "[api][rosbag2]") {
+  const fs::path dir = TempDir("api-import");
+  const std::string bag = (kBags / "square_run1.mcap").string();
+  api::ImportRosbag2Options o;
+  o.bags = {bag};
+  o.robot = io::ReadRobotToml((kBags / "robot.toml").string());
+  o.import.kind = ExperimentKind::kSquare;
+  o.import.side_m = 0.75;
+  o.import.wheels_topic = "/joint_states";
+  o.import.ground_truth_topic = "/mocap/pose";
+  o.import.pause_s = 0.0;
+  o.out = (dir / "api").string();
+  const api::ImportRosbag2Result r = api::ImportRosbag2(o);
+  nlohmann::json cli = Cli("import rosbag2 " + Q(bag) + " --out " + Q(dir / "cli") + " --experiment square --side 0.75 "
+                           "--robot " + Q(kBags / "robot.toml") + " --wheels /joint_states --ground-truth /mocap/pose "
+                           "--pause 0");
+  nlohmann::json api_json = RoundTrip(api::ToJson(r));
+  CHECK(api_json["manifest"] == (dir / "api" / "campaign.toml").string());
+  for (auto* j : {&cli, &api_json}) {
+    j->erase("manifest");
+    j->erase("runs_csv");
+  }
+  // The warnings name the runs.csv they are about: the one of each folder.
+  std::string api_text = api_json.dump();
+  const std::string api_csv = (dir / "api" / "runs.csv").string(), cli_csv = (dir / "cli" / "runs.csv").string();
+  for (std::size_t at = api_text.find(api_csv); at != std::string::npos; at = api_text.find(api_csv, at))
+    api_text.replace(at, api_csv.size(), cli_csv);
+  CHECK(nlohmann::json::parse(api_text) == cli);
+  CHECK(Slurp((dir / "api" / "runs.csv").string()) == Slurp((dir / "cli" / "runs.csv").string()));
+  CHECK(Slurp((dir / "api" / "campaign.toml").string()) == Slurp((dir / "cli" / "campaign.toml").string()));
+  REQUIRE(r.imported.runs.runs.size() == 1);
+  CHECK(r.imported.runs.runs[0].direction == "cw");
+
+  api::ImportRosbag2Options bad = o;
+  bad.out.clear();
+  CHECK_THAT(bad.Check(), Catch::StartsWith("--out"));
+  bad = o;
+  bad.import.side_m = 0.0;
+  CHECK_THAT(bad.Check(), Catch::StartsWith("side_m"));
+}
+
+TEST_CASE("api::Summarize gives summarize's JSON and CSV", "[api][fleet]") {
+  const fs::path dir = TempDir("api-summarize");
+  std::vector<std::string> files;
+  for (const char* est : {"mean", "x", "mean"}) {
+    files.push_back((dir / (std::string("cal-") + std::to_string(files.size()) + ".json")).string());
+    REQUIRE(RunCli("calibrate " + Q(kEx / "calibrate.toml") + " --estimator " + est + " --json " + Q(files.back())).status == 0);
+  }
+  api::SummarizeOptions o;
+  o.inputs = files;
+  const api::SummarizeResult r = api::Summarize(o);
+  std::string args = "summarize";
+  for (const auto& f : files) args += " " + Q(f);
+  CHECK(RoundTrip(api::ToJson(r)) == Cli(args + " --csv " + Q(dir / "fleet.csv")));
+  CHECK(api::SummarizeCsv(r) == Slurp((dir / "fleet.csv").string()));
+  REQUIRE(r.robots.size() == 3);
+  CHECK(r.robots[0].robot == "cal-0");
+  CHECK(r.files == 3);
+
+  api::SummarizeOptions bad = o;
+  bad.fleet.threshold = -1.0;
+  CHECK_THAT(bad.Check(), Catch::Contains("threshold"));
+  CHECK_THROWS_AS(api::Summarize(bad), InvalidOptions);
+}
