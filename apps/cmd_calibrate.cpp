@@ -31,6 +31,7 @@
 #include "formats/manifest.hpp"
 #include "formats/robot_id.hpp"
 #include "formats/ros2_params.hpp"
+#include "planning/advice.hpp"
 
 namespace umbmark::cli {
 
@@ -727,6 +728,7 @@ UnitAssessment Assess(const CalibrateInput& in, const FittedUnit& f, const Calib
   const ModelCheck check = CheckCentresAgainstModel(in, r.umbmark.runs, r.refined ? r.refined->refined : r.umbmark.corrected,
                                                     jo.refine ? jo.refine->final_turn : true);
   std::vector<std::string> warnings = TrustWarnings(r, heldout, check);
+  for (auto& m : planning::AdviseCalibration(in, chosen.parameters).messages) warnings.push_back(std::move(m));
   warnings.insert(warnings.end(), f.gate.warnings.begin(), f.gate.warnings.end());
   if (r.refined && in.trajectories && !HasInteriorGroundTruth(*in.trajectories)) {
     warnings.push_back("ground truth only at the first and last sample of each run: the refined fit used the "

@@ -238,7 +238,8 @@ int RunCheck(const PlanFlags& f) {
   }
   const planning::CheckResult r = planning::CheckCampaign(robot, experiments, o);
   nlohmann::json conf = nlohmann::json::array();
-  for (const auto& c : r.cannot_separate) conf.push_back({{"what", c.what}, {"add", c.add}, {"correlation", c.correlation}});
+  for (const auto& c : r.cannot_separate)
+    conf.push_back({{"what", c.what}, {"kind", c.kind}, {"add", c.add}, {"correlation", c.correlation}});
   nlohmann::json j = {{"input", f.check},
                       {"predicted_ci95", JsonHalfWidths(r.predicted)},
                       {"cannot_separate", conf},
@@ -246,6 +247,7 @@ int RunCheck(const PlanFlags& f) {
                       {"k_L", r.noise.k_L},
                       {"k_R", r.noise.k_R},
                       {"noise_fitted", r.noise_fitted},
+                      {"calibration_noise", {{"k_L", r.calibration_noise.k_L}, {"k_R", r.calibration_noise.k_R}}},
                       {"ground_truth", {{"along_path", r.ground_truth.along_path},
                                         {"sigma_xy_m", r.ground_truth.sigma_xy_m},
                                         {"sigma_theta_rad", r.ground_truth.sigma_theta_rad}}},

@@ -14,7 +14,9 @@
 #   3.4 ground_truth                  ground-truth sources read from a recording
 #   3.5 import                        the importers (rosbag2, OptiOdom) and their checks
 #   4   calibration, simulation       UMBmark + refine; simulators
-#   5   diagnosis, planning           sim-to-real gap; which runs to drive
+#   4.5 planning                      which runs to drive; what a campaign determines
+#                                     (diagnose uses its analysis)
+#   5   diagnosis                     sim-to-real gap
 #   5.5 api                           one call per command (options -> result -> JSON)
 #   6   apps                          the command-line suite
 #
@@ -28,7 +30,7 @@ set -euo pipefail
 root=${1:-$(cd "$(dirname "$0")/.." && pwd)}
 declare -A rank=([core]=0 [stats]=10 [kinematics]=10 [scan]=10 [model]=20 [error_models]=30 [evaluation]=30
   [output]=31 [report]=31 [formats]=32 [ros2]=33 [ground_truth]=34 [import]=35
-  [calibration]=40 [simulation]=40 [diagnosis]=50 [planning]=50 [api]=55 [apps]=60)
+  [calibration]=40 [simulation]=40 [diagnosis]=50 [planning]=45 [api]=55 [apps]=60)
 declare -A file_room=([output]=1 [report]=1 [formats]=1 [ros2]=1 [ground_truth]=1 [import]=1)
 declare -A file_room_users=([diagnosis]=1 [api]=1 [apps]=1)
 # "3.2" for rank 32.

@@ -6,9 +6,11 @@
 
 #include <Eigen/Dense>
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
 
 #include "core/errors.hpp"
 #include "kinematics/diff_drive.hpp"
+#include "planning/advice.hpp"
 #include "planning/information.hpp"
 #include "planning/motions.hpp"
 #include "planning/plan.hpp"
@@ -155,4 +157,57 @@ TEST_CASE("plan: options are checked by field", "[plan]") {
   o.noise = {1e-3, 1e-3};
   o.max_side_m = 0.1;
   CHECK_THROWS_WITH(Plan(o), Catch::Contains("max_side_m"));
+}
+
+TEST_CASE("advice: record_more is the closed form of classic UMBmark's 1/n covariance", "[plan][advice]") {
+  // Endpoint (tape) squares: classic UMBmark's covariance is G diag(C_cw /
+  // n_cw, C_ccw / n_ccw) G', so with n runs per direction its half-width
+  // is h(n) = h(3) sqrt(3 / n) exactly. The runs needed to bring E_d's to
+  // half of a 0.05 % correction follow in closed form.
+  CalibrateInput in;
+  in.label = in.path = "squares.csv";
+  in.recorded = Robot();
+  in.side_m = 1.0;
+  for (int i = 0; i < 6; ++i)  // the values do not enter: the noise is given
+    in.errors.push_back(ReturnError{std::to_string(i + 1), i % 2 ? "ccw" : "cw", 0.01 * i, -0.004 * i, 0.002, 0, {}});
+  RobotParams cal = in.recorded;
+  cal.wheel_diameter_right_m *= 1.0005;  // E_d = 1.0005
+  cal.wheelbase_m *= 1.02;               // E_b = 1.02: well determined
+  const DesignAdvice a = AdviseCalibration(in, cal, WheelNoise{1e-3, 1e-3}, GroundTruthModel{false, 2e-3, 5e-3});
+  INFO(a.note);
+  REQUIRE(a.available);
+  CHECK(a.check.method == "umbmark_mean");
+  REQUIRE(a.check.predicted.E_d);
+  const double h3 = *a.check.predicted.E_d, target = 0.5 * 0.0005;
+  REQUIRE(h3 > target);
+  REQUIRE(a.check.record_more.size() == 1);  // E_b's 2 % is determined
+  const RecordMore& m = a.check.record_more.front();
+  CHECK(m.quantity == "E_d");
+  CHECK(m.correction == Approx(0.0005).epsilon(1e-9));
+  CHECK(m.half_width == Approx(h3).epsilon(1e-12));
+  const int expected = static_cast<int>(std::ceil(3.0 * (h3 / target) * (h3 / target) - 1e-9)) - 3;
+  CHECK(m.extra_runs_per_direction == expected);
+  CHECK(m.half_width_after == Approx(h3 * std::sqrt(3.0 / (3.0 + expected))).epsilon(1e-6));
+  CHECK(m.half_width_after <= target);
+  REQUIRE(a.messages.size() == 1);
+  CHECK(a.messages.front().find(fmt::format("record {} more square run(s) of 1.00 m", expected)) != std::string::npos);
+  // A correction no practical design determines: the message says to keep the recorded value.
+  cal.wheel_diameter_right_m = in.recorded.wheel_diameter_right_m * 1.000001;
+  const DesignAdvice tiny = AdviseCalibration(in, cal, WheelNoise{1e-3, 1e-3}, GroundTruthModel{false, 2e-3, 5e-3});
+  REQUIRE(tiny.check.record_more.size() == 1);
+  CHECK(tiny.check.record_more.front().extra_runs_per_direction == 0);
+  CHECK(tiny.messages.front().find("keep the recorded value") != std::string::npos);
+  // The recorded parameters (no correction): nothing to determine.
+  CHECK(AdviseCalibration(in, in.recorded, WheelNoise{1e-3, 1e-3}).check.record_more.empty());
+}
+
+TEST_CASE("advice: never throws; what it cannot analyse is a note", "[plan][advice]") {
+  CalibrateInput in;
+  in.label = in.path = "cw_only.csv";
+  in.recorded = Robot();
+  in.side_m = 1.0;
+  const DesignAdvice none = AdviseCalibration(in, in.recorded);  // no runs at all
+  CHECK_FALSE(none.available);
+  CHECK(none.note.find("no square run") != std::string::npos);
+  CHECK(none.messages.empty());
 }

@@ -8,6 +8,9 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <fmt/format.h>
+#include <tuple>
+#include <vector>
 
 #include "support/run_cli.hpp"
 
@@ -96,33 +99,52 @@ TEST_CASE("plan: bad input exits 1 or 2 and writes nothing", "[plan][cli]") {
   CHECK_FALSE(fs::exists(dir / "p.json"));
 }
 
-TEST_CASE("plan --check on the June square sessions: predicted E_d interval agrees with their spread", "[plan][cli]") {
+TEST_CASE("plan --check on the June square sessions: predicted E_d and E_b intervals agree with their spread", "[plan][cli]") {
   // The four square sessions of 23 June 2020 (0.75 m, 3-5 runs per
   // direction): each session's plain least-squares calibration (what
   // calibrate recommends on them, docs/calibration-comparison.md) against
-  // plan --check's predicted half-width for that session. The wheel noise
-  // is fit-noise's on the four sessions pooled (docs/diagnosis.md:
-  // k_L = 0.000229, k_R = 0.00115 m^1/2). From four sessions a factor of 2
-  // between the predicted standard deviation and the sessions' spread is
-  // what can be checked (issue 30).
+  // plan --check's predicted half-width for that session. From four
+  // sessions a factor of 2 between the predicted standard deviation and
+  // the sessions' spread is what can be checked (issue 30).
+  //
+  // The wheel noise: fit-noise on the four sessions pooled. With the
+  // return errors' heading (k_L = 0.000229, k_R = 0.00115 m^1/2,
+  // docs/diagnosis.md) E_b's prediction is 2.3 times the spread: the June
+  // heading return errors carry a scatter their positions do not (the
+  // fit's own goodness of fit: x, y variances 10 and 3 times below what
+  // those k imply), and the plain fit sees positions only. fit-noise on
+  // the return POSITIONS (an endpoint CSV without etheta: the tape-measure
+  // case) is the wheel noise the plain fit's positions carry
+  // (docs/plan.md, "plan --check on the June recordings").
   const char* sessions[] = {"230620202042", "230620202144", "230620202258", "230620202317"};
-  std::vector<double> ed, b, var_ed, var_eb;
+  const fs::path pooled = TempDir("june_positions");
+  std::string manifest =
+      "[robot]\nwheelbase_m = 0.2\nwheel_diameter_left_m = 0.084\nwheel_diameter_right_m = 0.084\n";
+  std::vector<double> ed, b;
+  std::vector<fs::path> dirs;
   for (const char* s : sessions) {
     const fs::path dir = TempDir(std::string("june") + s);
+    dirs.push_back(dir);
     REQUIRE(RunCli("import optiodom " + Q(kSrc / "data/optiodom-2020-06/square" / s) + " --out " + Q(dir)).status == 0);
-    const auto check = RunCli("plan --check " + Q(dir / "campaign.toml") + " --kl 0.000229 --kr 0.00115 --json -");
-    INFO(check.err);
-    REQUIRE(check.status == 0);
-    const auto jc = nlohmann::json::parse(check.out);
-    CHECK(jc["method"] == "plain_least_squares");
-    var_ed.push_back(std::pow(jc["predicted_ci95"]["E_d"].get<double>() / 1.96, 2));
-    var_eb.push_back(std::pow(jc["predicted_ci95"]["E_b"].get<double>() / 1.96, 2));
     const auto cal = RunCli("calibrate " + Q(dir / "campaign.toml") + " --json -");
     REQUIRE(cal.status == 0);
-    const auto p = nlohmann::json::parse(cal.out)["heldout_error"]["plain_least_squares"]["parameters"];
+    const auto jc = nlohmann::json::parse(cal.out);
+    const auto p = jc["heldout_error"]["plain_least_squares"]["parameters"];
     ed.push_back(p["wheel_diameter_right_m"].get<double>() / p["wheel_diameter_left_m"].get<double>());
     b.push_back(p["wheelbase_m"].get<double>());
+    std::ofstream csv((pooled / (std::string(s) + ".csv")).string());
+    csv << "run,direction,ex_m,ey_m,etheta_rad\n";
+    for (const auto& r : jc["runs"])
+      csv << r["run"].get<std::string>() << "," << r["direction"].get<std::string>() << ","
+          << fmt::format("{:.9g},{:.9g},", r["ex_m"].get<double>(), r["ey_m"].get<double>()) << "\n";
+    manifest += fmt::format("\n[[experiment]]\nkind = \"square\"\nside_m = 0.75\nfile = \"{}.csv\"\n", s);
   }
+  std::ofstream((pooled / "campaign.toml").string()) << manifest;
+  const auto fn = RunCli("fit-noise " + Q(pooled / "campaign.toml") + " --meas-sigma 0.0003,0.001 --json -");
+  INFO(fn.err);
+  REQUIRE(fn.status == 0);
+  const auto jf = nlohmann::json::parse(fn.out);
+  const double kl_pos = std::max(jf["k_L"].get<double>(), 1e-7), kr_pos = std::max(jf["k_R"].get<double>(), 1e-7);
   auto sd = [](const std::vector<double>& v, double scale) {
     double m = 0.0, s = 0.0;
     for (double x : v) m += x / static_cast<double>(v.size());
@@ -134,15 +156,25 @@ TEST_CASE("plan --check on the June square sessions: predicted E_d interval agre
     for (double x : v) s += x / static_cast<double>(v.size());
     return std::sqrt(s);
   };
-  const double ratio_ed = sd(ed, 1.0) / rms(var_ed), ratio_eb = sd(b, 0.2007) / rms(var_eb);
-  INFO("E_d: sessions' sd " << sd(ed, 1.0) << ", predicted sd " << rms(var_ed) << ", ratio " << ratio_ed);
-  INFO("E_b: sessions' sd " << sd(b, 0.2007) << ", predicted sd " << rms(var_eb) << ", ratio " << ratio_eb);
-  CHECK(ratio_ed >= 0.5);
-  CHECK(ratio_ed <= 2.0);
-  // E_b: measured 0.44 (the sessions agree better than the pooled wheel
-  // noise implies; on the independent generator with this geometry and
-  // noise the prediction is within 3 %, docs/plan.md). The side that
-  // matters to a user holds: plan does not promise more than the
-  // sessions show.
-  CHECK(ratio_eb <= 2.0);
+  for (const auto& [kl, kr, what] : {std::tuple{0.000229, 0.00115, "with heading"}, std::tuple{kl_pos, kr_pos, "positions"}}) {
+    std::vector<double> var_ed, var_eb;
+    for (const fs::path& dir : dirs) {
+      const auto check = RunCli("plan --check " + Q(dir / "campaign.toml") + fmt::format(" --kl {} --kr {}", kl, kr) +
+                                " --json -");
+      INFO(check.err);
+      REQUIRE(check.status == 0);
+      const auto jc = nlohmann::json::parse(check.out);
+      CHECK(jc["method"] == "plain_least_squares");
+      var_ed.push_back(std::pow(jc["predicted_ci95"]["E_d"].get<double>() / 1.96, 2));
+      var_eb.push_back(std::pow(jc["predicted_ci95"]["E_b"].get<double>() / 1.96, 2));
+    }
+    const double ratio_ed = sd(ed, 1.0) / rms(var_ed), ratio_eb = sd(b, 0.2007) / rms(var_eb);
+    INFO("k " << what << ": k_L " << kl << ", k_R " << kr);
+    INFO("E_d: sessions' sd " << sd(ed, 1.0) << ", predicted sd " << rms(var_ed) << ", ratio " << ratio_ed);
+    INFO("E_b: sessions' sd " << sd(b, 0.2007) << ", predicted sd " << rms(var_eb) << ", ratio " << ratio_eb);
+    CHECK(ratio_ed >= 0.5);
+    CHECK(ratio_ed <= 2.0);
+    CHECK(ratio_eb <= 2.0);  // plan does not promise more than the sessions show
+    if (std::string(what) == "positions") CHECK(ratio_eb >= 0.5);  // with heading: 0.44 (see above)
+  }
 }

@@ -23,6 +23,7 @@
 #include "diagnosis/stop_model.hpp"
 #include "diagnosis/verdict.hpp"
 #include "diagnosis/where.hpp"
+#include "planning/advice.hpp"
 
 namespace umbmark::diag {
 
@@ -452,9 +453,36 @@ DiagnoseSummary DiagnoseCampaign(const CampaignData& recorded, const DiagnoseOpt
 
 }  // namespace
 
+namespace {
+
+/// `plan --check`'s analysis of the campaign (planning/advice.hpp), with
+/// the baseline's wheel noise: the effects its runs cannot tell apart and
+/// the smallest addition that separates each, added to `indistinguishable`
+/// (not for an effect the verdict names: the fits told it apart).
+void AddDesignAdvice(const CampaignData& c, DiagnoseSummary& s) {
+  std::vector<planning::CheckExperiment> x;
+  for (std::size_t i = 0; i < c.experiments.size() && i < c.files.size(); ++i)
+    x.push_back(planning::MakeCheckExperiment(c.experiments[i].kind, c.experiments[i].side_m,
+                                              c.experiments[i].distance_m, c.experiments[i].file, c.files[i]));
+  planning::CheckOptions o;
+  if (s.baseline.k_L > 0.0 && s.baseline.k_R > 0.0) o.noise = WheelNoise{s.baseline.k_L, s.baseline.k_R};
+  if (c.ground_truth) o.ground_truth = planning::GroundTruthModel{true, c.ground_truth->sigma_xy_m, c.ground_truth->sigma_theta_rad};
+  for (const planning::Confusion& k : planning::Advise(c.robot, x, o, {}).check.cannot_separate) {
+    const auto named = [&](const std::string& w) {
+      return std::find(s.verdict_effects.begin(), s.verdict_effects.end(), w) != s.verdict_effects.end();
+    };
+    if (k.kind == "effects" && std::none_of(k.what.begin(), k.what.end(), named))
+      s.indistinguishable.push_back(planning::ConfusionMessage(k));
+  }
+}
+
+}  // namespace
+
 DiagnoseSummary Diagnose(const CampaignData& recorded, const DiagnoseOptions& options) {
   if (auto e = options.Check(); !e.empty()) throw InvalidOptions("diagnose: " + e);
-  return DiagnoseCampaign(recorded, options, options.find_run_faults);
+  DiagnoseSummary s = DiagnoseCampaign(recorded, options, options.find_run_faults);
+  AddDesignAdvice(recorded, s);
+  return s;
 }
 
 }  // namespace umbmark::diag

@@ -27,12 +27,19 @@ std::string CheckOptions::Check() const {
   if (!(max_correlation > 0.0 && max_correlation < 1.0))
     return fmt::format("max_correlation = {} must be in (0, 1)", max_correlation);
   if (!(rate_hz > 0.0 && rate_hz <= 10000.0)) return fmt::format("rate_hz = {} must be in (0, 10000]", rate_hz);
+  for (const auto& [name, v] : {std::pair{"correction_E_d", correction_E_d}, std::pair{"correction_E_b", correction_E_b}})
+    if (v && !(std::isfinite(*v) && *v > 0.0)) return fmt::format("{} = {} must be a finite factor > 0", name, *v);
+  if (!(determined_fraction > 0.0 && determined_fraction <= 1.0))
+    return fmt::format("determined_fraction = {} must be in (0, 1]", determined_fraction);
+  if (max_extra_runs < 1 || max_extra_runs > 100000)
+    return fmt::format("max_extra_runs = {} must be in [1, 100000]", max_extra_runs);
   return {};
 }
 
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// Columns of the ground truth's footprint per run: the calibration
 /// parameters and the diagnosis effects (see check.hpp).
@@ -346,22 +353,39 @@ Gathered Gather(const RobotParams& robot, const std::vector<CheckExperiment>& ex
   return g;
 }
 
-/// Wheel noise for the prediction: given, or fitted to the campaign.
-WheelNoise NoiseFor(const Gathered& g, const CheckOptions& o, CheckResult* r) {
-  if (o.noise) return *o.noise;
+/// Wheel noise for the prediction: given (both uses), or fitted to the
+/// campaign: r->noise from all of the return errors (what fit-noise
+/// estimates, for k's half-widths), r->calibration_noise from their
+/// positions alone (the plain fit and classic UMBmark see positions only;
+/// a heading return error the positions do not share, such as a ground
+/// truth's heading error after motion, is no wheel noise to them).
+void NoiseFor(const Gathered& g, const CheckOptions& o, CheckResult* r) {
+  if (o.noise) {
+    r->noise = r->calibration_noise = *o.noise;
+    return;
+  }
   WheelNoiseFitOptions fo;
   fo.restricted = true;
   fo.intervals = false;
   try {
     const WheelNoiseFitSummary s = FitWheelNoise(g.noise_runs, fo);
     r->noise_fitted = true;
-    r->notes.push_back(fmt::format("wheel noise fitted to this campaign (fit-noise, REML, first order): k_L = {:.3g}, "
-                                   "k_R = {:.3g} m^1/2; give --kl/--kr to predict with other values",
-                                   s.k_L, s.k_R));
-    return {s.k_L, s.k_R};
+    r->noise = r->calibration_noise = {s.k_L, s.k_R};
   } catch (const std::exception& e) {
     throw QualityGateError(fmt::format("cannot fit the wheel noise from this campaign ({}); give --kl K --kr K", e.what()));
   }
+  std::vector<WheelNoiseFitRun> positions = g.noise_runs;
+  for (WheelNoiseFitRun& x : positions) x.has_theta = false;
+  try {
+    const WheelNoiseFitSummary p = FitWheelNoise(positions, fo);
+    r->calibration_noise = {p.k_L, p.k_R};
+  } catch (const std::exception&) {  // keep the full fit's (a note says which is used)
+  }
+  r->notes.push_back(fmt::format(
+      "wheel noise fitted to this campaign (fit-noise, REML, first order): k_L = {:.3g}, k_R = {:.3g} m^1/2 from "
+      "the return errors, for k's half-widths; k_L = {:.3g}, k_R = {:.3g} from their positions alone, for the "
+      "calibration's (it sees positions only); give --kl/--kr to predict with other values",
+      r->noise.k_L, r->noise.k_R, r->calibration_noise.k_L, r->calibration_noise.k_R));
 }
 
 std::string ColumnName(int c) { return c == kEs ? "scale_error" : kColumnName[c]; }
@@ -392,12 +416,12 @@ void EffectConfusions(const CampaignModel& cm, const std::vector<Addition>& adds
   const Info& M = cm.footprint;
   for (int e : effects) {
     if (!excited(M, e)) {
-      push({{ColumnName(e)}, search([&](const Info& N) { return excited(N, e) && Collinearity(N, e, params) <= mc; }),
+      push({"effects", {ColumnName(e)}, search([&](const Info& N) { return excited(N, e) && Collinearity(N, e, params) <= mc; }),
             1.0});
       continue;
     }
     if (const double col = Collinearity(M, e, params); col > mc) {
-      Confusion c{{ColumnName(e)}, "", col};
+      Confusion c{"effects", {ColumnName(e)}, "", col};
       for (int p : params)
         if (Collinearity(M, e, {p}) > 0.5) c.what.push_back(ColumnName(p));
       if (c.what.size() == 1) c.what.insert(c.what.end(), {"E_b", "E_d"});
@@ -410,7 +434,7 @@ void EffectConfusions(const CampaignModel& cm, const std::vector<Addition>& adds
       const int e = effects[i], f = effects[j];
       if ((e == kGtOffsetX && f == kGtOffsetY) || !excited(M, e) || !excited(M, f)) continue;
       if (const double pc = PartialCorrelation(M, e, f, params); pc > mc) {
-        push({{ColumnName(e), ColumnName(f)},
+        push({"effects", {ColumnName(e), ColumnName(f)},
               search([&](const Info& N) { return PartialCorrelation(N, e, f, params) <= mc; }), pc});
       }
     }
@@ -424,7 +448,7 @@ std::vector<Confusion> Confusions(const CampaignModel& cm, const std::vector<Add
   if (cm.along_path) {
     const Eigen::Matrix3d cov = cm.ls.Covariance();
     for (const auto& [i, j] : ParameterPairs(cm.ls, mc)) {
-      Confusion c{{kColumnName[i], kColumnName[j]}, "", std::abs(cov(i, j)) / std::sqrt(cov(i, i) * cov(j, j))};
+      Confusion c{"parameters", {kColumnName[i], kColumnName[j]}, "", std::abs(cov(i, j)) / std::sqrt(cov(i, i) * cov(j, j))};
       c.add = SmallestAddition(adds, 1, [&, i = i, j = j](const Addition& a, int n) {
         LeastSquaresTerms t = cm.ls;
         t.Add(a.ls, n);
@@ -436,7 +460,7 @@ std::vector<Confusion> Confusions(const CampaignModel& cm, const std::vector<Add
   }
   const double kc = NoiseCorrelation(NoiseInformation(cm.noise_runs, r.noise));
   if (kc > mc) {
-    Confusion c{{"k_L", "k_R"}, "", kc};
+    Confusion c{"noise", {"k_L", "k_R"}, "", kc};
     c.add = SmallestAddition(adds, 2, [&](const Addition& a, int n) {
       std::vector<NoiseRunModel> runs = cm.noise_runs;
       for (NoiseRunModel m : a.noise) {
@@ -448,6 +472,66 @@ std::vector<Confusion> Confusions(const CampaignModel& cm, const std::vector<Add
     out.push_back(c);
   }
   EffectConfusions(cm, adds, o, &out);
+  return out;
+}
+
+/// Predicted 95 % half-widths (E_d, E_b, scale) of the campaign's
+/// calibration with m more square runs per direction; NaN where not
+/// determined.
+using WidthsWith = std::function<Eigen::Vector3d(int)>;
+
+WidthsWith CalibrationWidths(const CampaignModel& cm, const Gathered& g, const std::vector<Addition>& adds,
+                             double side, double b, const CheckResult& r) {
+  if (g.along_path) {
+    return [&cm, &adds](int m) {
+      LeastSquaresTerms t = cm.ls;
+      if (m > 0) t.Add(adds[0].ls, m).Add(adds[1].ls, m);
+      const Eigen::Matrix3d c = t.Covariance();
+      return Eigen::Vector3d(kZ95 * std::sqrt(c(1, 1)), kZ95 * std::sqrt(c(0, 0)), kZ95 * std::sqrt(c(2, 2)));
+    };
+  }
+  auto ret = [&](bool cw) {
+    const PathCovarianceSummary pc =
+        PredictPathCovariance(ToWheelSegments(SquarePath(side, cw), b), b, r.calibration_noise, PoseCovariance::Zero());
+    return Eigen::Matrix2d(
+        (pc.covariance + MeasurementCovariance(r.ground_truth.sigma_xy_m, r.ground_truth.sigma_theta_rad, pc.mean))
+            .topLeftCorner<2, 2>());
+  };
+  return [cw_cov = ret(true), ccw_cov = ret(false), n_cw = g.cw, n_ccw = g.ccw, side, b](int m) {
+    if (n_cw + m < 1 || n_ccw + m < 1) return Eigen::Vector3d(kNaN, kNaN, kNaN);
+    const Eigen::Matrix2d c = ClassicCovariance(cw_cov, n_cw + m, ccw_cov, n_ccw + m, side, b);
+    return Eigen::Vector3d(kZ95 * std::sqrt(c(0, 0)), kZ95 * std::sqrt(c(1, 1)), kNaN);
+  };
+}
+
+/// record_more (check.hpp): for each correction given whose half-width is
+/// above determined_fraction |E - 1|, the fewest extra runs per direction
+/// that bring it there (the half-width falls with m: bisection).
+std::vector<RecordMore> RecordMoreRuns(const WidthsWith& widths, double pair_time_s, double side, const CheckOptions& o) {
+  std::vector<RecordMore> out;
+  for (const auto& [name, value, row] : {std::tuple{"E_d", o.correction_E_d, 0}, std::tuple{"E_b", o.correction_E_b, 1}}) {
+    if (!value) continue;
+    RecordMore m;
+    m.quantity = name;
+    m.correction = *value - 1.0;
+    m.half_width = widths(0)(row);
+    m.side_m = side;
+    const double target = o.determined_fraction * std::abs(m.correction);
+    if (!std::isfinite(m.half_width) || m.half_width <= target) continue;
+    const auto meets = [&](int n) { return widths(n)(row) <= target; };
+    int runs = o.max_extra_runs;
+    if (meets(runs)) {
+      int lo = 0;  // !meets(lo), meets(runs)
+      while (runs - lo > 1) {
+        const int mid = (lo + runs) / 2;
+        (meets(mid) ? runs : lo) = mid;
+      }
+      m.extra_runs_per_direction = runs;
+    }
+    m.half_width_after = widths(runs)(row);
+    m.time_s = runs * pair_time_s;
+    out.push_back(m);
+  }
   return out;
 }
 
@@ -472,7 +556,7 @@ CheckResult CheckCampaign(const RobotParams& robot, const std::vector<CheckExper
   if (g.cw + g.ccw == 0)
     throw InputError(experiments.empty() ? std::string() : experiments.front().label,
                      "no square run with ground truth at its start: the calibration cannot be predicted");
-  r.noise = NoiseFor(g, o, &r);
+  NoiseFor(g, o, &r);
   r.method = g.along_path ? "plain_least_squares" : "umbmark_mean";
   const double side = CampaignSide(experiments);
   // Calibration.
@@ -481,26 +565,17 @@ CheckResult CheckCampaign(const RobotParams& robot, const std::vector<CheckExper
   for (const CheckRun& run : g.runs) {
     cm.footprint += FootprintInformation(run, b, o.rate_hz);
     if (g.along_path && run.square)
-      cm.ls.Add(PathLeastSquaresTerms(run.travel, run.ground_truth, b, r.noise, r.ground_truth));
+      cm.ls.Add(PathLeastSquaresTerms(run.travel, run.ground_truth, b, r.calibration_noise, r.ground_truth));
   }
-  if (g.along_path) {
-    const Eigen::Matrix3d c = cm.ls.Covariance();
-    r.predicted.E_b = kZ95 * std::sqrt(c(0, 0));
-    r.predicted.E_d = kZ95 * std::sqrt(c(1, 1));
-    r.predicted.scale = kZ95 * std::sqrt(c(2, 2));
-  } else if (g.cw > 0 && g.ccw > 0) {
-    auto ret = [&](bool cw) {
-      const PathCovarianceSummary pc =
-          PredictPathCovariance(ToWheelSegments(SquarePath(side, cw), b), b, r.noise, PoseCovariance::Zero());
-      return Eigen::Matrix2d((pc.covariance + MeasurementCovariance(r.ground_truth.sigma_xy_m,
-                                                                    r.ground_truth.sigma_theta_rad, pc.mean))
-                                 .topLeftCorner<2, 2>());
-    };
-    const Eigen::Matrix2d c = ClassicCovariance(ret(true), g.cw, ret(false), g.ccw, side, b);
-    r.predicted.E_d = kZ95 * std::sqrt(c(0, 0));
-    r.predicted.E_b = kZ95 * std::sqrt(c(1, 1));
+  const std::vector<Addition> adds = Candidates(side, b, g.along_path, r.ground_truth, r.calibration_noise, o);
+  const WidthsWith widths = CalibrationWidths(cm, g, adds, side, b, r);
+  const Eigen::Vector3d now = widths(0);
+  if (std::isfinite(now(0))) r.predicted.E_d = now(0);
+  if (std::isfinite(now(1))) r.predicted.E_b = now(1);
+  if (std::isfinite(now(2))) r.predicted.scale = now(2);
+  if (!g.along_path)
     r.notes.push_back("ground truth at the end points only: classic UMBmark holds the overall scale at the recorded value");
-  }
+  r.record_more = RecordMoreRuns(widths, adds[0].time_s + adds[1].time_s, side, o);
   for (const auto& nr : g.noise_runs) cm.noise_runs.push_back({nr.group, nr.basis, nr.measurement, 1.0});
   const Eigen::Vector2d k = NoiseHalfWidths(NoiseInformation(cm.noise_runs, r.noise), r.noise);
   // A k the fit put at its boundary 0 has no interval the information can give.
@@ -514,8 +589,37 @@ CheckResult CheckCampaign(const RobotParams& robot, const std::vector<CheckExper
     }
     if (std::isfinite(width)) (std::string(name) == "k_L" ? r.predicted.k_L : r.predicted.k_R) = width;
   }
-  r.cannot_separate = Confusions(cm, Candidates(side, b, g.along_path, r.ground_truth, r.noise, o), r, o);
+  r.cannot_separate = Confusions(cm, adds, r, o);
   return r;
+}
+
+std::string ConfusionMessage(const Confusion& c) {
+  std::string what;
+  for (std::size_t i = 0; i < c.what.size(); ++i)
+    what += (i == 0 ? "" : i + 1 == c.what.size() ? " and " : ", ") + c.what[i];
+  // "no addition ... separates them" is said as it is; anything else is what to add.
+  const std::string add = c.add.starts_with("no addition") ? c.add : "add " + c.add;
+  if (c.what.size() == 1) return fmt::format("{} is not excited or not determined by these runs: {}", what, add);
+  return fmt::format("{} cannot be told apart on these runs (correlation {:.3f}): {}", what, c.correlation, add);
+}
+
+std::string RecordMoreMessage(const RecordMore& m) {
+  const std::string head =
+      m.half_width >= std::abs(m.correction)
+          ? fmt::format("{}'s correction ({:+.3g} %) is not determined by these runs: its predicted 95 % half-width "
+                        "is {:.3g} %",
+                        m.quantity, 100.0 * m.correction, 100.0 * m.half_width)
+          : fmt::format("{}'s correction ({:+.3g} %) is known only to +-{:.3g} % (predicted 95 % half-width)",
+                        m.quantity, 100.0 * m.correction, 100.0 * m.half_width);
+  if (m.extra_runs_per_direction == 0)
+    return head + fmt::format("; even {:.0f} s more of {:.2f} m squares would leave +-{:.3g} %: {}", m.time_s, m.side_m,
+                              100.0 * m.half_width_after,
+                              m.half_width_after >= std::abs(m.correction)
+                                  ? "the correction is within the noise, keep the recorded value"
+                                  : "it stays uncertain by more than half its size");
+  return head + fmt::format("; record {} more square run(s) of {:.2f} m in each direction (about {:.0f} s of driving) "
+                            "to bring it to +-{:.3g} %, half the correction or less",
+                            m.extra_runs_per_direction, m.side_m, m.time_s, 100.0 * m.half_width_after);
 }
 
 }  // namespace umbmark::planning
