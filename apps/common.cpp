@@ -16,42 +16,15 @@
 
 namespace umbmark::cli {
 
-void RobotFlags::Bind(CLI::App& app) {
-  app.add_option("--robot", robot_file, "Robot file (TOML): the parameters the odometry USED");
-  app.add_option("--wheelbase", wheelbase_m, "Override wheelbase_m [m]")->check(Plausible("wheelbase_m"));
-  app.add_option("--diameter-left", diameter_left_m, "Override wheel_diameter_left_m [m]")
+void BindRobot(CLI::App& app, api::RobotSource& robot) {
+  app.add_option("--robot", robot.robot_file, "Robot file (TOML): the parameters the odometry USED");
+  app.add_option("--wheelbase", robot.wheelbase_m, "Override wheelbase_m [m]")->check(Plausible("wheelbase_m"));
+  app.add_option("--diameter-left", robot.diameter_left_m, "Override wheel_diameter_left_m [m]")
       ->check(Plausible("wheel_diameter_left_m"));
-  app.add_option("--diameter-right", diameter_right_m, "Override wheel_diameter_right_m [m]")
+  app.add_option("--diameter-right", robot.diameter_right_m, "Override wheel_diameter_right_m [m]")
       ->check(Plausible("wheel_diameter_right_m"));
-  app.add_option("--ticks-per-rev", ticks_per_rev, "Override ticks_per_rev (ticks per wheel revolution)")
+  app.add_option("--ticks-per-rev", robot.ticks_per_rev, "Override ticks_per_rev (ticks per wheel revolution)")
       ->check(Plausible("ticks_per_rev"));
-}
-
-bool RobotFlags::Given() const {
-  return !robot_file.empty() || wheelbase_m || diameter_left_m || diameter_right_m || ticks_per_rev;
-}
-
-RobotParams RobotFlags::Resolve(const std::optional<RobotParams>& base) const {
-  RobotParams p;
-  bool have_file = false;
-  if (!robot_file.empty()) {
-    p = io::ReadRobotToml(robot_file);
-    have_file = true;
-  } else if (base) {
-    p = *base;
-    have_file = true;
-  }
-  if (wheelbase_m) p.wheelbase_m = *wheelbase_m;
-  if (diameter_left_m) p.wheel_diameter_left_m = *diameter_left_m;
-  if (diameter_right_m) p.wheel_diameter_right_m = *diameter_right_m;
-  if (ticks_per_rev) p.ticks_per_rev = *ticks_per_rev;
-  if (!have_file && !(wheelbase_m && diameter_left_m && diameter_right_m)) {
-    throw InvalidOptions(
-        "robot parameters missing: give --robot R.toml, a campaign manifest, or all of "
-        "--wheelbase, --diameter-left, --diameter-right");
-  }
-  if (auto err = p.Check(); !err.empty()) throw InvalidOptions("robot: " + err);
-  return p;
 }
 
 void JsonFlag::Bind(CLI::App& app) {
@@ -184,74 +157,6 @@ void RegisterInputs(const std::vector<std::string>& inputs, const RobotFlags* ro
     }
   }
   if (robot) outs.AddInput(robot->robot_file);
-}
-
-namespace {
-nlohmann::json EscapedStrings(const nlohmann::json& j) {
-  if (j.is_string()) {
-    const auto& s = j.get_ref<const std::string&>();
-    return IsValidUtf8(s) ? j : nlohmann::json(EscapeInvalidUtf8(s));
-  }
-  if (j.is_array()) {
-    nlohmann::json out = nlohmann::json::array();
-    for (const auto& v : j) out.push_back(EscapedStrings(v));
-    return out;
-  }
-  if (j.is_object()) {
-    nlohmann::json out = nlohmann::json::object();
-    for (auto it = j.begin(); it != j.end(); ++it) out[EscapeInvalidUtf8(it.key())] = EscapedStrings(it.value());
-    return out;
-  }
-  return j;
-}
-}  // namespace
-
-std::string DumpJson(const nlohmann::json& j, int indent) {
-  try {
-    return j.dump(indent);
-  } catch (const nlohmann::json::type_error&) {
-    return EscapedStrings(j).dump(indent);  // invalid UTF-8 somewhere: escape, then dump
-  }
-}
-
-nlohmann::json JsonNumber(double v) {
-  if (!std::isfinite(v)) return nullptr;
-  return v;
-}
-
-nlohmann::json JsonParams(const RobotParams& p) {
-  nlohmann::json j = {{"wheelbase_m", p.wheelbase_m},
-                      {"wheel_diameter_left_m", p.wheel_diameter_left_m},
-                      {"wheel_diameter_right_m", p.wheel_diameter_right_m}};
-  if (p.ticks_per_rev) j["ticks_per_rev"] = *p.ticks_per_rev;
-  return j;
-}
-
-nlohmann::json JsonEvaluationRuns(const EvaluationSummary& s) {
-  nlohmann::json runs = nlohmann::json::array();
-  for (const auto& r : s.runs) {
-    runs.push_back({{"experiment", r.experiment},
-                    {"run", r.run},
-                    {"direction", r.direction},
-                    {"final_position_error_m", r.final_position_error_m},
-                    {"max_position_error_m", r.max_position_error_m},
-                    {"final_heading_error_rad", r.final_heading_error_rad},
-                    {"max_heading_error_rad", r.max_heading_error_rad},
-                    {"return_error", {r.return_error.x, r.return_error.y, r.return_error.theta}}});
-  }
-  return runs;
-}
-
-nlohmann::json JsonEvaluationSummary(const EvaluationSummary& s) {
-  return {{"runs", s.runs.size()},
-          {"mean_final_position_error_m", s.mean_final_position_error_m},
-          {"max_final_position_error_m", s.max_final_position_error_m},
-          {"mean_max_position_error_m", s.mean_max_position_error_m},
-          {"max_max_position_error_m", s.max_max_position_error_m},
-          {"mean_final_heading_error_rad", s.mean_final_heading_error_rad},
-          {"max_final_heading_error_rad", s.max_final_heading_error_rad},
-          {"mean_max_heading_error_rad", s.mean_max_heading_error_rad},
-          {"max_max_heading_error_rad", s.max_max_heading_error_rad}};
 }
 
 std::string TaggedPath(const std::string& path, const std::string& tag) {

@@ -10,6 +10,8 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "api/json.hpp"
+#include "api/robot_source.hpp"
 #include "core/robot.hpp"
 #include "core/runs.hpp"
 #include "evaluation/trajectory_eval.hpp"
@@ -17,19 +19,14 @@
 
 namespace umbmark::cli {
 
-/// --robot FILE and the per-field override flags of the contract.
-struct RobotFlags {
-  std::string robot_file;
-  std::optional<double> wheelbase_m, diameter_left_m, diameter_right_m, ticks_per_rev;
+/// Binds --robot, --wheelbase, --diameter-left, --diameter-right,
+/// --ticks-per-rev to `robot` (lib/api/robot_source.hpp).
+void BindRobot(CLI::App& app, api::RobotSource& robot);
 
-  /// Binds --robot, --wheelbase, --diameter-left, --diameter-right, --ticks-per-rev.
-  void Bind(CLI::App& app);
-  bool Given() const;
-  /// Robot from the file (if any) with flag overrides applied, on top of
-  /// `base` (e.g. a manifest's [robot]). Throws InputError for a bad file,
-  /// InvalidOptions when the result fails RobotParams::Check() or a required
-  /// field is missing everywhere.
-  RobotParams Resolve(const std::optional<RobotParams>& base = std::nullopt) const;
+/// --robot FILE and the per-field override flags of the contract
+/// (api::RobotSource: Given(), Resolve()).
+struct RobotFlags : api::RobotSource {
+  void Bind(CLI::App& app) { BindRobot(app, *this); }
 };
 
 /// Where the machine-readable result goes: "" = nowhere, "-" = stdout alone.
@@ -89,18 +86,12 @@ io::OutputSet& CommandOutputs();
 /// robot file of `robot` when given.
 void RegisterInputs(const std::vector<std::string>& inputs, const RobotFlags* robot = nullptr);
 
-/// `j` as text (pretty when indent >= 0), every string and key with invalid
-/// UTF-8 bytes escaped as \xNN, so a run id read from a file never breaks
-/// the JSON writer.
-std::string DumpJson(const nlohmann::json& j, int indent = 2);
-
-/// Round-trips doubles; NaN/Inf become null so the JSON stays valid.
-nlohmann::json JsonNumber(double v);
-nlohmann::json JsonParams(const RobotParams& p);
-
-/// The contract's evaluation keys: `runs` (per run) and `summary`.
-nlohmann::json JsonEvaluationRuns(const EvaluationSummary& s);
-nlohmann::json JsonEvaluationSummary(const EvaluationSummary& s);
+/// The JSON building blocks of the results (lib/api/json.hpp).
+using api::DumpJson;
+using api::JsonEvaluationRuns;
+using api::JsonEvaluationSummary;
+using api::JsonNumber;
+using api::JsonParams;
 
 /// Inserts "-<tag>" before the extension: ("out.svg", "run1") -> "out-run1.svg".
 /// Used when one flag names an output and several inputs are processed.

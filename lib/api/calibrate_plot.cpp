@@ -1,5 +1,5 @@
 // Plots of a calibration (see calibrate_plot.hpp).
-#include "calibrate_plot.hpp"
+#include "api/calibrate_plot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include "evaluation/run_track.hpp"
 #include "report/svg_plot.hpp"
 
-namespace umbmark::cli {
+namespace umbmark::api {
 
 namespace {
 // cw and ccw differ by marker and fill as well as colour (greyscale-safe).
@@ -212,4 +212,4 @@ std::string CalibrationPlotSvg(const CalibrateInput& input, const CalibrateJobRe
   return io::SvgDocument(width, bottom + 10, parts);
 }
 
-}  // namespace umbmark::cli
+}  // namespace umbmark::api
