@@ -2,185 +2,68 @@
 // model (E_d, E_b, k_L, k_R), which contract effect causes the gap, and how
 // far it shrinks once that effect is modelled (lib/diagnosis/diagnose.hpp).
 // Readable report on stdout, contract JSON with --json, gap bars with --plot.
-#include <algorithm>
-#include <cmath>
+// The computation is the library's api::Diagnose (lib/api/diagnose.hpp):
+// this file binds the flags to its options, prints and draws.
 #include <memory>
-#include <variant>
-#include <optional>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "api/diagnose.hpp"
 #include "commands.hpp"
-#include "diagnosis/design_check.hpp"
-#include "formats/manifest.hpp"
-#include "api/diagnose_report.hpp"
-#include "progress.hpp"
 #include "common.hpp"
 #include "core/errors.hpp"
-#include "evaluation/data_warnings.hpp"
-#include "diagnosis/pieces.hpp"
-#include "diagnosis/diagnose.hpp"
-#include "output/atomic_write.hpp"
-#include "formats/file_text.hpp"
-#include "formats/params_json.hpp"
-#include "report/svg_plot.hpp"
+#include "api/diagnose_report.hpp"
+#include "progress.hpp"
 
 namespace umbmark::cli {
 
 namespace {
 
-struct DiagnoseCliOptions {
-  std::string manifest;
-  diag::DiagnoseOptions diag;
-  std::vector<std::string> effects;
+/// The command line's options: the library's, its output files and the gate.
+struct DiagnoseFlags {
+  api::DiagnoseOptions o;
   std::string plot;
   std::string report;
   bool quality_gate = false;
-  std::string baseline;  ///< --baseline CAL.json
-  bool baseline_other_robot = false;  ///< --baseline-other-robot: take a baseline from another robot
-  std::optional<double> k_L, k_R;
   JsonFlag json;
 };
 
-/// A --baseline whose wheelbase or a wheel diameter differs from the
-/// campaign's recorded one by more than this (relative) is another robot's
-/// (UMBmark corrections of a real robot are a few per cent at most).
-constexpr double kOtherRobotRelative = 0.10;
-
-/// Refuses (InputError, exit 1) a --baseline that belongs to another robot
-/// than the campaign's, unless --baseline-other-robot: its parameters lie
-/// more than kOtherRobotRelative from the campaign's recorded ones, or its
-/// own `recorded_parameters` (the robot file it was calibrated from) differ
-/// from the campaign's while its result is not the campaign's robot either
-/// (a second pass on a compensated robot records the corrected parameters:
-/// accepted).
-void CheckBaselineRobot(const std::string& path, const RobotParams& given, const RobotParams& campaign) {
-  const auto rel = [](double a, double b) { return std::abs(a / b - 1.0); };
-  const auto largest = [&](const RobotParams& a) {
-    return std::max({rel(a.wheelbase_m, campaign.wheelbase_m), rel(a.wheel_diameter_left_m, campaign.wheel_diameter_left_m),
-                     rel(a.wheel_diameter_right_m, campaign.wheel_diameter_right_m)});
-  };
-  const auto describe = [](const RobotParams& p) {
-    return fmt::format("wheelbase {:.6g} m, wheel diameters {:.6g} / {:.6g} m", p.wheelbase_m, p.wheel_diameter_left_m,
-                       p.wheel_diameter_right_m);
-  };
-  const std::string hint = "compare a robot with its own calibration or simulation, or give --baseline-other-robot "
-                           "to compare with this one on purpose";
-  if (largest(given) > kOtherRobotRelative) {
-    throw InputError(path, fmt::format("--baseline is another robot's: its parameters ({}) differ by {:.1f} % from "
-                                       "the campaign's recorded robot ({}), more than the {:.0f} % a calibration "
-                                       "corrects; {}",
-                                       describe(given), 100.0 * largest(given), describe(campaign),
-                                       100.0 * kOtherRobotRelative, hint));
-  }
-  nlohmann::json j = io::ParseJsonDocument(io::ReadWholeFile(path), path);
-  if (j.is_object() && j.contains("results") && j["results"].is_array() && j["results"].size() == 1) j = j["results"][0];
-  if (!j.is_object() || !j.contains("recorded_parameters")) return;  // a hand-written simulation model
-  const nlohmann::json& r = j["recorded_parameters"];
-  RobotParams recorded = campaign;
-  for (auto [key, field] : {std::pair{"wheelbase_m", &recorded.wheelbase_m},
-                            std::pair{"wheel_diameter_left_m", &recorded.wheel_diameter_left_m},
-                            std::pair{"wheel_diameter_right_m", &recorded.wheel_diameter_right_m}}) {
-    if (r.is_object() && r.contains(key) && r[key].is_number()) *field = r[key].get<double>();
-  }
-  constexpr double kSame = 1e-6;
-  if (largest(recorded) <= kSame || largest(given) <= kSame) return;
-  throw InputError(path, fmt::format("--baseline was calibrated from another robot's runs: its recorded_parameters "
-                                     "({}) are not the campaign's recorded robot ({}); {}",
-                                     describe(recorded), describe(campaign), hint));
-}
-
-/// --kl / --kr: both or neither, finite, >= 0, not both 0; only with --baseline.
-void CheckGivenNoise(const DiagnoseCliOptions& o) {
-  if ((o.k_L || o.k_R) && o.baseline.empty())
-    throw InvalidOptions("--kl/--kr give the wheel noise of a model given by --baseline CAL.json; without "
-                         "--baseline the noise is fitted to the runs");
-  if (o.k_L.has_value() != o.k_R.has_value())
-    throw InvalidOptions(fmt::format("{} given without {}: give both wheels' noise k_L and k_R [m^1/2] (or neither, "
-                                     "and it is fitted)",
-                                     o.k_L ? "--kl" : "--kr", o.k_L ? "--kr" : "--kl"));
-  for (const auto& [flag, v] : {std::pair{"--kl", o.k_L}, std::pair{"--kr", o.k_R}})
-    if (v && !(std::isfinite(*v) && *v >= 0.0))
-      throw InvalidOptions(fmt::format("{} = {} must be a finite wheel noise >= 0 [m^1/2]", flag, *v));
-  if (o.k_L && *o.k_L == 0.0 && *o.k_R == 0.0)
-    throw InvalidOptions("--kl and --kr are both 0: a model without wheel noise cannot be compared with real runs");
-}
-
-int RunDiagnose(DiagnoseCliOptions o) {
-  for (const auto& name : o.effects) {
-    const auto k = sim::EffectFromString(name);
-    if (!k) throw InvalidOptions(fmt::format("--effects: unknown effect '{}'", name));
-    o.diag.effects.push_back(*k);
-  }
-  CheckGivenNoise(o);
+int RunDiagnose(DiagnoseFlags f) {
+  if (std::string err = f.o.Check(); !err.empty()) throw InvalidOptions(err);
   io::OutputSet& outs = CommandOutputs();
-  RegisterInputs(o.baseline.empty() ? std::vector<std::string>{o.manifest}
-                                    : std::vector<std::string>{o.manifest, o.baseline});
-  outs.AddOutput("--json", o.json.path);
-  outs.AddOutput("--plot", o.plot);
-  outs.AddOutput("--report", o.report);
+  RegisterInputs(f.o.baseline.empty() ? std::vector<std::string>{f.o.manifest}
+                                      : std::vector<std::string>{f.o.manifest, f.o.baseline});
+  outs.AddOutput("--json", f.json.path);
+  outs.AddOutput("--plot", f.plot);
+  outs.AddOutput("--report", f.report);
   outs.Check();
-  // A design that cannot determine the baseline is refused before fitting.
-  if (const std::string why = diag::CampaignDesignProblem(io::ReadManifest(o.manifest)); !why.empty()) {
-    throw InputError(o.manifest, why);
-  }
-  const diag::CampaignData campaign = diag::LoadCampaign(o.manifest, o.diag.pieces);
-  // Degenerate data (evaluation/data_warnings.hpp), per file: trajectories
-  // and return errors.
-  std::vector<std::string> warnings;
-  for (const auto& file : campaign.files) {
-    if (const auto* t = std::get_if<TrajectoryData>(&file)) {
-      TrajectoryDataCheck check(campaign.robot);
-      for (const auto& run : t->runs) check.Add(run);
-      for (auto& w : check.Warnings(t->path)) warnings.push_back(std::move(w));
-    } else if (const auto* e = std::get_if<EndpointData>(&file)) {
-      EndpointDataCheck check;
-      for (const auto& run : e->runs) check.Add(run);
-      for (auto& w : check.Warnings(e->path)) warnings.push_back(std::move(w));
-    }
-  }
-  if (!o.baseline.empty()) {
-    diag::GivenModel g;
-    g.params = io::ReadParamsJson(o.baseline, campaign.robot);
-    if (!o.baseline_other_robot) CheckBaselineRobot(o.baseline, g.params, campaign.robot);
-    g.source = o.baseline;
-    g.noise_given = o.k_L.has_value();
-    g.k_L = o.k_L.value_or(0.0);
-    g.k_R = o.k_R.value_or(0.0);
-    o.diag.given = g;
-  }
-  const diag::DiagnoseSummary s = [&] {
-    Progress progress(fmt::format("diagnosing {} ({} null simulations)", o.manifest, o.diag.null_simulations));
-    diag::DiagnoseOptions d = o.diag;
-    d.progress = progress.Callback();
-    return diag::Diagnose(campaign, d);
+  const api::DiagnoseResult r = [&] {
+    Progress progress(fmt::format("diagnosing {} ({} null simulations)", f.o.manifest, f.o.diag.null_simulations));
+    f.o.progress = progress.Callback();
+    return api::Diagnose(f.o);
   }();
-  if (o.json.PrintText()) {
-    fmt::print("{}", diag::DiagnoseReport(s));
-    for (const auto& w : warnings) fmt::print("WARNING: {}\n", w);
+  if (f.json.PrintText()) {
+    fmt::print("{}", diag::DiagnoseReport(r.summary));
+    for (const auto& w : r.data_warnings) fmt::print("WARNING: {}\n", w);
   } else {
-    for (const auto& w : warnings) fmt::print(stderr, "warning: {}\n", w);
+    for (const auto& w : r.data_warnings) fmt::print(stderr, "warning: {}\n", w);
   }
-  nlohmann::json j = diag::DiagnoseToJson(s);
-  if (!warnings.empty()) {
-    nlohmann::json all = j.value("warnings", nlohmann::json::array());
-    for (const auto& w : warnings) all.push_back(w);
-    j["warnings"] = all;
-  }
-  j["manifest"] = o.manifest;
+  const nlohmann::json j = api::ToJson(r);
   std::vector<std::string> written;
-  if (!o.plot.empty()) {
-    outs.Write(o.plot, api::DiagnosePlotsSvg(j));
-    written.push_back(o.plot + " (plot)");
+  if (!f.plot.empty()) {
+    outs.Write(f.plot, api::DiagnosePlotsSvg(j));
+    written.push_back(f.plot + " (plot)");
   }
-  if (!o.report.empty()) {
-    outs.Write(o.report, api::DiagnoseReportHtml(j, o.manifest));
-    written.push_back(o.report + " (HTML report)");
+  if (!f.report.empty()) {
+    outs.Write(f.report, api::DiagnoseReportHtml(j, f.o.manifest));
+    written.push_back(f.report + " (HTML report)");
   }
-  o.json.EmitAndListOutputs(j, written);
-  if (o.quality_gate && s.verdict == "unexplained") {
+  f.json.EmitAndListOutputs(j, written);
+  if (f.quality_gate && r.summary.verdict == "unexplained") {
     throw QualityGateError("the campaign leaves the model and no known effect explains the gap");
   }
   return 0;
@@ -189,10 +72,10 @@ int RunDiagnose(DiagnoseCliOptions o) {
 }  // namespace
 
 Command SetupDiagnose(CLI::App& parent) {
-  auto opts = std::make_shared<DiagnoseCliOptions>();
+  auto opts = std::make_shared<DiagnoseFlags>();
   auto* app = parent.add_subcommand("diagnose", "Sim-to-real gap: where it lies, which effect causes it, how far it shrinks");
-  app->add_option("MANIFEST", opts->manifest, "Campaign manifest (TOML)")->required();
-  auto& d = opts->diag;
+  app->add_option("MANIFEST", opts->o.manifest, "Campaign manifest (TOML)")->required();
+  auto& d = opts->o.diag;
   app->add_option("--null-sims", d.null_simulations, "Simulated baseline campaigns for the p-value (default 500)")
       ->check(NumberIn(20, 1000000));
   app->add_option("--alpha", d.alpha, "False-alarm rate of the gap test (default 0.01)")->check(NumberIn(1e-6, 0.5));
@@ -220,7 +103,7 @@ Command SetupDiagnose(CLI::App& parent) {
   app->add_option("--seed", d.seed, "Seed of the null simulations (default 1)")->check(SeedValidator());
   app->add_option("--threads", d.threads, "Threads (default 2)")->check(NumberIn(1, 256));
   app->add_option("--where", d.where_top, "Discrepancies listed under 'where' (default 12)")->check(NonNegative());
-  app->add_option("--effects", opts->effects,
+  app->add_option("--effects", opts->o.effects,
                   "Effects to try, comma-separated (default: the contract's fourteen; with --baseline also its "
                   "parameter errors)")
       ->delimiter(',');
@@ -228,17 +111,17 @@ Command SetupDiagnose(CLI::App& parent) {
                   "SVG: located discrepancies against the model's 95% band, shrink per candidate and of the explanation");
   app->add_option("--report", opts->report, "Write a self-contained HTML report (verdict, next steps, tables, plots)");
   app->add_flag("--fail-unexplained", opts->quality_gate, "Exit 3 when the verdict is 'unexplained'");
-  app->add_option("--baseline", opts->baseline,
+  app->add_option("--baseline", opts->o.baseline,
                   "Compare the runs with your simulation's parameters (a `calibrate` JSON: refined.parameters if "
                   "present) instead of a model fitted to them; also names wheelbase_error and diameter_ratio_error");
-  app->add_flag("--baseline-other-robot", opts->baseline_other_robot,
+  app->add_flag("--baseline-other-robot", opts->o.baseline_other_robot,
                 "Accept a --baseline from another robot (parameters more than 10 % from the campaign's, or "
                 "calibrated from runs recorded with another robot file); refused without it")
       ->needs(app->get_option("--baseline"));
-  app->add_option("--kl", opts->k_L,
+  app->add_option("--kl", opts->o.k_L,
                   "With --baseline: your simulation's left wheel noise k_L [m^1/2] (with --kr; also names "
                   "wheel_noise_error; without them the noise is fitted)");
-  app->add_option("--kr", opts->k_R, "With --baseline: your simulation's right wheel noise k_R [m^1/2] (with --kl)");
+  app->add_option("--kr", opts->o.k_R, "With --baseline: your simulation's right wheel noise k_R [m^1/2] (with --kl)");
   opts->json.Bind(*app);
   return {app, [opts] { return RunDiagnose(*opts); }};
 }
