@@ -88,14 +88,47 @@ std::vector<std::int64_t> Counts(const Columns& c, const char* column) {
   return out;
 }
 
-/// A text column: one string for every sample, or one per sample.
+/// A text column: one string for every sample (a vector of one), or one
+/// per sample (`n`).
 std::vector<std::string> Texts(const Columns& c, const char* column, std::size_t n) {
   const py::object obj = c.dict[column];
-  if (py::isinstance<py::str>(obj) || py::isinstance<py::int_>(obj)) return std::vector<std::string>(n, py::str(obj));
+  if (py::isinstance<py::str>(obj) || py::isinstance<py::int_>(obj)) return {std::string(py::str(obj))};
   std::vector<std::string> out;
   for (const py::handle item : py::iter(obj)) out.push_back(py::str(item));
   if (out.size() != n) Fail(fmt::format("{} has {} values, t_s has {}", c.Cell(column), out.size(), n));
   return out;
+}
+
+/// The run column: one id for all samples, one per sample as text, or one
+/// per sample as an integer array (compared as numbers, named only where a
+/// run starts: a million-sample id column costs no million strings).
+struct RunIds {
+  std::vector<std::string> text;
+  std::vector<std::int64_t> number;
+  std::size_t size() const { return number.empty() ? text.size() : number.size(); }
+  bool Same(std::size_t i, std::size_t j) const {
+    if (!number.empty()) return number[i] == number[j];
+    return text.size() == 1 || text[i] == text[j];
+  }
+  std::string Name(std::size_t i) const {
+    if (!number.empty()) return std::to_string(number[i]);
+    return text.size() == 1 ? text[0] : text[i];
+  }
+};
+
+RunIds ReadRunIds(const Columns& c, std::size_t n) {
+  RunIds ids;
+  const py::object obj = c.dict["run"];
+  if (PyObject_CheckBuffer(obj.ptr())) {
+    const py::buffer_info info = py::reinterpret_borrow<py::buffer>(obj).request();
+    if (info.ndim == 1 && info.itemsize == 8 && (info.format == "l" || info.format == "q")) {
+      ids.number = Counts(c, "run");
+      if (ids.number.size() != n) Fail(fmt::format("{} has {} values, t_s has {}", c.Cell("run"), ids.number.size(), n));
+      return ids;
+    }
+  }
+  ids.text = Texts(c, "run", n);
+  return ids;
 }
 
 /// The numeric columns of one dict, checked for names and equal lengths.
@@ -141,16 +174,18 @@ Samples ReadSamples(const Columns& c) {
 }
 
 /// Samples [begin, end) of `s` as one run, with the CSV reader's checks.
-TrajectoryRun MakeRun(const Columns& c, const Samples& s, std::size_t begin, std::size_t end, std::string id,
+/// The columns are copied in bulk, or moved when the run is all of `s`
+/// (one dict per run): no sample is handled twice.
+TrajectoryRun MakeRun(const Columns& c, Samples& s, std::size_t begin, std::size_t end, std::string id,
                       const std::vector<std::string>& direction) {
   TrajectoryRun r;
   r.run = std::move(id);
-  r.direction = CanonicalDirection(direction[begin]);
+  r.direction = CanonicalDirection(direction.size() > 1 ? direction[begin] : direction[0]);
   const char* gt_names[3] = {"x_gt_m", "y_gt_m", "theta_gt_rad"};
   for (std::size_t i = begin; i < end; ++i) {
-    if (CanonicalDirection(direction[i]) != r.direction)
+    if (direction.size() > 1 && direction[i] != direction[begin] && CanonicalDirection(direction[i]) != r.direction)
       Fail(fmt::format("{}[{}] = '{}' differs from the run's first direction '{}'", c.Cell("direction"), i,
-                       direction[i], r.direction));
+                       direction[i], r.direction));  // (one text: the whole run's)
     if (!std::isfinite(s.t[i])) Fail(fmt::format("{}[{}] = {} is not a finite number", c.Cell("t_s"), i, s.t[i]));
     if (i > begin && !(s.t[i] > s.t[i - 1]))
       Fail(fmt::format("{}[{}] = {} does not increase (sample {} of run {} has {})", c.Cell("t_s"), i, s.t[i], i - 1,
@@ -164,16 +199,12 @@ TrajectoryRun MakeRun(const Columns& c, const Samples& s, std::size_t begin, std
           Fail(fmt::format("{}[{}] jumps from {} to {} ticks: counter wrap-around?",
                            c.Cell(v == &s.ticks_left ? "ticks_left" : "ticks_right"), i, a, b));
       }
-      r.ticks_left.push_back(s.ticks_left[i]);
-      r.ticks_right.push_back(s.ticks_right[i]);
     } else {
       for (const auto* v : {&s.left, &s.right}) {
         if (!std::isfinite((*v)[i]))
           Fail(fmt::format("{}[{}] = {} is not a finite number",
                            c.Cell(v == &s.left ? "dist_left_m" : "dist_right_m"), i, (*v)[i]));
       }
-      r.dist_left_m.push_back(s.left[i]);
-      r.dist_right_m.push_back(s.right[i]);
     }
     int given = 0;
     for (int k = 0; k < 3; ++k) {
@@ -186,12 +217,28 @@ TrajectoryRun MakeRun(const Columns& c, const Samples& s, std::size_t begin, std
     if (given == 0 && (i == begin || i + 1 == end))
       Fail(fmt::format("{} run {} has no ground truth at its {} sample ({}; each run needs x_gt_m, y_gt_m, "
                        "theta_gt_rad at its first and last sample)", c.where, r.run, i == begin ? "first" : "last", i));
-    r.t_s.push_back(s.t[i]);
-    r.gt_x_m.push_back(s.gt[0][i]);
-    r.gt_y_m.push_back(s.gt[1][i]);
-    r.gt_theta_rad.push_back(s.gt[2][i]);
-    r.lines.push_back(i + 1);  // 1-based sample number
   }
+  const bool all = begin == 0 && end == s.size();
+  auto take = [&](auto& from, auto& to) {
+    if (all) {
+      to = std::move(from);
+    } else {
+      to.assign(from.begin() + static_cast<std::ptrdiff_t>(begin), from.begin() + static_cast<std::ptrdiff_t>(end));
+    }
+  };
+  take(s.t, r.t_s);
+  if (s.ticks) {
+    take(s.ticks_left, r.ticks_left);
+    take(s.ticks_right, r.ticks_right);
+  } else {
+    take(s.left, r.dist_left_m);
+    take(s.right, r.dist_right_m);
+  }
+  take(s.gt[0], r.gt_x_m);
+  take(s.gt[1], r.gt_y_m);
+  take(s.gt[2], r.gt_theta_rad);
+  r.lines.resize(end - begin);
+  for (std::size_t i = begin; i < end; ++i) r.lines[i - begin] = i + 1;  // 1-based sample number
   return r;
 }
 
@@ -219,12 +266,13 @@ TrajectoryData TrajectoryFromArrays(const py::handle& runs) {
     const Columns c = AsColumns(runs, "runs");
     if (!c.Has("run")) Fail("runs: one dict of columns needs a 'run' column (or give a list of dicts, one per run)");
     if (!c.Has("direction")) Fail("runs has no column 'direction'");
-    const Samples s = ReadSamples(c);
-    const std::vector<std::string> ids = Texts(c, "run", s.size()), dirs = Texts(c, "direction", s.size());
+    Samples s = ReadSamples(c);
+    const RunIds ids = ReadRunIds(c, s.size());
+    const std::vector<std::string> dirs = Texts(c, "direction", s.size());
     for (std::size_t begin = 0; begin < s.size();) {
       std::size_t end = begin + 1;
-      while (end < s.size() && ids[end] == ids[begin]) ++end;
-      add(MakeRun(c, s, begin, end, ids[begin], dirs), fmt::format("runs['run'][{}]", begin));
+      while (end < s.size() && ids.Same(end, begin)) ++end;
+      add(MakeRun(c, s, begin, end, ids.Name(begin), dirs), fmt::format("runs['run'][{}]", begin));
       begin = end;
     }
     return data;
@@ -236,16 +284,16 @@ TrajectoryData TrajectoryFromArrays(const py::handle& runs) {
   for (std::size_t i = 0; i < list.size(); ++i) {
     const Columns c = AsColumns(list[i], fmt::format("runs[{}]", i));
     if (!c.Has("direction")) Fail(fmt::format("{} has no column 'direction' (cw or ccw for squares)", c.where));
-    const Samples s = ReadSamples(c);
+    Samples s = ReadSamples(c);
     const std::vector<std::string> dirs = Texts(c, "direction", s.size());
     std::string id = std::to_string(i + 1);
     if (c.Has("run")) {
-      const std::vector<std::string> ids = Texts(c, "run", s.size());
+      const RunIds ids = ReadRunIds(c, s.size());
       for (std::size_t k = 1; k < ids.size(); ++k)
-        if (ids[k] != ids[0])
-          Fail(fmt::format("{}['run'][{}] = '{}' differs from '{}': one dict holds one run", c.where, k, ids[k],
-                           ids[0]));
-      id = ids[0];
+        if (!ids.Same(k, 0))
+          Fail(fmt::format("{}['run'][{}] = '{}' differs from '{}': one dict holds one run", c.where, k, ids.Name(k),
+                           ids.Name(0)));
+      id = ids.Name(0);
     }
     add(MakeRun(c, s, 0, s.size(), std::move(id), dirs), c.where);
   }

@@ -1,13 +1,15 @@
 // The Python module `umbmark` (docs/python.md): one function per command,
 // named as the command with `-` as `_` (`import optiodom` ->
 // import_optiodom), positional inputs as the command's, options as keyword
-// arguments named as the long options. Each runs the `umbmark` executable
-// with `--json -` (the same parsing, checks, computation and JSON as the
-// command line, in a process of its own) and returns a Result whose
-// to_dict() is that JSON; a failure raises InputError (exit 1), UsageError
-// (2) or QualityGateError (3) with the command's message. Trajectory arrays
-// (`runs=`) are checked here, with messages naming the array cell, and
-// handed over as a temporary trajectory CSV.
+// arguments named as the long options. Each returns a Result whose
+// to_dict() is the command's JSON; a failure raises InputError (exit 1),
+// UsageError (2) or QualityGateError (3) with the command's message.
+// `calibrate` runs in this process over the library (calibrate.hpp:
+// api::Calibrate, trajectory arrays handed over in memory). The others
+// still run the `umbmark` executable with `--json -` (the same parsing,
+// checks, computation and JSON as the command line, in a process of its
+// own); their trajectory arrays (`runs=`) are checked here, with messages
+// naming the array cell, and handed over as a temporary trajectory CSV.
 #include <dlfcn.h>
 #include <poll.h>
 #include <spawn.h>
@@ -19,14 +21,18 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include <glog/logging.h>
 #include <pybind11/pybind11.h>
 
 #include "arrays.hpp"
+#include "inprocess.hpp"
+#include "result.hpp"
 #include "core/errors.hpp"
 #include "umbmark/version.hpp"
 
@@ -35,24 +41,26 @@ extern char** environ;
 namespace py = pybind11;
 
 namespace umbmark::python {
-namespace {
 
-/// A command's result: its JSON text, parsed on demand.
-struct Result {
-  std::string command;
-  std::string json;
+[[noreturn]] void Raise(int status, const std::string& message, const std::optional<std::string>& json,
+                        const std::string& command) {
+  const Errors& e = ErrorClasses();
+  const py::object cls = status == 2 ? e.usage : status == 3 ? e.quality_gate : e.input;
+  py::object error = cls(message);
+  error.attr("exit_status") = status;
+  // A batch that failed in part still has its JSON (per input: result or error).
+  error.attr("result") = json ? py::cast(Result{command, *json}) : py::none();
+  PyErr_SetObject(cls.ptr(), error.ptr());
+  throw py::error_already_set();
+}
 
-  py::object ToDict() const { return py::module_::import("json").attr("loads")(json); }
-};
 
-/// The exception classes, created once at import.
-struct Errors {
-  py::object base, input, usage, quality_gate;
-};
 Errors& ErrorClasses() {
   static Errors e;
   return e;
 }
+
+namespace {
 
 /// The umbmark executable: $UMBMARK_EXE, else the one beside this module
 /// (the build tree), else the installed one, else `umbmark` on PATH.
@@ -171,18 +179,6 @@ std::string FailureMessage(const std::string& err) {
   return message.empty() ? std::string("umbmark: the command failed and said nothing on stderr") : message;
 }
 
-[[noreturn]] void Raise(int status, const std::string& message, const std::optional<std::string>& json,
-                        const std::string& command) {
-  const Errors& e = ErrorClasses();
-  const py::object cls = status == 2 ? e.usage : status == 3 ? e.quality_gate : e.input;
-  py::object error = cls(message);
-  error.attr("exit_status") = status;
-  // A batch that failed in part still has its JSON (per input: result or error).
-  error.attr("result") = json ? py::cast(Result{command, *json}) : py::none();
-  PyErr_SetObject(cls.ptr(), error.ptr());
-  throw py::error_already_set();
-}
-
 /// The arrays of `runs=` in a temporary folder, removed with this object.
 struct TemporaryRuns {
   std::filesystem::path dir, csv;
@@ -245,8 +241,37 @@ Result Run(const std::vector<std::string>& words, const py::args& inputs, const 
   return {command, *json};
 }
 
+/// The commands of the contract (docs/formats.md), as command-line words.
+const std::vector<std::vector<std::string>>& Commands() {
+  static const std::vector<std::vector<std::string>> commands = {
+      {"calibrate"}, {"evaluate"}, {"fit-noise"}, {"predict"}, {"simulate"}, {"diagnose"}, {"summarize"},
+      {"import", "optiodom"}, {"import", "rosbag2"}, {"plan"}, {"calibrate-lidar"}};
+  return commands;
+}
+
+using InProcessFunction = Result (*)(const py::args&, const py::kwargs&);
+
+/// The functions that run in this process (inprocess.hpp), else null.
+const InProcessFunction* InProcess(const std::string& name) {
+  static const std::map<std::string, InProcessFunction> functions = {{"calibrate", &CalibrateInProcess},
+                                                                     {"predict", &PredictInProcess},
+                                                                     {"simulate", &SimulateInProcess},
+                                                                     {"diagnose", &DiagnoseInProcess}};
+  const auto it = functions.find(name);
+  return it == functions.end() ? nullptr : &it->second;
+}
+
+std::string FunctionName(const std::vector<std::string>& words) {
+  std::string name;
+  for (const auto& w : words) name += (name.empty() ? "" : "_") + w;
+  for (char& c : name) c = c == '-' ? '_' : c;
+  return name;
+}
+
+}  // namespace
+
 /// Translates the errors Run() raises before the command runs.
-Result RunChecked(const std::vector<std::string>& words, const py::args& inputs, const py::kwargs& options) {
+Result RunExecutable(const std::vector<std::string>& words, const py::args& inputs, const py::kwargs& options) {
   std::string command;
   for (const auto& w : words) command += (command.empty() ? "" : " ") + w;
   try {
@@ -258,22 +283,6 @@ Result RunChecked(const std::vector<std::string>& words, const py::args& inputs,
   }
 }
 
-/// The commands of the contract (docs/formats.md), as command-line words.
-const std::vector<std::vector<std::string>>& Commands() {
-  static const std::vector<std::vector<std::string>> commands = {
-      {"calibrate"}, {"evaluate"}, {"fit-noise"}, {"predict"}, {"simulate"}, {"diagnose"}, {"summarize"},
-      {"import", "optiodom"}, {"import", "rosbag2"}, {"plan"}, {"calibrate-lidar"}};
-  return commands;
-}
-
-std::string FunctionName(const std::vector<std::string>& words) {
-  std::string name;
-  for (const auto& w : words) name += (name.empty() ? "" : "_") + w;
-  for (char& c : name) c = c == '-' ? '_' : c;
-  return name;
-}
-
-}  // namespace
 }  // namespace umbmark::python
 
 PYBIND11_MODULE(umbmark, m) {
@@ -281,6 +290,9 @@ PYBIND11_MODULE(umbmark, m) {
   m.doc() = "umbmark: odometry calibration and sim-to-real diagnosis for differential-drive robots. One function "
             "per command (docs/python.md); each returns a Result whose to_dict() is the command's JSON.";
   m.attr("__version__") = umbmark::kVersion;
+  // Ceres (the refined fit, in this process for the in-process functions)
+  // logs through glog; its warnings would interleave with the caller's output.
+  FLAGS_minloglevel = google::GLOG_FATAL;
 
   Errors& e = ErrorClasses();
   e.base = py::reinterpret_steal<py::object>(PyErr_NewExceptionWithDoc(
@@ -315,10 +327,21 @@ PYBIND11_MODULE(umbmark, m) {
   py::list names;
   for (const auto& words : Commands()) {
     const std::string name = FunctionName(words);
+    if (const auto* f = InProcess(name)) {
+      m.def(name.c_str(), *f,
+            ("Runs `umbmark " + name + "` in this process (umbmark's library, lib/api): the same as the command "
+             "with `--json -` (`umbmark help " + name + "` lists the options). Positional arguments are the "
+             "command's inputs; options are keyword arguments named as the long options with '-' as '_' (True for "
+             "a flag); `runs=` gives trajectories as arrays, without a file (docs/python.md). Returns a Result "
+             "whose to_dict() is the command's JSON.")
+                .c_str());
+      names.append(name);
+      continue;
+    }
     std::string command;
     for (const auto& w : words) command += (command.empty() ? "" : " ") + w;
     m.def(
-        name.c_str(), [words](const py::args& a, const py::kwargs& k) { return RunChecked(words, a, k); },
+        name.c_str(), [words](const py::args& a, const py::kwargs& k) { return RunExecutable(words, a, k); },
         ("Runs `umbmark " + command + "` and returns its JSON as a Result (`umbmark help " + command +
          "` lists the options). Positional arguments are the command's inputs; options are keyword arguments named "
          "as the long options with '-' as '_' (True for a flag); `runs=` gives trajectories as arrays "

@@ -37,10 +37,15 @@ if ls "$BUILD_DIR"/umbmark.cpython-*.so >/dev/null 2>&1; then
   test -n "$pydeb" || { echo "check_install: no python3-umbmark .deb"; exit 1; }
   dpkg-deb --info "$pydeb" | grep -E '^ (Package|Version|Depends):'
   dpkg-deb -x "$pydeb" "$tmp/pyroot"
-  # The module runs the umbmark binary of the package umbmark (unpacked above).
-  UMBMARK_EXE="$tmp/debroot/usr/bin/umbmark" PYTHONPATH="$tmp/pyroot/usr/lib/python3/dist-packages" /usr/bin/python3 -c 'import sys, umbmark
+  # calibrate runs in the module's own process (the library is linked in):
+  # no executable needed. The other functions run the umbmark binary of the
+  # package umbmark (unpacked above).
+  UMBMARK_EXE=/nonexistent/umbmark PYTHONPATH="$tmp/pyroot/usr/lib/python3/dist-packages" /usr/bin/python3 -c 'import sys, umbmark
 assert umbmark.__file__.startswith(sys.argv[1]), umbmark.__file__
 r = umbmark.calibrate("data/examples/endpoints.csv", robot="data/examples/robot.toml", side=0.75, no_heldout=True)
-print("python3-umbmark", umbmark.__version__, "E_d =", r.E_d)' "$tmp/pyroot"
+print("python3-umbmark", umbmark.__version__, "in-process calibrate: E_d =", r.E_d)' "$tmp/pyroot"
+  UMBMARK_EXE="$tmp/debroot/usr/bin/umbmark" PYTHONPATH="$tmp/pyroot/usr/lib/python3/dist-packages" /usr/bin/python3 -c 'import umbmark
+r = umbmark.evaluate("data/examples/square_ticks.csv", robot="data/examples/robot.toml")
+print("python3-umbmark: evaluate through", umbmark.executable, "runs", r.summary["runs"])'
 fi
 echo "install: CMake package, pkg-config and .deb OK"

@@ -127,7 +127,24 @@ def test_usage_error_has_the_commands_message():
     assert status == 2
     with pytest.raises(umbmark.UsageError) as e:
         umbmark.calibrate(EXAMPLES / "endpoints.csv", robot=ROBOT, side=-1)
-    assert str(e.value) == err.strip()
+    # The command line's message; its second line ("Run with --help ...") is
+    # the command line's hint, not part of the message.
+    assert str(e.value) == err.strip().splitlines()[0] == "--side: must be a finite number > 0 (got '-1')"
+    # A value outside the plausible range: the same check as the flag's.
+    status, _, err = run_cli("calibrate", EXAMPLES / "endpoints.csv", "--robot", ROBOT, "--side", "750")
+    with pytest.raises(umbmark.UsageError) as e:
+        umbmark.calibrate(EXAMPLES / "endpoints.csv", robot=ROBOT, side=750)
+    assert status == 2 and str(e.value) == err.strip().splitlines()[0]
+    status, _, err = run_cli("calibrate", EXAMPLES / "endpoints.csv", "--robot", ROBOT, "--side", "1",
+                             "--estimator", "z")
+    with pytest.raises(umbmark.UsageError) as e:
+        umbmark.calibrate(EXAMPLES / "endpoints.csv", robot=ROBOT, side=1, estimator="z")
+    assert status == 2 and str(e.value) == err.strip().splitlines()[0]
+    # Errors the command raises after parsing: exactly its stderr.
+    status, _, err = run_cli("calibrate", EXAMPLES / "endpoints.csv", "--side", "1")
+    with pytest.raises(umbmark.UsageError) as e:
+        umbmark.calibrate(EXAMPLES / "endpoints.csv", side=1)
+    assert status == 2 and str(e.value) == err.strip()
     with pytest.raises(umbmark.UsageError, match="--no-such-option"):
         umbmark.calibrate(EXAMPLES / "endpoints.csv", no_such_option=1)
 
@@ -205,3 +222,116 @@ def test_numbers_reach_the_command_exactly():
     side = 0.1 + 0.2
     r = umbmark.calibrate(EXAMPLES / "endpoints.csv", robot=ROBOT, side=side, no_heldout=True)
     assert r.side_m == side
+
+
+def test_in_process_functions_need_no_executable(monkeypatch, tmp_path):
+    # No executable to run: calibrate, predict, simulate and diagnose run in
+    # this process (the other functions still run it: they fail here).
+    monkeypatch.setenv("UMBMARK_EXE", "/nonexistent/umbmark")
+    r = umbmark.calibrate(EXAMPLES / "endpoints.csv", robot=ROBOT, side=0.75, no_heldout=True)
+    assert r.recommended == "skipped" and r.command == "calibrate"
+    # Straight line of length D: var(x) = (k_L^2 + k_R^2) D / 4 (the mean of the two wheels' travel).
+    assert math.isclose(umbmark.predict(robot=ROBOT, kl=1e-3, kr=1e-3, path="line:1").covariance[0][0], 2e-6 / 4,
+                        rel_tol=1e-9)
+    s = umbmark.simulate(EXAMPLES / "simulate.toml", out=tmp_path / "c", seed=2, square_runs=2)
+    assert (tmp_path / "c" / "campaign.toml").exists() and s.seed == 2
+    d = umbmark.diagnose(tmp_path / "c" / "campaign.toml", null_sims=20, seed=1, threads=1)
+    assert d.manifest == str(tmp_path / "c" / "campaign.toml")
+    with pytest.raises(umbmark.InputError, match="cannot run the umbmark executable"):
+        umbmark.evaluate(EXAMPLES / "square_ticks.csv", robot=ROBOT)
+
+
+def test_in_process_usage_errors_name_the_flag():
+    with pytest.raises(umbmark.UsageError, match="--kl is required"):
+        umbmark.predict(robot=ROBOT, kr=1e-3, path="line:1")
+    with pytest.raises(umbmark.UsageError, match=r"--seed: the seed must be a whole number .* \(got '-1'\)"):
+        umbmark.predict(robot=ROBOT, kl=1e-3, kr=1e-3, path="line:1", monte_carlo=100, seed=-1)
+    with pytest.raises(umbmark.UsageError, match="--null-sims: must be a number from 20"):
+        umbmark.diagnose(EXAMPLES / "diagnose.toml", null_sims=5)
+    with pytest.raises(umbmark.UsageError, match="--effects: unknown effect 'warp'"):
+        umbmark.diagnose(EXAMPLES / "diagnose.toml", effects="turn_scrub,warp")
+    with pytest.raises(umbmark.UsageError, match="--E-d: must be a number from 0.5 to 2"):
+        umbmark.simulate(EXAMPLES / "simulate.toml", out="x", E_d=3)
+
+
+def test_calibrate_releases_the_gil():
+    # Another Python thread runs while the refined fit of the bundled
+    # campaign computes: with the GIL held it could not take one step.
+    import threading
+    steps, done = [0], threading.Event()
+
+    def count():
+        while not done.is_set():
+            steps[0] += 1
+
+    t = threading.Thread(target=count)
+    t.start()
+    try:
+        before = steps[0]
+        umbmark.calibrate(EXAMPLES / "calibrate.toml", refine=True)
+        during = steps[0] - before
+    finally:
+        done.set()
+        t.join()
+    assert during > 0
+
+
+def test_calibrate_from_arrays_equals_the_cli():
+    np = pytest.importorskip("numpy")
+    path = EXAMPLES / "square_ticks.csv"
+    runs = [{k: (np.asarray(v) if isinstance(v, list) else v) for k, v in r.items()} for r in read_runs(path)]
+    for r in runs:
+        r["ticks_left"] = r["ticks_left"].astype(np.int64)
+        r["ticks_right"] = r["ticks_right"].astype(np.int64)
+    a = umbmark.calibrate(runs=runs, robot=ROBOT, side=1.0, refine=True).to_dict()
+    cli = cli_json("calibrate", path, "--robot", ROBOT, "--side", "1", "--refine")
+    assert a["input"] == "<runs>" and a["experiments"] == ["<runs>"]
+    assert_same(json.loads(json.dumps(a).replace("<runs>", str(path))), cli)
+
+
+def test_calibrate_from_one_table_with_an_integer_run_column_equals_the_cli():
+    np = pytest.importorskip("numpy")
+    path = EXAMPLES / "square_ticks.csv"
+    runs = read_runs(path)
+    assert all(r["run"].isdigit() for r in runs)
+    table = {k: [] for k in runs[0]}
+    for r in runs:
+        n = len(r["t_s"])
+        for k in table:
+            table[k] += r[k] if isinstance(r[k], list) else [r[k]] * n
+    table = {k: np.asarray(v) for k, v in table.items()}
+    table["run"] = table["run"].astype(np.int64)
+    for k in ("ticks_left", "ticks_right"):
+        table[k] = table[k].astype(np.int64)
+    a = umbmark.calibrate(runs=table, robot=ROBOT, side=1.0).to_dict()
+    cli = cli_json("calibrate", path, "--robot", ROBOT, "--side", "1")
+    assert_same(json.loads(json.dumps(a).replace("<runs>", str(path))), cli)
+
+
+def test_calibrate_writes_the_files_the_command_writes(tmp_path):
+    a, b = tmp_path / "a", tmp_path / "b"
+    a.mkdir()
+    b.mkdir()
+    r = umbmark.calibrate(EXAMPLES / "calibrate.toml", ros2=a / "robot.yaml", plot=a / "plot.svg",
+                          report=a / "report.html")
+    status, _, err = run_cli("calibrate", EXAMPLES / "calibrate.toml", "--ros2", b / "robot.yaml", "--plot",
+                             b / "plot.svg", "--report", b / "report.html")
+    assert status == 0, err
+    for name in ("robot.yaml", "plot.svg", "report.html"):
+        assert (a / name).read_text() == (b / name).read_text(), name
+    assert f"{r.outputs_use['method']}" in (a / "robot.yaml").read_text()
+    # An output that is an input is refused before anything is written.
+    with pytest.raises(umbmark.UsageError, match="--ros2"):
+        umbmark.calibrate(EXAMPLES / "calibrate.toml", ros2=EXAMPLES / "calibrate.toml")
+
+
+def test_batch_with_a_bad_input_raises_with_the_result():
+    bad = SOURCE / "tests" / "data" / "bad" / "ep_nan.csv"
+    args = [EXAMPLES / "endpoints.csv", bad]
+    status, out, err = run_cli("calibrate", *args, "--robot", ROBOT, "--side", "0.75", "--no-heldout", "--json", "-")
+    assert status == 1
+    with pytest.raises(umbmark.InputError) as e:
+        umbmark.calibrate(*args, robot=ROBOT, side=0.75, no_heldout=True)
+    assert e.value.exit_status == 1 and str(bad) in str(e.value)
+    assert str(e.value) in err
+    assert_same(e.value.result.to_dict(), json.loads(out))
