@@ -44,6 +44,19 @@ int main(int argc, char** argv) {
   std::printf("api::Calibrate: E_d = %.5f, E_b = %.5f (JSON E_d %.5f)\n", unit.E_d, unit.E_b, j["E_d"].get<double>());
   const bool api_ok = !r.batch && std::abs(unit.E_d - 1.004) < 5e-4 && std::abs(unit.E_b - 0.99) < 5e-3 &&
                       j["E_d"].get<double>() == unit.E_d && j["parameters"]["wheelbase_m"] == unit.parameters.wheelbase_m;
-  std::printf("%s\n", ok && api_ok ? "consumer: OK" : "consumer: WRONG ESTIMATE");
-  return ok && api_ok ? 0 : 1;
+  // predict as one call: a straight line of 2 m, var(theta) = (k_L^2 + k_R^2) D / b^2 (Chong & Kleeman).
+  api::PredictOptions p;
+  p.robot.wheelbase_m = robot.wheelbase_m;
+  p.robot.diameter_left_m = robot.wheel_diameter_left_m;
+  p.robot.diameter_right_m = robot.wheel_diameter_right_m;
+  p.k_L = 1e-3;
+  p.k_R = 2e-3;
+  p.path = "line:2";
+  const api::PredictResult pr = api::Predict(p);
+  const double var_theta = (1e-6 + 4e-6) * 2.0 / (0.34 * 0.34);
+  std::printf("api::Predict: var(theta) = %.6e (closed form %.6e)\n", pr.covariance(2, 2), var_theta);
+  const bool predict_ok = std::abs(pr.covariance(2, 2) / var_theta - 1.0) < 1e-9;
+  const bool all = ok && api_ok && predict_ok;
+  std::printf("%s\n", all ? "consumer: OK" : "consumer: WRONG ESTIMATE");
+  return all ? 0 : 1;
 }
