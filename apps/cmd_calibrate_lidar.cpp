@@ -63,6 +63,7 @@ nlohmann::json ToJson(const calibration::LidarCalibration& r, const io::rosbag2:
   j["scan_time_offset_s_ci95"] = Interval(r.time_offset_ci95);
   j["gyro_scale"] = r.gyro_scale ? JsonNumber(*r.gyro_scale) : nlohmann::json(nullptr);
   j["gyro_bias_rad_s"] = r.gyro_bias_rad_s ? JsonNumber(*r.gyro_bias_rad_s) : nlohmann::json(nullptr);
+  j["gyro_time_offset_s"] = r.gyro_time_offset_s ? JsonNumber(*r.gyro_time_offset_s) : nlohmann::json(nullptr);
   const std::size_t n = r.covariance_order.size();
   nlohmann::json cov = nlohmann::json::array();
   for (std::size_t i = 0; i < n; ++i) {
@@ -139,6 +140,9 @@ void PrintText(const calibration::LidarCalibration& r) {
   if (r.gyro_scale)
     fmt::print("  gyro                scale {:.5f} +- {:.5f}, bias {:+.5f} +- {:.5f} rad/s\n", *r.gyro_scale, 1.96 * r.gyro_scale_sd,
                *r.gyro_bias_rad_s, 1.96 * r.gyro_bias_sd);
+  if (r.gyro_time_offset_s)
+    fmt::print("  gyro clock offset   {:+.4f} +- {:.4f} s (stamp minus the motion's time)\n", *r.gyro_time_offset_s,
+               1.96 * r.gyro_time_offset_sd);
   fmt::print("  overall scale from  {}\n", r.scale_source == "distance_m" ? "the measured distance (--distance-m)"
                                                                            : "the lidar's ranges (--distance-m D to set it)");
   for (const auto& e : r.excitation)

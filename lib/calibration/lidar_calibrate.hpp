@@ -8,7 +8,7 @@
 //      (scans against wheels, and the gyro against both);
 //   3. start values from the linear (Censi) step, then the joint fit
 //      (lidar_joint.hpp);
-//   4. the gyro's scale and bias against the fitted heading changes;
+//   4. the gyro's scale, bias and time offset against the heading changes;
 //   5. the overall scale from the lidar's ranges, or from a measured
 //      distance;
 //   6. per parameter, whether the drive excited it, and what to drive.
@@ -68,6 +68,9 @@ struct LidarCalibrationOptions {
   double target_wheelbase_rel = 0.003, target_diameter_rel = 0.002, target_position_m = 0.005;
   double target_yaw_rad = Deg2Rad(0.1), target_offset_s = 0.005, target_gyro_scale_rel = 0.003;
   double weak_factor = 20.0;       ///< a half-width up to this times the target is weak
+  /// Fit the gyro's time offset with its scale and bias (lidar_calibrate.cpp,
+  /// FitGyro); false fits scale and bias alone (for comparison).
+  bool gyro_time_offset = true;
   /// Empty when valid, else a message naming the bad field.
   std::string Validate() const;
 };
@@ -82,6 +85,10 @@ struct LidarCalibration {
   std::array<double, 2> time_offset_ci95{};
   std::optional<double> gyro_scale, gyro_bias_rad_s;
   double gyro_scale_sd = 0.0, gyro_bias_sd = 0.0;
+  /// The gyro's stamp minus the time of the motion it measures [s] (fitted
+  /// with its scale and bias; absent when the drive's rate never changes).
+  std::optional<double> gyro_time_offset_s;
+  double gyro_time_offset_sd = 0.0;
   /// Covariance over covariance_order (row-major): wheelbase_m,
   /// wheel_diameter_left_m, wheel_diameter_right_m, mount x_m, y_m, yaw_rad,
   /// scan_time_offset_s, then gyro_scale, gyro_bias_rad_s with a gyro.

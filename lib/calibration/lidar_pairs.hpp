@@ -9,7 +9,9 @@
 //
 //     keyframe a  --lidar_a_T_lidar_b-->  keyframe b      (scan frames as recorded)
 //
-// with its covariance (residual variance times (J^T J)^-1). A measurement the
+// with its covariance (residual variance times (J^T J)^-1). The measurement
+// is the mean of the registration both ways (b onto a, a onto b), which
+// cancels most of the bias of point-to-line ICP towards its model. A measurement the
 // scene does not determine (a corridor's length) is kept, marked with the
 // direction it leaves open, in the room's frame (the first scan's), so the
 // caller can drop it and name the direction.
@@ -55,6 +57,10 @@ struct PairOptions {
   double min_paired_fraction = 0.6;  ///< or when fewer of the scan's points pair
   double max_dilution = 5.0;         ///< registration dilution of precision above which a direction is open
   std::size_t min_points = 30;       ///< a registration with fewer pairs is lost (tracking restarts)
+  /// Each measurement the mean of the registration both ways (b onto a and
+  /// a onto b): cancels most of point-to-line ICP's bias towards its model
+  /// (lidar_pairs.cpp, Symmetrised). Costs one registration per keyframe.
+  bool symmetric = true;
   scan::MatchOptions match;
   /// Empty when valid, else a message naming the bad field.
   std::string Validate() const;

@@ -9,7 +9,9 @@
 // Written with the independent writers: MCAP by @mcap/core, CDR by
 // @foxglove/rosmsg2-serialization, zstd chunks by @foxglove/wasm-zstd.
 //   node drive_gen.mjs [OUTDIR]     (default ../lidar; CI never runs this)
-// The truth of each recording is in OUTDIR/README-truth.json.
+// The truth of each recording is in OUTDIR/README-truth.json. drive_odom.mcap
+// adds the controller's /odom (nav_msgs/Odometry) and a lidar whose ranges
+// read 1 % long, for --odometry and --distance-m.
 import fs from "node:fs";
 import path from "node:path";
 import { McapWriter } from "@mcap/core";
@@ -56,6 +58,31 @@ geometry_msgs/Quaternion rotation
 ${VEC}
 ${QUAT}
 ${HEADER}`,
+  "nav_msgs/msg/Odometry": `std_msgs/Header header\nstring child_frame_id\ngeometry_msgs/PoseWithCovariance pose
+geometry_msgs/TwistWithCovariance twist\n${HEADER}
+================================================================================
+MSG: geometry_msgs/PoseWithCovariance
+geometry_msgs/Pose pose
+float64[36] covariance
+================================================================================
+MSG: geometry_msgs/Pose
+geometry_msgs/Point position
+geometry_msgs/Quaternion orientation
+================================================================================
+MSG: geometry_msgs/Point
+float64 x
+float64 y
+float64 z
+${QUAT}
+================================================================================
+MSG: geometry_msgs/TwistWithCovariance
+geometry_msgs/Twist twist
+float64[36] covariance
+================================================================================
+MSG: geometry_msgs/Twist
+geometry_msgs/Vector3 linear
+geometry_msgs/Vector3 angular
+${VEC}`,
 };
 const writers = {};
 for (const [type, def] of Object.entries(DEFS)) writers[type] = new MessageWriter(parse(def, { ros2: true }));
@@ -202,6 +229,12 @@ function laserScan(ns, frame, lidar, ranges) {
     ranges: Float32Array.from(ranges), intensities: new Float32Array(0) });
 }
 const zeros9 = new Array(9).fill(0);
+const zeros36 = new Array(36).fill(0);
+function odometry(ns, [x, y, th]) {
+  return encode("nav_msgs/msg/Odometry", { header: { stamp: stamp(ns), frame_id: "odom" }, child_frame_id: "base_footprint",
+    pose: { pose: { position: { x, y, z: 0 }, orientation: quatRpy(0, th) }, covariance: zeros36 },
+    twist: { twist: { linear: { x: 0, y: 0, z: 0 }, angular: { x: 0, y: 0, z: 0 } }, covariance: zeros36 } });
+}
 function imu(ns, rate) {
   return encode("sensor_msgs/msg/Imu", { header: { stamp: stamp(ns), frame_id: "imu_link" },
     orientation: { x: 0, y: 0, z: 0, w: 1 }, orientation_covariance: [-1, 0, 0, 0, 0, 0, 0, 0, 0],
@@ -225,8 +258,18 @@ function recording(cfg) {
   const [mx, my, myaw] = cfg.mount;
   const lidar = cfg.lidar;
   msgs.push({ topic: cfg.tfTopic, log: at(0), data: tfStatic(at(0), "laser", cfg.tfMount, cfg.upsideDown ? Math.PI : 0) });
+  // The controller's odometry (nominal radius 0.033 m and wheelbase 0.28 m,
+  // midpoint integration of the joint positions at 50 Hz), when asked for.
+  let odom = [0, 0, 0], prevL = 0, prevR = 0;
   states.forEach((s, ms) => {
     if (ms % 20 === 0) msgs.push({ topic: "/joint_states", log: at(ms) + 1000000n, data: jointState(at(ms), s.phiL, s.phiR) });
+    if (cfg.odom && ms % 20 === 0) {
+      const dl = 0.033 * (s.phiL - prevL), dr = 0.033 * (s.phiR - prevR), ds = (dl + dr) / 2, dth = (dr - dl) / 0.28;
+      odom = [odom[0] + ds * Math.cos(odom[2] + dth / 2), odom[1] + ds * Math.sin(odom[2] + dth / 2), odom[2] + dth];
+      prevL = s.phiL;
+      prevR = s.phiR;
+      msgs.push({ topic: "/odom", log: at(ms) + 1200000n, data: odometry(at(ms), odom) });
+    }
     if (ms % 10 === 3) {  // 100 Hz gyro: the mean rate over its 10 ms sample
       const wm = ms >= 10 ? (s.th - states[ms - 10].th) / 0.01 : 0;
       msgs.push({ topic: "/imu", log: at(ms) + 500000n, data: imu(at(ms), cfg.imu.scale * wm + cfg.imu.bias + cfg.imu.noise * R.n()) });
@@ -239,7 +282,7 @@ function recording(cfg) {
         const beam = lidar.angleMin + i * lidar.inc;
         const a = lth + (cfg.upsideDown ? -beam : beam);
         const d = castRay(lx, ly, Math.cos(a), Math.sin(a));
-        const noisy = d + lidar.noise * R.n();
+        const noisy = (cfg.rangeScale ?? 1) * d + lidar.noise * R.n();
         ranges[i] = R.u() < lidar.dropout ? NaN : d > lidar.rangeMax ? Infinity : Math.round(noisy * 1024) / 1024;
       }
       const t = at(ms) + offsetNs;
@@ -286,6 +329,12 @@ const VARIANTS = [
   // as /robot1/tf_static and right.
   { file: "drive_ns.mcap", seed: 2902, seconds: 100, mount: [-0.06, 0.02, -1.2], tfMount: [-0.06, 0.02, -1.2],
     upsideDown: false, clockOffsetS: -0.02, tfTopic: "/robot1/tf_static" },
+  // For --odometry and --distance-m: the controller's /odom beside
+  // /joint_states, and a lidar whose ranges read 1 % long (so the scale
+  // from the ranges is 1 % off and a measured distance corrects it); the
+  // first seed from 2903 whose drive ends at least 1.5 m from its start.
+  { file: "drive_odom.mcap", seed: 2903, seconds: 100, mount: [0.08, -0.03, 0.2], tfMount: [0.08, -0.03, 0.2],
+    upsideDown: false, clockOffsetS: 0.01, tfTopic: "/tf_static", odom: true, rangeScale: 1.01, minEndDistance: 1.5 },
 ];
 
 await zstd.isLoaded;
@@ -295,12 +344,23 @@ fs.writeFileSync(path.join(outDir, "robot.toml"),
   "# the parameters the odometry uses (nominal) for drive_*.mcap\nwheelbase_m = 0.28\nwheel_diameter_left_m = 0.066\nwheel_diameter_right_m = 0.066\n");
 const truth = {};
 for (const v of VARIANTS) {
+  while (v.minEndDistance) {  // the first seed whose drive ends far enough from its start
+    const end = simulate(ROBOT, v.seconds, v.seed).at(-1);
+    if (Math.hypot(end.x, end.y) >= v.minEndDistance) break;
+    ++v.seed;
+  }
   const msgs = recording({ ...v, robot: ROBOT, lidar: LIDAR, imu: { scale: 1.012, bias: 0.006, noise: 0.004 } });
-  await writeMcap(path.join(outDir, v.file), [["/joint_states", "sensor_msgs/msg/JointState"], ["/scan", "sensor_msgs/msg/LaserScan"],
-    ["/imu", "sensor_msgs/msg/Imu"], [v.tfTopic, "tf2_msgs/msg/TFMessage"]], msgs);
+  const topics = [["/joint_states", "sensor_msgs/msg/JointState"], ["/scan", "sensor_msgs/msg/LaserScan"],
+    ["/imu", "sensor_msgs/msg/Imu"], [v.tfTopic, "tf2_msgs/msg/TFMessage"]];
+  if (v.odom) topics.push(["/odom", "nav_msgs/msg/Odometry"]);
+  await writeMcap(path.join(outDir, v.file), topics, msgs);
   truth[v.file] = { wheelbase_m: ROBOT.trueB, wheel_diameter_left_m: 2 * ROBOT.trueRL, wheel_diameter_right_m: 2 * ROBOT.trueRR,
     mount: v.mount, upside_down: v.upsideDown, scan_time_offset_s: v.clockOffsetS, gyro_scale: 1.012, gyro_bias_rad_s: 0.006,
     tf_static: { topic: v.tfTopic, mount: v.tfMount } };
+  if (v.minEndDistance) {
+    const end = simulate(ROBOT, v.seconds, v.seed).at(-1);
+    Object.assign(truth[v.file], { seed: v.seed, distance_start_end_m: Math.hypot(end.x, end.y), lidar_range_scale: v.rangeScale });
+  }
   process.stdout.write(`wrote ${v.file}: ${msgs.filter((m) => m.topic === "/scan").length} scans\n`);
 }
 fs.writeFileSync(path.join(outDir, "README-truth.json"), JSON.stringify(truth, null, 2) + "\n");
