@@ -6,8 +6,9 @@
 # report, timeout or out-of-memory; the reproducer is left in
 # $FUZZ_BUILD_DIR/artifacts/.
 # Budget with the defaults: 4 targets x 60 s + 3 x 30 s (fuzz_params_json,
-# fuzz_manifest, fuzz_endpoint_csv) = 5.5 min of fuzzing plus the build.
-#   env: FUZZ_SECONDS (60), FUZZ_NEW_SECONDS (30: the three newer targets), FUZZ_BUILD_DIR (build-fuzz), FUZZ_CXX (clang++)
+# fuzz_manifest, fuzz_endpoint_csv) = 5.5 min of fuzzing, run FUZZ_PARALLEL
+# at a time (default nproc: about 3 min on 2 cores), plus the build.
+#   env: FUZZ_SECONDS (60), FUZZ_PARALLEL (nproc), FUZZ_NEW_SECONDS (30: the three newer targets), FUZZ_BUILD_DIR (build-fuzz), FUZZ_CXX (clang++)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -96,10 +97,10 @@ cat > "$build/json.dict" <<'DICT'
 "\xff"
 DICT
 
-status=0
-for target in "${targets[@]}"; do
-  seeds="$build/seeds/$target"
-  corpus="$build/corpus/$target"
+# One target's seeds, dictionary and run; its log goes to $build/logs/TARGET.log
+# and its exit status to $build/logs/TARGET.status.
+fuzz_one() {
+  local target=$1 seeds="$build/seeds/$1" corpus="$build/corpus/$1" dict=""
   mkdir -p "$seeds" "$corpus" "$build/artifacts"
   case $target in
     fuzz_csv)
@@ -110,10 +111,8 @@ for target in "${targets[@]}"; do
       dict=toml.dict
       find tests/data data -maxdepth 3 -type f -name '*.toml' -exec cp {} "$seeds/" \; ;;
     fuzz_mcap)
-      dict=""
       find tests/data/rosbag2 -type f -name '*.mcap' -size -64k -exec cp {} "$seeds/" \; ;;
     fuzz_cdr)
-      dict=""
       cp tests/data/rosbag2/cdr/*.bin "$seeds/" ;;
     fuzz_manifest)
       dict=toml.dict
@@ -132,18 +131,36 @@ JSON
  "refined": {"parameters": {"wheelbase_m": 0.341, "wheel_diameter_left_m": 0.1523, "wheel_diameter_right_m": 0.1526}}}]}
 JSON
       ;;
-    *) dict="" ;;
   esac
   # Targets added by issue 9 run FUZZ_NEW_SECONDS (default 30) to keep CI short.
-  t_seconds=$seconds
+  local t_seconds=$seconds
   case $target in fuzz_params_json | fuzz_manifest | fuzz_endpoint_csv) t_seconds=${FUZZ_NEW_SECONDS:-30} ;; esac
   echo "== $target: $(ls "$seeds" | wc -l) seed files, $(ls "$corpus" | wc -l) corpus files, ${t_seconds} s"
-  args=(-max_total_time="$t_seconds" -timeout=10 -rss_limit_mb=2048 -max_len=16384 -print_final_stats=1
-        -artifact_prefix="$build/artifacts/$target-")
+  local args=(-max_total_time="$t_seconds" -timeout=10 -rss_limit_mb=2048 -max_len=16384 -print_final_stats=1
+              -artifact_prefix="$build/artifacts/$target-")
   if [[ -n $dict ]]; then args+=(-dict="$build/$dict"); fi
-  # Keep the log short: progress lines and libFuzzer's dictionary advice out.
-  if ! "$build/$target" "${args[@]}" "$corpus" "$seeds" 2>&1 | grep -v -e '# Uses:' -e 'NEW_FUNC' -e '^#[0-9]*[[:space:]]*\(NEW\|REDUCE\|pulse\|RELOAD\)' | tail -n 40; then
-    echo "FUZZ FAILURE in $target; reproducers:" >&2
+  "$build/$target" "${args[@]}" "$corpus" "$seeds"
+}
+
+# The targets run FUZZ_PARALLEL at a time (default: the number of cores), each
+# for its full time: the same fuzzing in less wall time. Each log is printed
+# whole, in order, when all are done (short: progress lines and libFuzzer's
+# dictionary advice are filtered out).
+mkdir -p "$build/logs"
+parallel=${FUZZ_PARALLEL:-$(nproc)}
+running=0
+for target in "${targets[@]}"; do
+  if (( running >= parallel )); then wait -n || true; running=$((running - 1)); fi
+  ( set +e; fuzz_one "$target" > "$build/logs/$target.log" 2>&1; echo $? > "$build/logs/$target.status" ) &
+  running=$((running + 1))
+done
+wait
+
+status=0
+for target in "${targets[@]}"; do
+  grep -v -e '# Uses:' -e 'NEW_FUNC' -e '^#[0-9]*[[:space:]]*\(NEW\|REDUCE\|pulse\|RELOAD\)' "$build/logs/$target.log" | tail -n 40
+  if [[ "$(cat "$build/logs/$target.status" 2>/dev/null)" != 0 ]]; then
+    echo "FUZZ FAILURE in $target (exit $(cat "$build/logs/$target.status" 2>/dev/null)); reproducers:" >&2
     ls -l "$build/artifacts" >&2 || true
     status=1
   fi
