@@ -365,13 +365,16 @@ TEST_CASE("diagnose: turn_scrub needs arcs: found with figure-eights", "[diagnos
   CHECK_THAT(c->E_b, WithinAbs(1.012, 3e-3));
 }
 
-TEST_CASE("diagnose: a turn scrub fitted 2 SE below 0 is a symptom in the explanation too, never named",
+TEST_CASE("diagnose: a turn scrub fitted 2 SE below 0 is a symptom in the explanation too, never a step",
           "[diagnose]") {
   // Scrubbing only loses rotation (k >= 0). A slightly negative k (here
   // -0.006, above advice.hpp's fixed floor of -0.01) is flagged by its
   // standard error; the explanation's joint fits take the single-effect
   // fit's SE. Before that they had none, and the June campaign named such
   // a scrub (k = -0.0062) while its candidate was flagged impossible.
+  // Issue 28 (item 5): an impossible fit is a symptom, never a step: it is
+  // listed among the explanation's symptoms (JSON `symptoms`), not its
+  // steps (until then it was a step marked `unphysical`).
   Small s = MakeSmall(51, 5, 10, true);
   s.manifest.ground_truth = GroundTruthNoise{1e-4, 5e-4};
   s.sim.effects.scrub_k = -0.006;
@@ -386,18 +389,21 @@ TEST_CASE("diagnose: a turn scrub fitted 2 SE below 0 is a symptom in the explan
   // Slightly below 0 (above the fixed floor): a symptom, but its
   // likelihood-ratio test still shows the gap (verdict.cpp).
   CHECK_FALSE(c->impossible);
-  bool stepped = false;
-  for (const ExplanationStep& st : d.explanation)
+  for (const ExplanationStep& st : d.explanation) CHECK(st.effect != sim::EffectKind::kTurnScrub);
+  bool symptom = false;
+  for (const ExplanationStep& st : d.symptoms)
     if (st.effect == sim::EffectKind::kTurnScrub) {
-      stepped = true;
+      symptom = true;
       CHECK(st.unphysical.find("negative turn scrub") != std::string::npos);
     }
-  CHECK(stepped);
+  CHECK(symptom);
   CHECK(std::find(d.verdict_effects.begin(), d.verdict_effects.end(), "turn_scrub") == d.verdict_effects.end());
   CHECK(d.verdict != "turn_scrub");
   const nlohmann::json j = DiagnoseToJson(d);
   bool flagged = false;
-  for (const auto& st : j.at("explanation")) flagged = flagged || st.contains("unphysical");
+  for (const auto& st : j.at("symptoms"))
+    flagged = flagged || (st.at("effect") == "turn_scrub" && st.at("why").get<std::string>().find("negative") !=
+                                                                 std::string::npos);
   CHECK(flagged);
 }
 

@@ -64,15 +64,17 @@ TEST_CASE("design: with figure-eights the turn scrub is named, without the note"
 
 // A negative scrub (heading gained in spot turns) is no physical scrub: the
 // explanation may still fit it (it closes the gap), but an effect at an
-// impossible value is a symptom of something else and is never named.
+// impossible value is a symptom of something else, never named and (issue
+// 28, item 5) never a step: it is listed among the explanation's symptoms.
 TEST_CASE("design: a turn scrub fitted at an impossible value is not named", "[diagnose][design]") {
   const DiagnoseSummary d = RunScrub(true, -0.05);
   INFO(d.verdict_reason);
   CHECK(d.verdict == "unexplained");
   CHECK(std::find(d.verdict_effects.begin(), d.verdict_effects.end(), "turn_scrub") == d.verdict_effects.end());
-  const auto it = std::find_if(d.explanation.begin(), d.explanation.end(),
+  for (const ExplanationStep& e : d.explanation) CHECK(e.effect != sim::EffectKind::kTurnScrub);
+  const auto it = std::find_if(d.symptoms.begin(), d.symptoms.end(),
                                [](const ExplanationStep& e) { return e.effect == sim::EffectKind::kTurnScrub; });
-  REQUIRE(it != d.explanation.end());
+  REQUIRE(it != d.symptoms.end());
   CHECK_THAT(it->params.at("k"), WithinRel(-0.05, 0.10));
   CHECK(d.verdict_reason.find("impossible values") != std::string::npos);
 }

@@ -370,6 +370,11 @@ void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
   rep.Table({"step", "effect", "parameters", "gap closed, held-out", "in-sample", "size over a run",
              "size / noise of one piece"},
             rows, 3);
+  for (const auto& y : j.value("symptoms", nlohmann::json::array()))  // impossible fits: never steps
+    rep.Paragraph(fmt::format("Symptom, not a step: {} {} ({}).", y.value("effect", "?"),
+                              ParamsText(y.value("params", nlohmann::json::object()), nlohmann::json::object(),
+                                         y.value("effect", "")),
+                              y.value("why", "")));
   const auto& v = j.at("verdict");
   rep.Paragraph(fmt::format("{} of the gap stays unexplained on held-out runs. An effect is negligible when its size is "
                             "below {:.2g} x the noise of one piece (1 m of travel or a spot turn), or, for a noise "
@@ -421,21 +426,25 @@ std::string DiagnoseReportHtml(const nlohmann::json& j, const std::string& manif
   const std::string effect = v.value("effect", "?");
   const auto& gap = j.at("gap");
   const double p = Number(gap, "p_value");
+  // What is wrong and what to do in plain words first (the diagnosis'
+  // `summary`); the verdict's statistics follow the next steps.
+  const std::string plain = j.value("summary", std::string());
+  std::string stats;
   if (effect == "none") {
-    rep.Headline(fmt::format("No gap that matters between the runs and the model ({}). {}", PText(p), v.value("reason", "")),
-                 io::HtmlReport::Level::kGood);
+    stats = fmt::format("No gap that matters between the runs and the model ({}). {}", PText(p), v.value("reason", ""));
   } else if (effect == "unexplained") {
-    rep.Headline(fmt::format("The runs leave the model ({}) and no known effect explains it. {}", PText(p),
-                             v.value("reason", "")),
-                 io::HtmlReport::Level::kBad);
+    stats = fmt::format("The runs leave the model ({}) and no known effect explains it. {}", PText(p), v.value("reason", ""));
   } else {
-    rep.Headline(fmt::format("The runs leave the model ({}); the cause: {}. {}", PText(p), effect, v.value("reason", "")),
-                 io::HtmlReport::Level::kWarn);
+    stats = fmt::format("The runs leave the model ({}); the cause: {}. {}", PText(p), effect, v.value("reason", ""));
   }
+  rep.Headline(plain.empty() ? stats : plain, effect == "none"          ? io::HtmlReport::Level::kGood
+                                              : effect == "unexplained" ? io::HtmlReport::Level::kBad
+                                                                        : io::HtmlReport::Level::kWarn);
   std::vector<std::string> steps;
   for (const auto& s : j.value("next_steps", nlohmann::json::array()))
     if (s.is_string()) steps.push_back(s.get<std::string>());
   rep.NextSteps(steps);
+  if (!plain.empty()) rep.Paragraph("Verdict: " + stats);
   RunFaultTable(rep, j);
   std::vector<std::string> warnings;
   for (const auto& w : j.value("warnings", nlohmann::json::array())) warnings.push_back(w.get<std::string>());

@@ -262,4 +262,106 @@ std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSu
   return out;
 }
 
+namespace {
+
+/// One named effect as a plain statement with the explained model's numbers.
+std::string PlainProblem(const ExplanationStep& step) {
+  const auto p = [&](const char* k) {
+    const auto it = step.params.find(k);
+    return it == step.params.end() ? 0.0 : it->second;
+  };
+  switch (step.effect) {
+    case sim::EffectKind::kScaleError:
+      return fmt::format("both wheels are {:.2f}% {} than the model says", 100.0 * std::abs(p("s")),
+                         p("s") >= 0.0 ? "larger" : "smaller");
+    case sim::EffectKind::kGtOffset:
+      return fmt::format("the motion capture tracks a point ({:+.1f}, {:+.1f}) mm from the axle midpoint", 1e3 * p("dx"),
+                         1e3 * p("dy"));
+    case sim::EffectKind::kTimeOffset:
+      return fmt::format("the ground truth's clock {} the encoders' by {:.0f} ms", p("tau") >= 0.0 ? "lags" : "leads",
+                         1e3 * std::abs(p("tau")));
+    case sim::EffectKind::kRunTimeOffset:
+      return fmt::format("each recording's ground-truth clock is offset differently (by about {:.0f} ms)",
+                         1e3 * p("tau_sd"));
+    case sim::EffectKind::kTurnScrub:
+      return fmt::format("spot turns turn {:.1f}% less than the wheels say (the wheels scrub)", 100.0 * p("k"));
+    case sim::EffectKind::kDirectionAsymmetry:
+      return fmt::format("driving backward the wheels travel {:.2f}% {} than forward", 100.0 * std::abs(p("a")),
+                         p("a") >= 0.0 ? "more" : "less");
+    case sim::EffectKind::kCastorKick:
+      return fmt::format("the castor turns the robot by {:.1f} mrad at every start", 1e3 * std::abs(p("kappa")));
+    case sim::EffectKind::kCastorSwivel:
+      return fmt::format("the swivel castor turns the robot by {:.1f} mrad as it starts after a spot turn",
+                         1e3 * std::abs(p("kappa")));
+    case sim::EffectKind::kParameterDrift:
+      return fmt::format("the right wheel's diameter changes by {:.3g}% from run to run", 100.0 * p("r"));
+    case sim::EffectKind::kStopSlide:
+      return fmt::format("the robot slides on after its wheels stop (d = {:.3g} s^2/m)", p("d"));
+    case sim::EffectKind::kStandstillMotion:
+      return fmt::format("the robot still moves as it comes to rest (about {:.1f} mm, {:.1f} mrad)",
+                         1e3 * p("sigma_xy"), 1e3 * p("sigma_theta"));
+    case sim::EffectKind::kMotionNoiseFloor:
+      return fmt::format("every start and stop adds about {:.2f} mm of wheel travel error", 1e3 * p("sigma"));
+    case sim::EffectKind::kBumpOutliers:
+      return fmt::format("the wheels hit bumps or slip ({:.2g} per metre, {:.1f} mm each)", p("rate"),
+                         1e3 * p("sigma"));
+    case sim::EffectKind::kCorrelatedNoise:
+      return fmt::format("the two wheels' errors are correlated (rho = {:.2f})", p("rho"));
+    default:
+      return fmt::format("{} is off", sim::EffectToString(step.effect));
+  }
+}
+
+bool OfTheRecording(sim::EffectKind k) {
+  return k == sim::EffectKind::kGtOffset || k == sim::EffectKind::kTimeOffset || k == sim::EffectKind::kRunTimeOffset;
+}
+
+}  // namespace
+
+// Plain words first; the numbers are the explained model's (the same as the
+// explanation table, the JSON and the simulate command).
+std::string PlainSummary(const DiagnoseSummary& s) {
+  std::vector<std::string> parts;
+  if (!s.run_faults.empty()) {
+    std::vector<std::string> runs;
+    for (const RunFault& f : s.run_faults)
+      runs.push_back(fmt::format("experiment {} run {} ({})", f.experiment + 1, f.run_id,
+                                 f.statistic == "clock"    ? fmt::format("its clock is {:+.0f} ms off", 1e3 * f.tau_s)
+                                 : f.statistic == "marker" ? std::string("its marker moved")
+                                                           : std::string("its data scatter far more")));
+    parts.push_back(fmt::format("{} faulty, not the robot: {}; fix or drop {} (left out below).",
+                                s.run_faults.size() == 1 ? "One recorded run is" : "Some recorded runs are",
+                                fmt::join(runs, ", "), s.run_faults.size() == 1 ? "it" : "them"));
+  }
+  std::vector<std::string> robot, recording;
+  for (const ExplanationStep& st : s.explanation) {
+    const std::string name = sim::EffectToString(st.effect);
+    if (std::find(s.verdict_effects.begin(), s.verdict_effects.end(), name) == s.verdict_effects.end()) continue;
+    if (sim::IsParameterError(st.effect)) continue;  // the corrections below say it
+    (OfTheRecording(st.effect) ? recording : robot).push_back(PlainProblem(st));
+  }
+  for (const ParameterCorrection& pc : s.corrections) robot.push_back("your simulation: " + pc.text);
+  const bool unexplained = s.verdict == "unexplained";
+  if (s.verdict == "none") {
+    parts.push_back(s.baseline.given ? "Nothing that matters is wrong: your simulation describes these runs within "
+                                       "their noise."
+                                     : "Nothing that matters is wrong: the calibrated model describes these runs "
+                                       "within their noise.");
+  } else {
+    if (unexplained)
+      parts.push_back("The runs differ from the model in a way no listed effect explains" +
+                      std::string(robot.empty() && recording.empty()
+                                      ? "."
+                                      : fmt::format(" (the effects below explain {:.0f}% of it).",
+                                                    100.0 * (1.0 - s.unexplained_fraction))));
+    if (!robot.empty())
+      parts.push_back(fmt::format("{}: {}.", unexplained ? "Partly, the robot" : "The robot", fmt::join(robot, "; ")));
+    if (!recording.empty())
+      parts.push_back(fmt::format("{}: {}.", unexplained ? "Partly, the recording" : "The recording",
+                                  fmt::join(recording, "; ")));
+  }
+  if (!s.next_steps.empty()) parts.push_back("What to do first: " + s.next_steps.front());
+  return fmt::format("{}", fmt::join(parts, " "));
+}
+
 }  // namespace umbmark::diag

@@ -50,4 +50,13 @@ std::string EvidenceInWords(double heldout_gain_nats, double evidence_nats, doub
 /// and the fits that came out unphysical.
 std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSummary& s);
 
+/// What is wrong with the robot or the recording and what to do, in plain
+/// words and the explained model's numbers, no statistics: the report's
+/// first paragraph (text, HTML; JSON `summary`). Faulty runs first, then
+/// the named effects (the recording's: marker, clocks; the robot's: the
+/// others), or that nothing matters (`none`), or, for `unexplained`, where
+/// the runs leave the model and what part the listed effects explain.
+/// Needs s.next_steps (AdviseNextSteps) filled.
+std::string PlainSummary(const DiagnoseSummary& s);
+
 }  // namespace umbmark::diag

@@ -481,6 +481,19 @@ void FitNoiseEffect(const Shared& x, sim::EffectKind kind, Candidate& cd) {
   cd.heldout_shrink = Shrink(Gap(gcv, x.null_median), x.gap_cv_before);
   if (kind == sim::EffectKind::kRunTimeOffset) CheckRunTimeOffset(x, bases, ne, cf, cd);
   else cd.footprint = CheckNoiseFootprint(c, x.b.eps, bases, ne);
+  // Fitted at zero, a noise effect is the baseline: what its refit changes
+  // (the other noise parameters beside it, the folds' fits) is not its own,
+  // so it is credited with nothing (issue 28: standstill_motion at sigma 0
+  // showed 24 % held-out shrink on the example campaign).
+  if (std::string why = NullNoiseFit(sim::EffectToString(kind), cd.params); !why.empty()) {
+    cd.gap_after = x.gap_score;
+    cd.gap_by_kind = x.gap_by_kind;
+    cd.heldout_shrink = 0.0;
+    cd.heldout_loglik_gain = 0.0;
+    cd.loglik_gain = 0.0;
+    cd.lr_p_value = 1.0;
+    cd.note = std::string(cd.note.empty() ? "" : cd.note + "; ") + why;
+  }
   // With the wheel noise given (diagnose --baseline --kl --kr), bumps at
   // their rate bound are their Gaussian limit: many small travel errors,
   // rate x sigma_b^2 of variance per metre, i.e. wheel noise growing with

@@ -18,6 +18,7 @@
 #include "diagnosis/cross_validation.hpp"
 #include "diagnosis/design_check.hpp"
 #include "diagnosis/explanation.hpp"
+#include "diagnosis/mean_fit.hpp"
 #include "diagnosis/null_distribution.hpp"
 #include "diagnosis/return_check.hpp"
 #include "diagnosis/stop_model.hpp"
@@ -159,6 +160,23 @@ StopChoice ChooseStopModel(const CampaignData& recorded, const BaselineStart& st
   return out;
 }
 
+/// A single-effect verdict the explanation did not admit as its first step
+/// (a symptom, or no held-out evidence; explanation.hpp) is no verdict: it
+/// becomes `unexplained`, with the reason.
+void DropUnadmittedVerdict(const Explanation& ex, DiagnoseSummary& out) {
+  const auto k = sim::EffectFromString(out.verdict);
+  if (!k || std::any_of(ex.steps.begin(), ex.steps.end(), [&](const ExplanationStep& s) { return s.effect == *k; }))
+    return;
+  const auto y =
+      std::find_if(ex.symptoms.begin(), ex.symptoms.end(), [&](const ExplanationStep& s) { return s.effect == *k; });
+  out.verdict_reason = y != ex.symptoms.end()
+                           ? fmt::format("{} closes the gap only at an impossible value ({}): a symptom of something "
+                                         "else; {}", out.verdict, y->unphysical, out.verdict_reason)
+                           : fmt::format("{} is not admitted as a step of the explanation (it gains no held-out "
+                                         "evidence jointly); {}", out.verdict, out.verdict_reason);
+  out.verdict = "unexplained";
+}
+
 /// The verdict's effects from the explanation: its effects that are neither
 /// negligible nor fitted at impossible values (advice.hpp UnphysicalFit,
 /// e.g. a negative turn scrub: a symptom of something else, never a cause).
@@ -166,7 +184,7 @@ StopChoice ChooseStopModel(const CampaignData& recorded, const BaselineStart& st
 /// `unexplained` gap that the explanation closes (no significant gap left,
 /// held-out shrink >= min_heldout_shrink) is named by its effects.
 void NameEffects(const Explanation& ex, const DiagnoseOptions& options, DiagnoseSummary& out) {
-  std::vector<std::string> named, negligible, impossible;
+  std::vector<std::string> named, negligible, impossible, symptoms;
   for (const ExplanationStep& s : ex.steps) {
     const std::string name = sim::EffectToString(s.effect);
     if (!s.unphysical.empty())
@@ -174,14 +192,19 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, Diagnose
     else
       (s.negligible ? negligible : named).push_back(name);
   }
+  for (const ExplanationStep& s : ex.symptoms) symptoms.push_back(sim::EffectToString(s.effect));
+  DropUnadmittedVerdict(ex, out);
   const double heldout = ex.steps.empty() ? 0.0 : ex.steps.back().cumulative_heldout_shrink;
   out.unexplained_fraction = std::clamp(1.0 - heldout, 0.0, 1.0);
   std::string negligible_text =
       negligible.empty() ? std::string()
                          : fmt::format("; negligible in practice (size below {:.2g} x the noise of one piece): {}",
                                        options.negligible, fmt::join(negligible, ", "));
-  if (!impossible.empty())
-    negligible_text += fmt::format("; fitted at impossible values (a symptom, not named): {}", fmt::join(impossible, ", "));
+  std::vector<std::string> all_impossible = impossible;
+  all_impossible.insert(all_impossible.end(), symptoms.begin(), symptoms.end());
+  if (!all_impossible.empty())
+    negligible_text += fmt::format("; fitted at impossible values (a symptom, not named, never a step): {}",
+                                   fmt::join(all_impossible, ", "));
   if (out.verdict == "unexplained") {
     if (!ex.steps.empty() && !ex.gap_left && heldout >= options.min_heldout_shrink && !impossible.empty() &&
         named.empty()) {
@@ -238,8 +261,11 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, Diagnose
 /// Stage 6: the stepwise explanation, which effects the verdict names, and
 /// what this design cannot separate (turn_scrub from E_b without arcs),
 /// unless a weakly identifiable scrub was named on its own evidence.
+/// `explained`: the explained model (Explanation::p, noise, bases), left
+/// empty without a significant gap.
 void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit& base, const Folds& folds,
-                const CandidateFits& fits, const DiagnoseOptions& options, StageTimer& timer, DiagnoseSummary& out) {
+                const CandidateFits& fits, const DiagnoseOptions& options, StageTimer& timer, DiagnoseSummary& out,
+                Explanation& explained) {
   out.negligible_threshold = options.negligible;
   if (out.significant) {
     ExplanationOptions eo;
@@ -266,7 +292,9 @@ void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit
     }
     out.explanation = ex.steps;
     out.explanation_stop = ex.stop_reason;
+    out.symptoms = ex.symptoms;
     NameEffects(ex, options, out);
+    explained = std::move(ex);
     timer.Lap("stepwise explanation");
   }
   const bool scrub_named = std::find(out.verdict_effects.begin(), out.verdict_effects.end(), "turn_scrub") !=
@@ -300,19 +328,72 @@ std::string StandstillDisagreement(const BaselineSummary& b) {
           : "check the manifest's [ground_truth] values");
 }
 
-/// Stage 1b: faults of single runs (run_faults.hpp) under the baseline of
-/// all runs. Returns the campaign without the faulty runs when there are
-/// any (and at least two runs with pieces stay), else nothing; the faults
-/// and the test go into `out` either way.
-std::optional<CampaignData> ScanRunFaults(const CampaignData& recorded, const CampaignData& c, const MeanModel& model,
-                                          const BaselineFit& base, const DiagnoseOptions& options,
-                                          DiagnoseSummary& out) {
+/// Stage 1b: faults of single runs (run_faults.hpp), first pass: the
+/// screen under the baseline of all runs. Its faults are only suspects: an
+/// effect the baseline does not model (a marker offset, a scale error) has
+/// a footprint that differs from run to run and passes for per-run clocks
+/// or markers there; ConfirmRunFaults decides under the explained model.
+RunFaultScan ScreenRunFaults(const CampaignData& c, const MeanModel& model, const BaselineFit& base,
+                             const DiagnoseOptions& options) {
   RunFaultOptions ro = options.run_faults;
   ro.seed = options.seed;
-  RunFaultScan scan = FindRunFaults(c, model, base, ro);
-  out.run_fault_test = std::move(scan.test);
-  out.run_faults = std::move(scan.faults);
-  if (out.run_faults.empty() || out.run_faults.size() + 2 > c.runs.size()) return std::nullopt;
+  return FindRunFaults(c, model, base, ro);
+}
+
+/// The baseline with the explained model's mean and noise in its place
+/// (residuals and whiteners at them), for the run statistics. The per-run
+/// clock spread (run_time_offset's tau_sd) is left out of the noise: it is
+/// the spread the test measures the runs against.
+BaselineFit UnderExplanation(const CampaignData& c, const MeanModel& model, const BaselineFit& base,
+                             const Explanation& ex) {
+  BaselineFit b = base;
+  b.p = ex.p;
+  model.Residuals(b.p, b.eps);
+  b.noise = ex.noise;
+  b.noise.run_tau2 = 0.0;
+  b.W = Whiteners(ex.bases.empty() ? base.bases : ex.bases, c.pieces, b.noise);
+  return b;
+}
+
+/// Stage 1b, second pass (after the explanation): the run statistics again
+/// under the explained model; a run is faulty when it stands out in both
+/// passes (each at the campaign false-alarm rate alpha, so together at most
+/// alpha). Returns the confirmed faults and, for the suspects it clears, a
+/// note naming the effects that explain them.
+struct ConfirmedFaults {
+  std::vector<RunFault> faults;
+  std::string cleared_note;  ///< empty when nothing was cleared
+};
+ConfirmedFaults ConfirmRunFaults(const CampaignData& c, const MeanModel& model, const BaselineFit& base,
+                                 const Explanation& ex, const DiagnoseOptions& options, std::vector<RunFault> suspects) {
+  if (ex.steps.empty()) return {std::move(suspects), {}};  // nothing modelled: the explained model is the baseline
+  const RunFaultScan second = ScreenRunFaults(c, model, UnderExplanation(c, model, base, ex), options);
+  ConfirmedFaults out;
+  std::vector<std::string> cleared;
+  for (RunFault& f : suspects) {
+    const auto it = std::find_if(second.faults.begin(), second.faults.end(),
+                                 [&](const RunFault& g) { return g.run == f.run; });
+    if (it != second.faults.end()) {
+      out.faults.push_back(*it);
+      continue;
+    }
+    cleared.push_back(fmt::format("experiment {} run {} ({} z = {:+.1f} against {:.1f})", f.experiment + 1, f.run_id,
+                                  f.statistic, f.z, f.threshold));
+  }
+  std::vector<std::string> effects;
+  for (const ExplanationStep& st : ex.steps) effects.push_back(sim::EffectToString(st.effect));
+  if (!cleared.empty())
+    out.cleared_note = fmt::format(
+        "no faulty run: {} stood out of {} experiment under the baseline, but not once the explanation's effects "
+        "({}) are modelled: their footprint differs from run to run, the runs are not faulty",
+        fmt::join(cleared, ", "), cleared.size() == 1 ? "its" : "their", fmt::join(effects, ", "));
+  return out;
+}
+
+/// The campaign without the faulty runs `out.run_faults` when there are
+/// any and at least two runs with pieces stay, else nothing.
+std::optional<CampaignData> WithoutFaults(const CampaignData& recorded, const DiagnoseSummary& out) {
+  if (out.run_faults.empty() || out.run_faults.size() + 2 > recorded.runs.size()) return std::nullopt;
   std::vector<int> drop;
   for (const RunFault& f : out.run_faults) drop.push_back(f.run);
   CampaignData rest = WithoutRuns(recorded, drop);
@@ -325,9 +406,9 @@ DiagnoseSummary DiagnoseCampaign(const CampaignData& recorded, const DiagnoseOpt
 /// The diagnosis of the campaign without its faulty runs, carrying the
 /// faults found on all runs.
 DiagnoseSummary WithoutFaultyRuns(const CampaignData& rest, const DiagnoseOptions& options, DiagnoseSummary& first,
-                                  StageTimer& timer) {
-  timer.Lap("run faults");
+                                  const std::string& cleared_note, StageTimer& timer) {
   DiagnoseSummary out = DiagnoseCampaign(rest, options, false);
+  if (!cleared_note.empty()) out.notes.insert(out.notes.begin(), cleared_note);
   std::vector<std::string> names;
   for (const RunFault& f : first.run_faults) names.push_back(fmt::format("experiment {} run {}", f.experiment + 1, f.run_id));
   out.notes.insert(out.notes.begin(), fmt::format("{} faulty run{} left out of every fit below: {}",
@@ -355,7 +436,7 @@ DiagnoseSummary WithoutFaultyRuns(const CampaignData& rest, const DiagnoseOption
 }
 
 // The diagnosis as its numbered stages, each a call into its own file. About
-// 95 lines because each stage's options are filled from DiagnoseOptions here,
+// 105 lines because each stage's options are filled from DiagnoseOptions here,
 // in place, so that every route of a user's option is visible in one place.
 DiagnoseSummary DiagnoseCampaign(const CampaignData& recorded, const DiagnoseOptions& options, bool scan_faults) {
   DiagnoseSummary out;
@@ -386,10 +467,12 @@ DiagnoseSummary DiagnoseCampaign(const CampaignData& recorded, const DiagnoseOpt
     out.notes.push_back(fmt::format("encoder stops: {} (log-likelihood {:+.1f} against the other reading)",
                                     StopModelToString(c.stop_model), stops.loglik_margin));
   timer.Lap("baseline fit and stop reading");
+  std::vector<RunFault> suspects;
   if (scan_faults) {
-    if (std::optional<CampaignData> rest = ScanRunFaults(recorded, c, model, base, options, out))
-      return WithoutFaultyRuns(*rest, options, out, timer);
-    timer.Lap("run faults");
+    RunFaultScan screen = ScreenRunFaults(c, model, base, options);
+    out.run_fault_test = std::move(screen.test);
+    suspects = std::move(screen.faults);
+    timer.Lap("run faults (screen)");
   }
   out.notes.insert(out.notes.end(), base.notes.begin(), base.notes.end());
   const ReturnCheck returns = CheckReturns(c, model, base);
@@ -443,7 +526,18 @@ DiagnoseSummary DiagnoseCampaign(const CampaignData& recorded, const DiagnoseOpt
   timer.Lap("verdict");
 
   // 6. Stepwise explanation and practical significance.
-  ExplainGap(c, model, base, folds, fits, options, timer, out);
+  Explanation explained;
+  ExplainGap(c, model, base, folds, fits, options, timer, out, explained);
+  // 1b, confirmed: faulty runs are left out and everything is fitted again.
+  if (!suspects.empty()) {
+    ConfirmedFaults confirmed = ConfirmRunFaults(c, model, base, explained, options, std::move(suspects));
+    out.run_faults = std::move(confirmed.faults);
+    timer.Lap("run faults (under the explained model)");
+    if (std::optional<CampaignData> rest = WithoutFaults(recorded, out))
+      return WithoutFaultyRuns(*rest, options, out, confirmed.cleared_note, timer);
+    out.run_faults.clear();
+    if (!confirmed.cleared_note.empty()) out.notes.push_back(std::move(confirmed.cleared_note));
+  }
   if (options.given) DescribeGivenModel(c, *options.given, out);
   if (options.progress) options.progress(1000.0, 1000.0);
   out.next_steps = AdviseNextSteps(c, out);
@@ -482,6 +576,7 @@ DiagnoseSummary Diagnose(const CampaignData& recorded, const DiagnoseOptions& op
   if (auto e = options.Check(); !e.empty()) throw InvalidOptions("diagnose: " + e);
   DiagnoseSummary s = DiagnoseCampaign(recorded, options, options.find_run_faults);
   AddDesignAdvice(recorded, s);
+  s.summary = PlainSummary(s);
   return s;
 }
 

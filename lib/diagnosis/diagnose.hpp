@@ -180,6 +180,9 @@ struct DiagnoseSummary {
   /// without a significant gap.
   std::vector<ExplanationStep> explanation;
   std::string explanation_stop;
+  /// Fits the explanation met that no robot can have, or noise effects at
+  /// zero (Explanation::symptoms): symptoms, never steps (JSON `symptoms`).
+  std::vector<ExplanationStep> symptoms;
   /// Every effect the verdict names (the explanation's non-negligible
   /// effects; for `unexplained` those that close part of the gap).
   std::vector<std::string> verdict_effects;
@@ -206,6 +209,10 @@ struct DiagnoseSummary {
   StopModel stop_model = StopModel::kWheelEdge;
   /// What to do next, for a person (advice.hpp).
   std::vector<std::string> next_steps;
+  /// What is wrong with the robot or the recording and what to do, in plain
+  /// words, no statistics (advice.hpp PlainSummary; JSON `summary`): the
+  /// report opens with it.
+  std::string summary;
   std::uint64_t seed = 0;
 };
 

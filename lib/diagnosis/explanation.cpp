@@ -10,6 +10,7 @@
 
 #include "core/angles.hpp"
 #include "diagnosis/mean_fit.hpp"
+#include "diagnosis/plausibility.hpp"
 #include "diagnosis/run_block.hpp"
 #include "core/parallel_for.hpp"
 
@@ -417,18 +418,73 @@ BaselineFit RefittedWeights(const CampaignData& c, const BaselineFit& b) {
 }
 
 /// Every step's practical size at the last step's joint fit `current`
-/// (mean part `last`), and whether it is negligible.
+/// (mean part `last`), and whether it is negligible; the explained model
+/// into ex.p, ex.noise, ex.bases.
 void SizeSteps(const CampaignData& c, const MeanModel& model, const BaselineFit& b, const MeanPart& last,
                const SetFit& current, double negligible, Explanation& ex) {
   const std::vector<PieceBases>& last_bases = !current.rescaled.empty() ? current.rescaled
                                               : last.scrub              ? last.scrub_bases
                                                                         : b.bases;
+  ex.p = current.p;
+  ex.noise = current.noise;
+  ex.bases = last_bases;
   const PieceScatter scatter = Scatter(c, last_bases, current.noise);
   for (ExplanationStep& s : ex.steps) {
     Size(c, model, b, last_bases, scatter, current, s.effect, s);
     s.practical_floor = PracticalFloor(s.effect, s.params, negligible);
     s.negligible = s.relative_size < negligible || !s.practical_floor.empty();
   }
+}
+
+/// Why the fit `f` of effect e is a symptom rather than a step (see
+/// Explanation::symptoms), with the single-effect candidate's standard
+/// errors; empty when it is no symptom.
+std::string SymptomOf(sim::EffectKind e, const SetFit& f, const std::vector<Candidate>& candidates, int runs) {
+  const std::string name = sim::EffectToString(e);
+  const std::map<std::string, double> params = ParamsOf(e, f);
+  std::map<std::string, double> se;
+  for (const Candidate& cd : candidates)
+    if (cd.effect == e) se = cd.param_se;
+  if (std::string why = UnphysicalFit(name, params, runs, se); !why.empty()) return why;
+  return NullNoiseFit(name, params);
+}
+
+/// The next step among `trial` (the chosen set plus remaining[i]) by the
+/// rule of explanation.hpp: the admissible trial with the most held-out
+/// evidence, or -1. Symptoms met on the way (better evidence than the
+/// step) go into ex.symptoms and out of `pool`.
+int ChooseStep(const std::vector<sim::EffectKind>& remaining, const std::vector<SetFit>& trial, const SetFit& current,
+               double null_median, double gap_cv_before, const std::vector<Candidate>& candidates, int runs,
+               const ExplanationOptions& options, std::vector<sim::EffectKind>& pool, Explanation& ex) {
+  const double penalty = options.complexity_penalty_nats;
+  std::vector<std::size_t> order(remaining.size());
+  std::vector<double> evidence(remaining.size());
+  for (std::size_t i = 0; i < remaining.size(); ++i) {
+    order[i] = i;
+    evidence[i] = trial[i].cv_loglik - current.cv_loglik - penalty * EffectParameterCount(remaining[i]);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return evidence[a] > evidence[b]; });
+  const double shrink_now = Shrink(Gap(current.heldout_gap, null_median), gap_cv_before);
+  for (std::size_t i : order) {
+    if (!(evidence[i] > 0.0)) break;
+    if (std::string why = SymptomOf(remaining[i], trial[i], candidates, runs); !why.empty()) {
+      ExplanationStep s;
+      s.effect = remaining[i];
+      s.params = ParamsOf(remaining[i], trial[i]);
+      s.unphysical = std::move(why);
+      s.heldout_gain_nats = trial[i].cv_loglik - current.cv_loglik;
+      s.gap_after = trial[i].gap_after;
+      s.cumulative_heldout_shrink = Shrink(Gap(trial[i].heldout_gap, null_median), gap_cv_before);
+      ex.symptoms.push_back(std::move(s));
+      pool.erase(std::remove(pool.begin(), pool.end(), remaining[i]), pool.end());
+      continue;
+    }
+    // With keep_heldout_shrink, a step never lowers the cumulative held-out shrink.
+    if (options.keep_heldout_shrink && Shrink(Gap(trial[i].heldout_gap, null_median), gap_cv_before) < shrink_now)
+      continue;
+    return static_cast<int>(i);
+  }
+  return -1;
 }
 
 }  // namespace
@@ -473,11 +529,18 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
   };
   ProgressCounter progress(options.progress,
                            static_cast<double>(options.max_effects) * static_cast<double>(std::max<std::size_t>(candidates.size(), 1)));
+  const int runs = static_cast<int>(c.runs.size());
+  std::vector<sim::EffectKind> pool;
   for (sim::EffectKind e : first) {
+    // The single-effect verdict starts the explanation when the rule
+    // admits it as a step (it nearly always does: it qualified held out).
     std::vector<sim::EffectKind> set = chosen;
     set.push_back(e);
     means.Prepare({set});
-    add(e, FitSet(c, model, b, folds, set, means.Get(set), options.gap));
+    std::vector<SetFit> trial{FitSet(c, model, b, folds, set, means.Get(set), options.gap)};
+    if (ChooseStep({e}, trial, current, null_median, gap_cv_before, candidates, runs,
+                   options, pool, ex) == 0)
+      add(e, trial.front());
     progress.Add();
   }
   // Candidates worth trying: every identifiable one, also those that lost
@@ -491,10 +554,10 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
   // only on its own evidence, as in the verdict: jointly with others it
   // bends into whatever misfit is left (turn_scrub at k = -19 % on real
   // squares).
-  std::vector<sim::EffectKind> pool;
   for (const Candidate& cd : candidates)
     if (cd.identifiable && (!cd.weak || cd.heldout_loglik_gain > 0.0) && !Contains(chosen, cd.effect) &&
-        cd.clock.supported && cd.footprint.consistent)
+        cd.clock.supported && cd.footprint.consistent &&
+        std::none_of(ex.symptoms.begin(), ex.symptoms.end(), [&](const ExplanationStep& y) { return y.effect == cd.effect; }))
       pool.push_back(cd.effect);
   ex.stop_reason = "the largest explanation considered";
   while (static_cast<int>(chosen.size()) < options.max_effects) {
@@ -519,20 +582,13 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
       trial[static_cast<std::size_t>(i)] = FitSet(c, model, b, folds, set, means.Get(set), options.gap, warm);
       progress.Add();
     });
-    std::size_t best = 0;
-    double best_evidence = -1e300;
-    for (std::size_t i = 0; i < remaining.size(); ++i) {
-      const double ev = trial[i].cv_loglik - current.cv_loglik - options.complexity_penalty_nats * EffectParameterCount(remaining[i]);
-      if (ev > best_evidence) {
-        best_evidence = ev;
-        best = i;
-      }
-    }
-    if (!(best_evidence > 0.0)) {
-      ex.stop_reason = "no further effect gains held-out evidence";
+    const int best = ChooseStep(remaining, trial, current, null_median, gap_cv_before, candidates, runs, options,
+                                pool, ex);
+    if (best < 0) {
+      ex.stop_reason = "no further effect gains held-out evidence without lowering the held-out shrink";
       break;
     }
-    add(remaining[best], trial[best]);
+    add(remaining[static_cast<std::size_t>(best)], trial[static_cast<std::size_t>(best)]);
   }
   progress.Finish();
   ex.gap_left = current.gap_after > null_quantile;

@@ -54,6 +54,13 @@ struct ExplanationOptions {
   /// Threads (>= 1); results do not depend on them. Default 2.
   int threads = 2;
   GapOptions gap;
+  /// Admit a step only when it does not lower the cumulative held-out
+  /// shrink (besides gaining held-out evidence and being no symptom).
+  /// Default false: measured on the injection harness' tuning sessions
+  /// (docs/diagnosis.md, "The verdict's rule"), the held-out gap score of
+  /// real recordings falls for correct effects (the baseline's noise, fitted
+  /// with the effect unmodelled, is too wide), and the rule dropped them.
+  bool keep_heldout_shrink = false;
   /// Progress in effect sets fitted, of at most max_effects x the candidates
   /// (core/progress.hpp); reaches the total when the search stops early.
   /// Default: none.
@@ -62,7 +69,9 @@ struct ExplanationOptions {
 
 struct ExplanationStep {
   sim::EffectKind effect = sim::EffectKind::kScaleError;
-  /// Parameters of this effect as fitted jointly at this step.
+  /// Parameters of this effect as fitted jointly at this step: the one
+  /// value the report, the JSON, the HTML page, the advice and the
+  /// suggested `simulate` command give.
   std::map<std::string, double> params;
   double gap_after = 0.0;                  ///< G with every effect so far
   double cumulative_shrink = 0.0;          ///< in-sample
@@ -94,8 +103,28 @@ struct Explanation {
   std::vector<ExplanationStep> steps;  ///< in the order added
   bool gap_left = true;  ///< G after the last step still above the null's 1 - alpha quantile
   std::string stop_reason;
+  /// Effects whose joint fit would have been the next step but came out at
+  /// a value no robot can have (plausibility.hpp UnphysicalFit, e.g. a
+  /// noise correlation of 0.995) or, for a noise effect, at zero (NullNoiseFit:
+  /// whatever it gains is the other noise refitted): symptoms, never
+  /// steps. Each with its params, the reason in `unphysical` and the
+  /// held-out gain it showed; at most one entry per effect.
+  std::vector<ExplanationStep> symptoms;
+  /// The explained model: the last step's joint fit (the baseline's when
+  /// there is no step): mean parameters, noise, and the covariance bases it
+  /// is whitened with (run_faults.hpp' second pass is taken under it).
+  ParamVector p{};
+  NoiseParams noise;
+  std::vector<PieceBases> bases;
 };
 
+/// The rule that admits a step (docs/diagnosis.md, "The verdict's rule"):
+/// it gains more than the penalty per parameter in held-out log-likelihood,
+/// does not lower the cumulative held-out shrink, and is no symptom (see
+/// Explanation::symptoms); among the admissible trials the largest
+/// held-out gain wins. So every step adds held-out evidence and the
+/// cumulative held-out shrink never drops.
+///
 /// `known`: mean fits already made (FitCandidates' mean_fits: the same
 /// fits, so not repeated). `first`: the effect to start with (the single-effect verdict), or none
 /// (empty) to select from scratch. gap_score, null_median, null_quantile:

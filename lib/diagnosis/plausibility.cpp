@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -56,6 +57,34 @@ std::string UnphysicalFit(const std::string& effect, const std::map<std::string,
   if (effect == "run_time_offset" && get("tau_sd") > 1.0)
     return fmt::format("run time offsets of {:.1f} s: the recordings are not aligned at all", get("tau_sd"));
   return {};
+}
+
+std::string NullNoiseFit(const std::string& effect, const std::map<std::string, double>& params) {
+  // The largest value of each parameter that still counts as zero.
+  static const std::map<std::string, double> kZero = {{"sigma_xy", 1e-6}, {"sigma_theta", 1e-6}, {"sigma", 1e-6},
+                                                      {"tau_sd", 1e-5},   {"rho", 1e-4}};
+  static const std::map<std::string, std::vector<std::string>> kEffects = {
+      {"standstill_motion", {"sigma_xy", "sigma_theta"}},
+      {"motion_noise_floor", {"sigma"}},
+      {"run_time_offset", {"tau_sd"}},
+      {"correlated_noise", {"rho"}}};
+  if (effect == "bump_outliers") {  // no bumps, or bumps of no size
+    const auto r = params.find("rate"), sg = params.find("sigma");
+    if (r == params.end() || sg == params.end()) return {};
+    if (r->second <= 1e-6) return "fitted at rate = 0: it adds nothing, so what its fit gains is the other noise refitted beside it";
+    if (sg->second <= 1e-6) return "fitted at sigma = 0: it adds nothing, so what its fit gains is the other noise refitted beside it";
+    return {};
+  }
+  const auto it = kEffects.find(effect);
+  if (it == kEffects.end()) return {};
+  std::string values;
+  for (const std::string& k : it->second) {
+    const auto v = params.find(k);
+    if (v == params.end() || !(std::abs(v->second) <= kZero.at(k))) return {};
+    values += fmt::format("{}{} = 0", values.empty() ? "" : ", ", k);
+  }
+  return fmt::format("fitted at {}: it adds nothing, so what its fit gains is the other noise refitted beside it",
+                     values);
 }
 
 }  // namespace umbmark::diag

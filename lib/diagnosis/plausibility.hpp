@@ -22,4 +22,11 @@ namespace umbmark::diag {
 std::string UnphysicalFit(const std::string& effect, const std::map<std::string, double>& params, int runs,
                           const std::map<std::string, double>& se = {});
 
+/// Why a noise effect fitted at zero is no explanation (empty otherwise):
+/// every variance it adds is below a micrometre, a microradian, 10 us of
+/// clock or a correlation of 1e-4, so what its fit gains (the other noise
+/// parameters refitted beside it) is not its own. Mean effects and the
+/// given model's wheel_noise_error (a k of 0 is a finding) are never null.
+std::string NullNoiseFit(const std::string& effect, const std::map<std::string, double>& params);
+
 }  // namespace umbmark::diag

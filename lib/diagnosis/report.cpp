@@ -70,6 +70,19 @@ nlohmann::json ExplanationJson(const DiagnoseSummary& s) {
   return steps;
 }
 
+nlohmann::json SymptomsJson(const DiagnoseSummary& s) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& e : s.symptoms) {
+    nlohmann::json params = nlohmann::json::object();
+    for (const auto& [k, v] : e.params) params[k] = Num(v);
+    out.push_back({{"effect", sim::EffectToString(e.effect)},
+                   {"params", params},
+                   {"why", e.unphysical},
+                   {"heldout_gain_nats", Num(e.heldout_gain_nats)}});
+  }
+  return out;
+}
+
 nlohmann::json WhereJson(const DiagnoseSummary& s) {
   nlohmann::json where = nlohmann::json::array();
   for (const auto& w : s.where) {
@@ -276,7 +289,8 @@ void WhereSection(TextReport& o, const DiagnoseSummary& s) {
 
 void CandidatesSection(TextReport& o, const DiagnoseSummary& s) {
   const BaselineSummary& b = s.baseline;
-  o.line("3. Which: candidate effects (best first; shrink = 1 - gap after / gap before)");
+  o.line("3. Which: candidate effects, each fitted alone on top of the baseline (best first; shrink = 1 - gap after "
+         "/ gap before; the values to use are the explanation's, below)");
   o.line(fmt::format("    {:<20} {:>8} {:>9} {:>11} {:>10}  {}", "effect", "shrink", "held-out", "evidence", "LR p",
                      "parameters"));
   for (const auto& c : s.candidates) {
@@ -320,6 +334,11 @@ void ExplanationSection(TextReport& o, const DiagnoseSummary& s) {
                          : e.negligible                 ? std::string(" (negligible)")
                                                         : std::string(),
                          params));
+    }
+    for (const auto& e : s.symptoms) {
+      std::string params;
+      for (const auto& [n, v] : e.params) params += FormatParam(n, v, sim::EffectToString(e.effect)) + "  ";
+      o.line(fmt::format("    symptom, not a step: {} {}-- {}", sim::EffectToString(e.effect), params, e.unphysical));
     }
     o.line(fmt::format("    unexplained on held-out runs: {:.0f}%; negligible = size below {:.2g} x the noise of one "
                        "piece (<= 1 m of travel or a spot turn); for a noise effect, widening the pose spread of the "
@@ -374,6 +393,8 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
             {"seed", s.seed}}},
           {"candidates", CandidatesJson(s)},
           {"explanation", ExplanationJson(s)},
+          {"symptoms", SymptomsJson(s)},
+          {"summary", s.summary},
           {"verdict",
            {{"effect", s.verdict},
             {"effects", s.verdict_effects},
@@ -399,6 +420,11 @@ std::string DiagnoseReport(const DiagnoseSummary& s) {
   o.line("Diagnosis of the sim-to-real gap");
   for (const auto& l : s.experiment_labels) o.line("  experiment " + l);
   o.line("");
+  // What is wrong and what to do, in plain words, before the statistics.
+  if (!s.summary.empty()) {
+    o.line("In short: " + s.summary);
+    o.line("");
+  }
   RunFaultSection(o, s);
   BaselineSection(o, s);
   WhereSection(o, s);
