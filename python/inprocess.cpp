@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <map>
 #include <new>
 #include <optional>
@@ -16,9 +17,12 @@
 
 #include "api/calibrate.hpp"
 #include "api/diagnose.hpp"
+#include "api/fit_noise.hpp"
 #include "api/json.hpp"
 #include "api/predict.hpp"
+#include "api/robot_source.hpp"
 #include "api/simulate.hpp"
+#include "api/summarize.hpp"
 #include "arrays.hpp"
 #include "core/errors.hpp"
 #include "keywords.hpp"
@@ -101,6 +105,11 @@ std::string OneInput(const py::args& inputs, const char* name) {
   std::vector<std::string> in = Inputs(inputs, name);
   if (in.size() != 1) throw InvalidOptions(fmt::format("{} takes exactly one path (got {})", name, in.size()));
   return in.front();
+}
+
+/// CLI11's PositiveNumber message for `--flag value`, as the command line says it.
+std::string NotPositive(const std::string& flag, double value) {
+  return fmt::format("{}: Value {} not in range 0.000000 to {:f}", flag, value, std::numeric_limits<double>::max());
 }
 
 // ----- calibrate -----
@@ -270,6 +279,98 @@ Result SimulateInProcess(const py::args& inputs, const py::kwargs& kwargs) {
   const Failure f = Compute([&] { r = api::Simulate(std::move(o)); });
   if (f.status != 0) Raise(f.status, f.message, std::nullopt, "simulate");
   return {"simulate", JsonText(api::ToJson(*r))};
+}
+
+// One line per option: a table, about 50 lines.
+Result FitNoiseInProcess(const py::args& inputs, const py::kwargs& kwargs) {
+  // The plot, the report and the --ros2 file are written by the command
+  // line; arrays (runs=) go to it as a trajectory CSV.
+  for (const char* written : {"plot", "report", "ros2", "runs"})
+    if (kwargs.contains(written) && !kwargs[written].is_none()) return RunExecutable({"fit-noise"}, inputs, kwargs);
+  using O = api::FitNoiseOptions;
+  using H = const py::handle&;
+  using K = const std::string&;
+  static const std::map<std::string, Setter<O>> setters = [] {
+    std::map<std::string, Setter<O>> s;
+    RobotSetters(s);
+    s["distance"] = [](O& o, K k, H v) {
+      const double d = Number(k, v);
+      if (std::string err = api::CheckPlausibleFlag("--distance", "distance_m", d); !err.empty())
+        throw InvalidOptions(err);
+      o.distance_m = d;
+    };
+    s["meas_sigma"] = [](O& o, K k, H v) { o.meas_sigma = Numbers(k, v); };
+    s["first_order"] = [](O& o, K, H v) { o.first_order = Truth(v); };
+    s["ml"] = [](O& o, K, H v) { o.ml = Truth(v); };
+    s["params"] = [](O& o, K k, H v) {
+      o.params_file = Path(k, v);
+      if (!std::filesystem::is_regular_file(o.params_file))
+        throw InvalidOptions(fmt::format("--params: File does not exist: {}", o.params_file));
+    };
+    s["systematic"] = [](O& o, K k, H v) {
+      o.systematic = Text(k, v);
+      if (o.systematic != "none" && o.systematic != "estimate")
+        throw InvalidOptions(fmt::format("--systematic: {} not in {{none,estimate}}", o.systematic));
+    };
+    s["controller"] = [](O& o, K k, H v) { o.controller = Text(k, v); };
+    s["rate"] = [](O& o, K k, H v) { o.covariance.rate_hz = Number(k, v); };
+    s["speed"] = [](O& o, K k, H v) { o.covariance.speed_mps = Number(k, v); };
+    s["reml"] = [](O&, K, H) {};  // the default; checked against ml below
+    s["json"] = [](O&, K, H) {
+      throw InvalidOptions("json=: the module returns the JSON (result.to_dict()); write it with the json module");
+    };
+    return s;
+  }();
+  auto given = [&](const char* key) { return kwargs.contains(key) && !kwargs[key].is_none(); };
+  auto o = Options<O>("fit-noise", [&](O& opts) {
+    opts.inputs = Inputs(inputs, "DATA");
+    if (opts.inputs.empty()) throw InvalidOptions("DATA is required");
+    ApplyKeywords(opts, kwargs, setters, "fit_noise");
+    for (const char* positive : {"rate", "speed"})
+      if (given(positive) && !(Number(positive, kwargs[positive]) > 0))
+        throw InvalidOptions(NotPositive(FlagOf(positive), Number(positive, kwargs[positive])));
+  });
+  const bool params_and_estimate = !o.params_file.empty() && given("systematic") && o.systematic == "estimate";
+  const bool ml_and_reml = o.ml && given("reml") && Truth(kwargs["reml"]);
+  std::optional<api::FitNoiseResult> r;
+  const Failure f = Compute([&] {
+    // The command's own checks (apps/cmd_fit_noise.cpp), said as it says them.
+    if (params_and_estimate)
+      throw InvalidOptions("--params and --systematic estimate contradict each other (give one)");
+    if (ml_and_reml) throw InvalidOptions("--ml and --reml contradict each other (give one)");
+    r = api::FitNoise(o);
+  });
+  if (f.status != 0) Raise(f.status, f.message, std::nullopt, "fit-noise");
+  return {"fit-noise", JsonText(api::ToJson(*r))};
+}
+
+// umbmark.summarize: api::Summarize (with csv= or report=, the executable,
+// which writes those files).
+Result SummarizeInProcess(const py::args& inputs, const py::kwargs& kwargs) {
+  for (const char* written : {"csv", "report"})
+    if (kwargs.contains(written) && !kwargs[written].is_none()) return RunExecutable({"summarize"}, inputs, kwargs);
+  using O = api::SummarizeOptions;
+  using H = const py::handle&;
+  using K = const std::string&;
+  static const std::map<std::string, Setter<O>> setters = {
+      {"threshold", [](O& o, K k, H v) {
+         o.fleet.threshold = Number(k, v);
+         if (!(o.fleet.threshold > 0))
+           throw InvalidOptions(NotPositive("--threshold", o.fleet.threshold));
+       }},
+      {"json", [](O&, K, H) {
+         throw InvalidOptions("json=: the module returns the JSON (result.to_dict()); write it with the json module");
+       }},
+  };
+  auto o = Options<O>("summarize", [&](O& opts) {
+    opts.inputs = Inputs(inputs, "CAL");
+    if (opts.inputs.empty()) throw InvalidOptions("CAL is required");
+    ApplyKeywords(opts, kwargs, setters, "summarize");
+  });
+  std::optional<api::SummarizeResult> r;
+  const Failure f = Compute([&] { r = api::Summarize(o); });
+  if (f.status != 0) Raise(f.status, f.message, std::nullopt, "summarize");
+  return {"summarize", JsonText(api::ToJson(*r))};
 }
 
 // One line per option: a table, about 50 lines.

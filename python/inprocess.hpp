@@ -16,6 +16,12 @@ namespace umbmark::python {
 Result CalibrateInProcess(const pybind11::args& inputs, const pybind11::kwargs& options);
 /// umbmark.predict(**options): api::Predict.
 Result PredictInProcess(const pybind11::args& inputs, const pybind11::kwargs& options);
+/// umbmark.fit_noise(*inputs, **options): api::FitNoise (with plot=,
+/// report=, ros2= or runs=, the executable, which writes those).
+Result FitNoiseInProcess(const pybind11::args& inputs, const pybind11::kwargs& options);
+/// umbmark.summarize(*inputs, **options): api::Summarize (with csv= or
+/// report=, the executable).
+Result SummarizeInProcess(const pybind11::args& inputs, const pybind11::kwargs& options);
 /// umbmark.simulate(manifest, **options): api::Simulate.
 Result SimulateInProcess(const pybind11::args& inputs, const pybind11::kwargs& options);
 /// umbmark.diagnose(manifest, **options): api::Diagnose (with plot= or

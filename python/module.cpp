@@ -255,6 +255,8 @@ using InProcessFunction = Result (*)(const py::args&, const py::kwargs&);
 const InProcessFunction* InProcess(const std::string& name) {
   static const std::map<std::string, InProcessFunction> functions = {{"calibrate", &CalibrateInProcess},
                                                                      {"predict", &PredictInProcess},
+                                                                     {"fit_noise", &FitNoiseInProcess},
+                                                                     {"summarize", &SummarizeInProcess},
                                                                      {"simulate", &SimulateInProcess},
                                                                      {"diagnose", &DiagnoseInProcess}};
   const auto it = functions.find(name);

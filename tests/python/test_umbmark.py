@@ -47,6 +47,48 @@ def test_fit_noise_equals_cli():
     assert lo < r.k_L < hi
 
 
+def test_fit_noise_in_process_with_options_equals_cli(monkeypatch):
+    # The trajectory CSV given directly, with the robot and the reference's
+    # noise as options: in this process (no executable), the CLI's JSON.
+    args = dict(robot=ROBOT, meas_sigma=[0.001, 0.002], first_order=True, ml=True, systematic="none")
+    cli = cli_json("fit-noise", EXAMPLES / "fwd_back_travel.csv", "--robot", ROBOT, "--meas-sigma", "0.001,0.002",
+                   "--first-order", "--ml", "--systematic", "none")
+    monkeypatch.setenv("UMBMARK_EXE", "/nonexistent/umbmark")
+    r = umbmark.fit_noise(EXAMPLES / "fwd_back_travel.csv", **args)
+    assert_same(r.to_dict(), cli)
+    assert r.command == "fit-noise" and r.meas_sigma == [0.001, 0.002] and r.second_order is False
+    lo, hi = r.k_R_ci95
+    assert lo < r.k_R < hi
+
+
+@pytest.mark.parametrize("kwargs,flags", [
+    (dict(systematic="maybe"), ["--systematic", "maybe"]),
+    (dict(ml=True, reml=True), ["--ml", "--reml"]),
+    (dict(distance=-2), ["--distance", "-2"]),
+    (dict(rate=-5), ["--rate", "-5"]),
+])
+def test_fit_noise_in_process_usage_errors_are_the_commands(monkeypatch, kwargs, flags):
+    status, _, err = run_cli("fit-noise", EXAMPLES / "fit-noise.toml", *flags)
+    assert status == 2
+    monkeypatch.setenv("UMBMARK_EXE", "/nonexistent/umbmark")
+    with pytest.raises(umbmark.UsageError) as e:
+        umbmark.fit_noise(EXAMPLES / "fit-noise.toml", **kwargs)
+    assert e.value.exit_status == 2 and str(e.value) == err.splitlines()[0]
+    with pytest.raises(umbmark.UsageError, match="fit_noise has no option --no-such-option"):
+        umbmark.fit_noise(EXAMPLES / "fit-noise.toml", no_such_option=1)
+
+
+def test_fit_noise_in_process_input_error_has_the_commands_message(monkeypatch, tmp_path):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("run,direction,t_s,dist_left_m\n1,cw,0,x\n")
+    status, _, err = run_cli("fit-noise", bad, "--robot", ROBOT)
+    assert status == 1
+    monkeypatch.setenv("UMBMARK_EXE", "/nonexistent/umbmark")
+    with pytest.raises(umbmark.InputError) as e:
+        umbmark.fit_noise(bad, robot=ROBOT)
+    assert str(e.value) == err.strip()
+
+
 def test_predict_equals_cli_and_closed_form():
     args = dict(robot=ROBOT, kl=1e-3, kr=2e-3, path="line:2")
     r = umbmark.predict(**args, monte_carlo=2000, seed=7, threads=1)
@@ -95,6 +137,23 @@ def test_summarize_equals_cli(tmp_path):
     r = umbmark.summarize(*files)
     assert_same(r.to_dict(), cli_json("summarize", *files))
     assert len(r.robots) == 3
+
+
+def test_summarize_in_process_equals_cli(monkeypatch, tmp_path):
+    files = []
+    for i, side in enumerate([0.75, 0.7, 0.8, 0.76]):
+        f = tmp_path / f"robot{i}.json"
+        f.write_text(umbmark.calibrate(EXAMPLES / "endpoints.csv", robot=ROBOT, side=side).json)
+        files.append(f)
+    cli = cli_json("summarize", *files, "--threshold", "2.5")
+    status, _, err = run_cli("summarize", *files, "--threshold", "-1")
+    monkeypatch.setenv("UMBMARK_EXE", "/nonexistent/umbmark")
+    r = umbmark.summarize(files, threshold=2.5)
+    assert_same(r.to_dict(), cli)
+    assert r.command == "summarize" and r.threshold == 2.5 and len(r.robots) == 4
+    with pytest.raises(umbmark.UsageError) as e:
+        umbmark.summarize(*files, threshold=-1)
+    assert status == 2 and e.value.exit_status == 2 and str(e.value) == err.splitlines()[0]
 
 
 def test_import_optiodom_equals_cli(tmp_path):
@@ -225,8 +284,8 @@ def test_numbers_reach_the_command_exactly():
 
 
 def test_in_process_functions_need_no_executable(monkeypatch, tmp_path):
-    # No executable to run: calibrate, predict, simulate and diagnose run in
-    # this process (the other functions still run it: they fail here).
+    # No executable to run: calibrate, predict, simulate, diagnose and
+    # fit_noise run in this process (the other functions still run it: they fail here).
     monkeypatch.setenv("UMBMARK_EXE", "/nonexistent/umbmark")
     r = umbmark.calibrate(EXAMPLES / "endpoints.csv", robot=ROBOT, side=0.75, no_heldout=True)
     assert r.recommended == "skipped" and r.command == "calibrate"
