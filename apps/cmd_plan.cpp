@@ -6,6 +6,8 @@
 // `umbmark plan --check MANIFEST.toml [--kl K --kr K | --noise FIT.json]
 //   [--json FILE]`: what a recorded campaign determines, and the smallest
 // addition that separates what it confuses.
+// The command's logic is api::Plan / api::PlanCheck (lib/api/plan.hpp); this
+// file parses, calls them and prints.
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -18,12 +20,10 @@
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
+#include "api/plan.hpp"
 #include "commands.hpp"
 #include "common.hpp"
 #include "core/errors.hpp"
-#include "formats/file_text.hpp"
-#include "formats/data_file.hpp"
-#include "formats/manifest.hpp"
 #include "planning/check.hpp"
 #include "planning/plan.hpp"
 
@@ -45,61 +45,12 @@ struct PlanFlags {
   std::string check;  ///< --check MANIFEST
 };
 
-/// k_L, k_R of a `fit-noise --json` file.
-WheelNoise NoiseFromJson(const std::string& path) {
-  const std::string text = io::ReadWholeFile(path);
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path, 0, e.byte, fmt::format("not valid JSON: {}", e.what()));
-  }
-  auto get = [&](const char* key) {
-    if (!j.is_object() || !j.contains(key) || !j[key].is_number())
-      throw InputError(path, fmt::format("no number `{}` (expected the JSON of `umbmark fit-noise --json`)", key));
-    const double v = j[key].get<double>();
-    if (!std::isfinite(v) || v < 0.0) throw InputError(path, fmt::format("`{}` = {} must be a finite number >= 0", key, v));
-    return v;
-  };
-  return {get("k_L"), get("k_R")};
-}
+api::PlanNoise Noise(const PlanFlags& f) { return {f.k_L, f.k_R, f.noise_json}; }
 
-planning::PlanOptions LibraryOptions(const PlanFlags& f) {
-  planning::PlanOptions o;
-  o.robot = f.robot.Resolve();
-  if (!f.noise_json.empty()) {
-    if (f.k_L || f.k_R) throw InvalidOptions("give the wheel noise either as --noise FIT.json or as --kl/--kr, not both");
-    o.noise = NoiseFromJson(f.noise_json);
-  } else {
-    if (!f.k_L || !f.k_R) throw InvalidOptions("the wheel noise is needed: --kl K --kr K, or --noise FIT.json");
-    o.noise = {*f.k_L, *f.k_R};
-  }
-  o.ground_truth = *planning::GroundTruthKindFromString(f.ground_truth);
-  o.gt_sigma_xy_m = f.gt_sigma_xy;
-  o.gt_sigma_theta_rad = f.gt_sigma_theta;
-  o.target_E_d = f.target_E_d;
-  o.target_E_b = f.target_E_b;
-  o.target_scale = f.target_scale;
-  o.target_k = f.target_k;
-  o.max_side_m = f.max_side;
-  o.max_time_s = f.max_time;
-  o.timing.speed_m_s = f.speed;
-  o.timing.turn_rate_rad_s = f.turn_rate;
-  o.timing.pause_s = f.pause;
-  o.rate_hz = f.rate;
-  if (auto e = o.Check(); !e.empty()) throw InvalidOptions(e);
-  return o;
-}
+api::PlanTiming Timing(const PlanFlags& f) { return {f.speed, f.turn_rate, f.pause, f.rate}; }
 
-nlohmann::json JsonDesign(const planning::PlanDesign& d) {
-  return {{"square_side_m", d.square_side_m},
-          {"runs_cw", d.runs_cw},
-          {"runs_ccw", d.runs_ccw},
-          {"back_and_forth_runs", d.back_and_forth_runs},
-          {"back_and_forth_length_m", d.back_and_forth_length_m},
-          {"free_paths", d.free_paths},
-          {"pause_s", d.pause_s},
-          {"time_s", d.time_s}};
+api::RobotSource Robot(const RobotFlags& r) {
+  return {r.robot_file, r.wheelbase_m, r.diameter_left_m, r.diameter_right_m, r.ticks_per_rev};
 }
 
 /// (name, predicted, target) of the five quantities.
@@ -110,28 +61,6 @@ std::vector<std::tuple<const char*, std::optional<double>, std::optional<double>
           {"scale", h.scale, o.target_scale},
           {"k_L", h.k_L, o.target_k},
           {"k_R", h.k_R, o.target_k}};
-}
-
-nlohmann::json JsonMotions(const std::vector<planning::DesignMotion>& motions) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const auto& dm : motions) {
-    const planning::Motion& m = dm.motion;
-    nlohmann::json j = {{"kind", planning::MotionKindToString(m.kind)}};
-    switch (m.kind) {
-      case planning::Motion::Kind::kLine: j["distance_m"] = m.distance_m; j["speed"] = m.speed; break;
-      case planning::Motion::Kind::kTurn: j["angle_rad"] = m.angle_rad; j["speed"] = m.speed; break;
-      case planning::Motion::Kind::kArc:
-        j["radius_m"] = m.radius_m;
-        j["angle_rad"] = m.angle_rad;
-        j["speed"] = m.speed;
-        break;
-      case planning::Motion::Kind::kPause: j["duration_s"] = m.duration_s; break;
-    }
-    j["run"] = dm.run;
-    j["experiment"] = planning::RunKindToString(dm.kind);
-    out.push_back(j);
-  }
-  return out;
 }
 
 void PrintPlan(const planning::PlanResult& r, const planning::PlanOptions& o) {
@@ -161,15 +90,6 @@ void PrintPlan(const planning::PlanResult& r, const planning::PlanOptions& o) {
   for (const auto& n : r.notes) fmt::print("  note: {}\n", n);
   fmt::print("Next: drive it (--motions FILE.json lists the motions), then `umbmark calibrate` and `umbmark plan "
              "--check` on the recording.\n");
-}
-
-/// Names of the quantities with a half-width in `h`, as JSON.
-nlohmann::json JsonHalfWidths(const planning::HalfWidths& h) {
-  nlohmann::json j = nlohmann::json::object();
-  for (const auto& [name, v] : {std::pair{"E_d", h.E_d}, std::pair{"E_b", h.E_b}, std::pair{"scale", h.scale},
-                                std::pair{"k_L", h.k_L}, std::pair{"k_R", h.k_R}})
-    if (v) j[name] = JsonNumber(*v);
-  return j;
 }
 
 void PrintCheck(const std::string& manifest, const planning::CheckResult& r) {
@@ -203,61 +123,16 @@ int RunCheck(const PlanFlags& f) {
   CommandOutputs().AddOutput("--json", f.json.path);
   CommandOutputs().Check();
   if (!f.motions.empty()) throw InvalidOptions("--motions writes a planned design; it does not go with --check");
-  if (!io::IsManifestPath(f.check)) throw InvalidOptions(fmt::format("--check {}: expected a campaign manifest (.toml)", f.check));
-  const Manifest m = io::ReadManifest(f.check);
-  const RobotParams robot = f.robot.Resolve(m.robot);
-  planning::CheckOptions o;
-  if (!f.noise_json.empty()) {
-    if (f.k_L || f.k_R) throw InvalidOptions("give the wheel noise either as --noise FIT.json or as --kl/--kr, not both");
-    o.noise = NoiseFromJson(f.noise_json);
-  } else if (f.k_L || f.k_R) {
-    if (!f.k_L || !f.k_R) throw InvalidOptions("--kl and --kr go together");
-    o.noise = WheelNoise{*f.k_L, *f.k_R};
-  }
-  if (m.ground_truth) o.ground_truth = planning::GroundTruthModel{true, m.ground_truth->sigma_xy_m, m.ground_truth->sigma_theta_rad};
-  if (f.gt_sigma_xy || f.gt_sigma_theta) {
-    planning::GroundTruthModel g = o.ground_truth.value_or(planning::GroundTruthModel{});
-    if (f.gt_sigma_xy) g.sigma_xy_m = *f.gt_sigma_xy;
-    if (f.gt_sigma_theta) g.sigma_theta_rad = *f.gt_sigma_theta;
-    o.ground_truth = g;
-  }
-  o.timing.speed_m_s = f.speed;
-  o.timing.turn_rate_rad_s = f.turn_rate;
-  o.timing.pause_s = f.pause;
-  o.rate_hz = f.rate;
-  std::vector<io::RunFile> files;
-  files.reserve(m.experiments.size());
-  std::vector<planning::CheckExperiment> experiments;
-  for (const auto& e : m.experiments) files.push_back(io::ReadRunFile(e.resolved_file));
-  for (std::size_t i = 0; i < m.experiments.size(); ++i) {
-    const auto& e = m.experiments[i];
-    planning::CheckExperiment x{e.kind, e.side_m, e.distance_m, e.resolved_file, nullptr, nullptr};
-    if (auto* t = std::get_if<TrajectoryData>(&files[i])) x.trajectories = t;
-    else x.endpoints = &std::get<EndpointData>(files[i]);
-    experiments.push_back(x);
-  }
-  const planning::CheckResult r = planning::CheckCampaign(robot, experiments, o);
-  nlohmann::json conf = nlohmann::json::array();
-  for (const auto& c : r.cannot_separate)
-    conf.push_back({{"what", c.what}, {"kind", c.kind}, {"add", c.add}, {"correlation", c.correlation}});
-  nlohmann::json j = {{"input", f.check},
-                      {"predicted_ci95", JsonHalfWidths(r.predicted)},
-                      {"cannot_separate", conf},
-                      {"method", r.method},
-                      {"k_L", r.noise.k_L},
-                      {"k_R", r.noise.k_R},
-                      {"noise_fitted", r.noise_fitted},
-                      {"calibration_noise", {{"k_L", r.calibration_noise.k_L}, {"k_R", r.calibration_noise.k_R}}},
-                      {"ground_truth", {{"along_path", r.ground_truth.along_path},
-                                        {"sigma_xy_m", r.ground_truth.sigma_xy_m},
-                                        {"sigma_theta_rad", r.ground_truth.sigma_theta_rad}}},
-                      {"square_runs_cw", r.square_runs_cw},
-                      {"square_runs_ccw", r.square_runs_ccw},
-                      {"other_runs", r.other_runs},
-                      {"notes", r.notes},
-                      {"warnings", nlohmann::json::array()}};
-  if (f.json.PrintText()) PrintCheck(f.check, r);
-  if (!f.json.path.empty()) f.json.EmitAndListOutputs(j, {});
+  api::PlanCheckOptions o;
+  o.manifest = f.check;
+  o.robot = Robot(f.robot);
+  o.noise = Noise(f);
+  o.gt_sigma_xy_m = f.gt_sigma_xy;
+  o.gt_sigma_theta_rad = f.gt_sigma_theta;
+  o.timing = Timing(f);
+  const api::PlanCheckResult r = api::PlanCheck(o);
+  if (f.json.PrintText()) PrintCheck(f.check, r.check);
+  if (!f.json.path.empty()) f.json.EmitAndListOutputs(api::ToJson(r), {});
   return 0;
 }
 
@@ -267,40 +142,28 @@ int RunPlan(const PlanFlags& f) {
   CommandOutputs().AddOutput("--json", f.json.path);
   CommandOutputs().AddOutput("--motions", f.motions);
   CommandOutputs().Check();
-  const planning::PlanOptions o = LibraryOptions(f);
-  const planning::PlanResult r = planning::Plan(o);
-  if (!r.ok()) throw QualityGateError("umbmark plan: target cannot be met: " + r.unmet);
-  nlohmann::json pred = nlohmann::json::object(), other = nlohmann::json::object(), targets = nlohmann::json::object();
-  for (const auto& [name, p, target] : Quantities(r.predicted, o)) {
-    if (target) {
-      pred[name] = p ? JsonNumber(*p) : nullptr;
-      targets[name] = *target;
-    } else if (p) {
-      other[name] = *p;
-    }
-  }
-  const planning::GroundTruthModel gt = o.GroundTruth();
-  nlohmann::json j = {{"design", JsonDesign(r.design)},
-                      {"predicted_ci95", pred},
-                      {"targets", targets},
-                      {"also_predicted_ci95", other},
-                      {"binding", r.binding},
-                      {"method", r.method},
-                      {"ground_truth", {{"kind", planning::GroundTruthKindToString(o.ground_truth)},
-                                        {"sigma_xy_m", gt.sigma_xy_m},
-                                        {"sigma_theta_rad", gt.sigma_theta_rad}}},
-                      {"k_L", o.noise.k_L},
-                      {"k_R", o.noise.k_R},
-                      {"notes", r.notes},
-                      {"warnings", nlohmann::json::array()}};
-  if (f.json.PrintText()) PrintPlan(r, o);
+  api::PlanOptions o;
+  o.robot = Robot(f.robot);
+  o.noise = Noise(f);
+  o.ground_truth = f.ground_truth;
+  o.gt_sigma_xy_m = f.gt_sigma_xy;
+  o.gt_sigma_theta_rad = f.gt_sigma_theta;
+  o.target_E_d = f.target_E_d;
+  o.target_E_b = f.target_E_b;
+  o.target_scale = f.target_scale;
+  o.target_k = f.target_k;
+  o.max_side_m = f.max_side;
+  o.max_time_s = f.max_time;
+  o.timing = Timing(f);
+  const api::PlanResult r = api::Plan(o);
+  if (f.json.PrintText()) PrintPlan(r.plan, r.options);
   std::vector<std::string> written;
   if (!f.motions.empty()) {
-    CommandOutputs().Write(f.motions, DumpJson(JsonMotions(planning::DesignMotions(r.design, o))) + "\n");
+    CommandOutputs().Write(f.motions, api::PlanMotionsJson(r));
     written.push_back(f.motions + " (motions)");
   }
   if (!f.json.path.empty()) {
-    f.json.EmitAndListOutputs(j, written);
+    f.json.EmitAndListOutputs(api::ToJson(r), written);
   } else {
     PrintWritten(written, true);
   }

@@ -1,5 +1,5 @@
 // The library API of the commands (lib/api, installed as include/umbmark/):
-// evaluate, fit-noise, import and summarize called as functions give the
+// evaluate, fit-noise, import, plan and summarize called as functions give the
 // command line's JSON key for key and number for number (the JSON of a
 // separate `umbmark` process), their options name the bad field, and the
 // numbers they return agree with what follows from them (a summary is the
@@ -15,6 +15,7 @@
 #include "api/evaluate.hpp"
 #include "api/fit_noise.hpp"
 #include "api/import.hpp"
+#include "api/plan.hpp"
 #include "api/summarize.hpp"
 #include "core/errors.hpp"
 #include "formats/robot_toml.hpp"
@@ -157,4 +158,60 @@ TEST_CASE("api::Summarize gives summarize's JSON and CSV", "[api][fleet]") {
   bad.fleet.threshold = -1.0;
   CHECK_THAT(bad.Check(), Catch::Contains("threshold"));
   CHECK_THROWS_AS(api::Summarize(bad), InvalidOptions);
+}
+
+TEST_CASE("api::Plan gives plan's JSON and motions, api::PlanCheck plan --check's JSON", "[api][plan]") {
+  const fs::path dir = TempDir("api-plan");
+  api::PlanOptions o;
+  o.robot.robot_file = (kEx / "robot.toml").string();
+  o.noise.k_L = 1e-3;
+  o.noise.k_R = 8e-4;
+  o.target_E_d = 5e-4;
+  o.target_E_b = 2e-3;
+  o.target_k = 2e-4;
+  o.max_side_m = 2.0;
+  const api::PlanResult r = api::Plan(o);
+  CHECK(RoundTrip(api::ToJson(r)) ==
+        Cli("plan --robot " + Q(kEx / "robot.toml") + " --kl 1e-3 --kr 8e-4 --target-E_d 5e-4 --target-E_b 2e-3 "
+            "--target-k 2e-4 --max-side 2 --motions " + Q(dir / "cli-motions.json")));
+  api::WritePlanMotions(r, (dir / "api-motions.json").string());
+  CHECK(Slurp((dir / "api-motions.json").string()) == Slurp((dir / "cli-motions.json").string()));
+  // Every targeted quantity is met, and the one that binds is a target.
+  for (const auto& [name, target] : r.targets) {
+    INFO(name);
+    REQUIRE(r.predicted_ci95.at(name));
+    CHECK(*r.predicted_ci95.at(name) <= target);
+  }
+  CHECK(r.targets.size() == 4);  // E_d, E_b, k_L, k_R (--target-k is both wheels)
+  CHECK(r.design.square_side_m <= 2.0);
+
+  api::PlanOptions bad = o;
+  bad.noise.noise_file = "fit.json";
+  CHECK_THAT(bad.Check(), Catch::Contains("not both"));
+  bad = o;
+  bad.noise.k_R.reset();
+  CHECK_THAT(bad.Check(), Catch::Contains("wheel noise is needed"));
+  bad = o;
+  bad.ground_truth = "laser";
+  CHECK_THAT(bad.Check(), Catch::StartsWith("--ground-truth"));
+  bad = o;
+  bad.timing.speed_m_s = 0.0;
+  CHECK_THAT(bad.Check(), Catch::StartsWith("--speed"));
+  CHECK_THROWS_AS(api::Plan(bad), InvalidOptions);
+
+  api::PlanCheckOptions c;
+  c.manifest = (kEx / "calibrate.toml").string();
+  c.noise.k_L = 2.29e-4;
+  c.noise.k_R = 1.15e-3;
+  const api::PlanCheckResult cr = api::PlanCheck(c);
+  CHECK(RoundTrip(api::ToJson(cr)) == Cli("plan --check " + Q(kEx / "calibrate.toml") + " --kl 2.29e-4 --kr 1.15e-3"));
+  CHECK(cr.k_L == 2.29e-4);
+  CHECK_FALSE(cr.noise_fitted);
+  CHECK(cr.square_runs_cw + cr.square_runs_ccw > 0);
+  api::PlanCheckOptions bad_check = c;
+  bad_check.manifest = (kEx / "square_ticks.csv").string();
+  CHECK_THAT(bad_check.Check(), Catch::StartsWith("--check"));
+  bad_check = c;
+  bad_check.noise.k_R.reset();
+  CHECK_THAT(bad_check.Check(), Catch::Contains("--kl and --kr go together"));
 }

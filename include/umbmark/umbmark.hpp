@@ -1,5 +1,5 @@
 // umbmark's public API in one include: calibrate, refine, evaluate,
-// fit-noise, import, predict, simulate, diagnose, summarize, io. Link umbmark::umbmark (CMake:
+// fit-noise, import, plan, predict, simulate, diagnose, summarize, io. Link umbmark::umbmark (CMake:
 // find_package(umbmark)) or `pkg-config --cflags --libs umbmark`.
 // Only the declarations these headers name are the API; the headers under
 // umbmark/detail/ they pull in are internals and may change.
@@ -11,6 +11,7 @@
 #include "umbmark/fit_noise.hpp"
 #include "umbmark/import.hpp"
 #include "umbmark/io.hpp"
+#include "umbmark/plan.hpp"
 #include "umbmark/predict.hpp"
 #include "umbmark/refine.hpp"
 #include "umbmark/simulate.hpp"
