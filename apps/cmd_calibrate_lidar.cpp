@@ -2,20 +2,20 @@
 //   --robot R.toml [--imu TOPIC] [--tf-static TOPIC] [--distance-m D] [--ros2 FILE] [--json FILE]`:
 // the wheels, the lidar's mounting pose, the scan clock and the gyro jointly
 // from one ordinary drive (contract section "Calibration from a bag without
-// motion capture"). Reads with import/lidar_drive.hpp, computes with
-// calibration/lidar_calibrate.hpp, prints.
+// motion capture"). The command's logic is api::CalibrateLidar
+// (lib/api/calibrate_lidar.hpp); this file parses, calls it and prints.
 #include <cmath>
 #include <memory>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "api/calibrate_lidar.hpp"
 #include "calibration/lidar_calibrate.hpp"
 #include "commands.hpp"
 #include "common.hpp"
 #include "core/angles.hpp"
 #include "core/errors.hpp"
-#include "formats/ros2_params.hpp"
 #include "import/lidar_drive.hpp"
 
 namespace umbmark::cli {
@@ -30,98 +30,6 @@ struct CalibrateLidarOptions {
   std::string controller = "diff_drive_controller";
   JsonFlag json;
 };
-
-calibration::LidarCalibrationInput ToInput(const io::rosbag2::LidarDrive& d, const RobotParams& robot,
-                                           std::optional<double> distance_m) {
-  calibration::LidarCalibrationInput in;
-  in.wheels.reserve(d.wheels.size());
-  for (const auto& w : d.wheels) in.wheels.push_back({w.t_ns, w.left_m, w.right_m});
-  in.scans = d.scans;
-  in.gyro = d.gyro;
-  in.nominal = robot;
-  if (d.mount) in.tf_mount = calibration::StaticMount{d.mount->pose, d.mount->upside_down, d.mount->frames};
-  in.distance_m = distance_m;
-  return in;
-}
-
-nlohmann::json Interval(const std::array<double, 2>& a) { return {JsonNumber(a[0]), JsonNumber(a[1])}; }
-
-nlohmann::json ToJson(const calibration::LidarCalibration& r, const io::rosbag2::LidarDrive& d) {
-  nlohmann::json j;
-  j["parameters"] = JsonParams(r.parameters);
-  j["ros2_multipliers"] = {{"wheel_separation_multiplier", JsonNumber(r.wheel_separation_multiplier)},
-                           {"left_wheel_radius_multiplier", JsonNumber(r.left_wheel_radius_multiplier)},
-                           {"right_wheel_radius_multiplier", JsonNumber(r.right_wheel_radius_multiplier)}};
-  j["lidar_mount"] = {{"x_m", JsonNumber(r.mount.x)},        {"y_m", JsonNumber(r.mount.y)},
-                      {"yaw_rad", JsonNumber(r.mount.theta)}, {"upside_down", r.upside_down},
-                      {"x_m_ci95", Interval(r.x_ci95)},       {"y_m_ci95", Interval(r.y_ci95)},
-                      {"yaw_rad_ci95", Interval(r.yaw_ci95)}, {"frame", d.scan_frame}};
-  if (d.mount) j["lidar_mount"]["tf_static"] = {{"x_m", JsonNumber(d.mount->pose.x)}, {"y_m", JsonNumber(d.mount->pose.y)},
-                                                {"yaw_rad", JsonNumber(d.mount->pose.theta)},
-                                                {"upside_down", d.mount->upside_down}, {"frames", d.mount->frames}};
-  j["scan_time_offset_s"] = JsonNumber(r.time_offset_s);
-  j["scan_time_offset_s_ci95"] = Interval(r.time_offset_ci95);
-  j["gyro_scale"] = r.gyro_scale ? JsonNumber(*r.gyro_scale) : nlohmann::json(nullptr);
-  j["gyro_bias_rad_s"] = r.gyro_bias_rad_s ? JsonNumber(*r.gyro_bias_rad_s) : nlohmann::json(nullptr);
-  j["gyro_time_offset_s"] = r.gyro_time_offset_s ? JsonNumber(*r.gyro_time_offset_s) : nlohmann::json(nullptr);
-  const std::size_t n = r.covariance_order.size();
-  nlohmann::json cov = nlohmann::json::array();
-  for (std::size_t i = 0; i < n; ++i) {
-    nlohmann::json row = nlohmann::json::array();
-    for (std::size_t k = 0; k < n; ++k) row.push_back(JsonNumber(r.covariance[i * n + k]));
-    cov.push_back(row);
-  }
-  j["covariance"] = cov;
-  j["covariance_order"] = r.covariance_order;
-  j["scale_source"] = r.scale_source;
-  nlohmann::json ex = nlohmann::json::object(), what = nlohmann::json::object();
-  for (const auto& e : r.excitation) {
-    ex[e.key] = calibration::ExcitationToString(e.level);
-    if (!e.what_to_drive.empty()) what[e.key] = e.what_to_drive;
-  }
-  j["excitation"] = ex;
-  j["what_to_drive"] = what;
-  j["drive"] = {{"duration_s", JsonNumber(r.duration_s)},      {"scans", r.scans},
-                {"measurements", r.measurements},              {"outliers", r.fit.outliers},
-                {"open_measurements", r.open_measurements},    {"lost_registrations", r.lost},
-                {"straight_m", JsonNumber(r.straight_m)},      {"turned_left_rad", JsonNumber(r.turned_left_rad)},
-                {"turned_right_rad", JsonNumber(r.turned_right_rad)},
-                {"registration_scale", JsonNumber(r.fit.registration_scale)},
-                {"wheel_noise_k", JsonNumber(r.fit.wheel_noise_k)}};
-  const auto& lin = r.linear.params;
-  j["linear_start"] = {{"wheelbase_m", JsonNumber(lin.wheelbase_m)},
-                       {"wheel_diameter_left_m", JsonNumber(lin.c_left * r.parameters.wheel_diameter_left_m / r.fit.params.c_left)},
-                       {"wheel_diameter_right_m", JsonNumber(lin.c_right * r.parameters.wheel_diameter_right_m / r.fit.params.c_right)},
-                       {"x_m", JsonNumber(lin.mount.x)}, {"y_m", JsonNumber(lin.mount.y)}, {"yaw_rad", JsonNumber(lin.mount.theta)}};
-  j["warnings"] = r.warnings;
-  return j;
-}
-
-// The --ros2 file: the multipliers, and the mount as a comment block.
-std::string Ros2File(const calibration::LidarCalibration& r, const io::rosbag2::LidarDrive& d, const RobotParams& robot,
-                     const std::string& controller) {
-  const std::string parent = d.mount ? d.mount->frames.substr(0, d.mount->frames.find(' ')) : "base_link";
-  const std::string child = d.scan_frame.empty() ? "laser" : d.scan_frame;
-  const double roll = r.upside_down ? kPi : 0.0;
-  const std::string z = d.mount ? fmt::format("{:.4f}", d.mount->z_m) : "Z";
-  std::vector<std::string> comment = {
-      fmt::format("ros2_control diff_drive_controller parameters from umbmark calibrate-lidar ({} scale)",
-                  r.scale_source == "distance_m" ? "measured distance" : "lidar ranges"),
-      "Load with: ros2 param load /" + controller + " FILE (or add to the controller's --param-file list)",
-      "",
-      fmt::format("The lidar's mount, fitted ({}; z is not seen by a planar drive: {}):", r.upside_down ? "upside down" : "right way up",
-                  d.mount ? "kept from /tf_static" : "replace Z by its height"),
-      fmt::format("  URDF: <joint name=\"{}_joint\" type=\"fixed\"><parent link=\"{}\"/><child link=\"{}\"/>", child, parent, child),
-      fmt::format("        <origin xyz=\"{:.4f} {:.4f} {}\" rpy=\"{:.6f} 0 {:.6f}\"/></joint>", r.mount.x, r.mount.y, z, roll,
-                  r.mount.theta),
-      fmt::format("  static transform: ros2 run tf2_ros static_transform_publisher --x {:.4f} --y {:.4f} --z {} --roll {:.6f} "
-                  "--pitch 0 --yaw {:.6f} --frame-id {} --child-frame-id {}",
-                  r.mount.x, r.mount.y, z, roll, r.mount.theta, parent, child),
-      fmt::format("  scan clock: header stamp - scan time = {:+.4f} s", r.time_offset_s)};
-  return io::FormatDiffDriveCalibration(
-      controller, {r.wheel_separation_multiplier, r.left_wheel_radius_multiplier, r.right_wheel_radius_multiplier}, robot,
-      comment);
-}
 
 void PrintText(const calibration::LidarCalibration& r) {
   const std::size_t n = r.covariance_order.size();
@@ -158,25 +66,28 @@ int RunCalibrateLidar(const CalibrateLidarOptions& o) {
   outs.AddOutput("--json", o.json.path);
   outs.AddOutput("--ros2", o.ros2);
   outs.Check();
-  const io::rosbag2::LidarDrive drive = io::rosbag2::ReadLidarDrive(o.bags, robot, o.read);
-  for (const auto& w : drive.warnings) fmt::print(stderr, "warning: {}\n", w);
-  const calibration::LidarCalibration r = calibration::CalibrateLidar(ToInput(drive, robot, o.distance_m));
-  for (const auto& w : r.warnings) fmt::print(stderr, "warning: {}\n", w);
-  if (o.json.PrintText()) PrintText(r);
-  nlohmann::json j = ToJson(r, drive);
-  if (!r.wheels_determined) {
+  api::CalibrateLidarOptions co;
+  co.bags = o.bags;
+  co.robot = robot;
+  co.read = o.read;
+  co.distance_m = o.distance_m;
+  co.controller = o.controller;
+  const api::CalibrateLidarResult r = api::CalibrateLidar(co);
+  for (const auto& w : r.recording.warnings) fmt::print(stderr, "warning: {}\n", w);
+  for (const auto& w : r.calibration.warnings) fmt::print(stderr, "warning: {}\n", w);
+  if (o.json.PrintText()) PrintText(r.calibration);
+  const nlohmann::json j = api::ToJson(r);
+  if (r.refused) {
     std::string advice;
-    for (const auto& e : r.excitation)
+    for (const auto& e : r.calibration.excitation)
       if (!e.what_to_drive.empty()) advice += "\n  " + e.what_to_drive;
-    j["refused"] = "the drive determines none of the wheel parameters";
     o.json.EmitAndListOutputs(j, {});
-    fmt::print(stderr, "umbmark: quality gate failed: the drive determines none of the wheel parameters; nothing is "
-                       "written to --ros2:{}\n", advice);
+    fmt::print(stderr, "umbmark: quality gate failed: {}; nothing is written to --ros2:{}\n", *r.refused, advice);
     return 3;
   }
   std::vector<std::string> written;
   if (!o.ros2.empty()) {
-    outs.Write(o.ros2, Ros2File(r, drive, robot, o.controller));
+    outs.Write(o.ros2, api::CalibrateLidarRos2(r));
     written.push_back(o.ros2 + " (ros2_control parameters and the lidar's mount)");
   }
   o.json.EmitAndListOutputs(j, written);

@@ -1,5 +1,5 @@
 // The library API of the commands (lib/api, installed as include/umbmark/):
-// evaluate, fit-noise, import, plan and summarize called as functions give the
+// calibrate-lidar, evaluate, fit-noise, import, plan and summarize called as functions give the
 // command line's JSON key for key and number for number (the JSON of a
 // separate `umbmark` process), their options name the bad field, and the
 // numbers they return agree with what follows from them (a summary is the
@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <string>
 
+#include "api/calibrate_lidar.hpp"
 #include "api/evaluate.hpp"
 #include "api/fit_noise.hpp"
 #include "api/import.hpp"
@@ -214,4 +215,37 @@ TEST_CASE("api::Plan gives plan's JSON and motions, api::PlanCheck plan --check'
   bad_check = c;
   bad_check.noise.k_R.reset();
   CHECK_THAT(bad_check.Check(), Catch::Contains("--kl and --kr go together"));
+}
+
+TEST_CASE("api::CalibrateLidar gives calibrate-lidar's JSON and --ros2 file", "[api][lidar]") {
+  const fs::path dir = TempDir("api-calibrate-lidar");
+  const fs::path lidar = kBags / "lidar";
+  api::CalibrateLidarOptions o;
+  o.bags = {(lidar / "drive_upside.mcap").string()};
+  o.robot = io::ReadRobotToml((lidar / "robot.toml").string());
+  o.read.scan_topic = "/scan";
+  o.read.wheels_topic = "/joint_states";
+  o.read.imu_topic = "/imu";
+  const api::CalibrateLidarResult r = api::CalibrateLidar(o);
+  CHECK(RoundTrip(api::ToJson(r)) ==
+        Cli("calibrate-lidar " + Q(lidar / "drive_upside.mcap") + " --scan /scan --wheels /joint_states --imu /imu --robot " +
+            Q(lidar / "robot.toml") + " --ros2 " + Q(dir / "cli.yaml")));
+  api::WriteCalibrateLidarRos2(r, (dir / "api.yaml").string());
+  CHECK(Slurp((dir / "api.yaml").string()) == Slurp((dir / "cli.yaml").string()));
+  CHECK_FALSE(r.refused);
+  CHECK(r.calibration.upside_down);
+  REQUIRE(r.calibration.gyro_scale);
+  // The ROS 2 multipliers are the fitted parameters over the recorded ones.
+  CHECK(r.calibration.wheel_separation_multiplier == Approx(r.calibration.parameters.wheelbase_m / o.robot.wheelbase_m));
+
+  api::CalibrateLidarOptions bad = o;
+  bad.read.odometry_topic = "/odom";
+  CHECK_THAT(bad.Check(), Catch::Contains("exactly one wheel source"));
+  bad = o;
+  bad.bags.clear();
+  CHECK_THAT(bad.Check(), Catch::StartsWith("bags:"));
+  bad = o;
+  bad.distance_m = -3.0;
+  CHECK_THAT(bad.Check(), Catch::StartsWith("--distance-m"));
+  CHECK_THROWS_AS(api::CalibrateLidar(bad), InvalidOptions);
 }

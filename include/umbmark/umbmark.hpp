@@ -1,4 +1,4 @@
-// umbmark's public API in one include: calibrate, refine, evaluate,
+// umbmark's public API in one include: calibrate, calibrate-lidar, refine, evaluate,
 // fit-noise, import, plan, predict, simulate, diagnose, summarize, io. Link umbmark::umbmark (CMake:
 // find_package(umbmark)) or `pkg-config --cflags --libs umbmark`.
 // Only the declarations these headers name are the API; the headers under
@@ -6,6 +6,7 @@
 #pragma once
 
 #include "umbmark/calibrate.hpp"
+#include "umbmark/calibrate_lidar.hpp"
 #include "umbmark/diagnose.hpp"
 #include "umbmark/evaluate.hpp"
 #include "umbmark/fit_noise.hpp"
