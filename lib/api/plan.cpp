@@ -243,7 +243,8 @@ PlanCheckResult PlanCheck(const PlanCheckOptions& options) {
 nlohmann::json ToJson(const PlanCheckResult& r) {
   nlohmann::json pred = nlohmann::json::object(), conf = nlohmann::json::array();
   for (const auto& [name, v] : r.predicted_ci95) pred[name] = JsonNumber(v);
-  for (const auto& c : r.cannot_separate) conf.push_back({{"what", c.what}, {"kind", c.kind}, {"add", c.add}, {"correlation", c.correlation}});
+  for (const auto& c : r.cannot_separate)
+    conf.push_back({{"what", c.what}, {"kind", c.kind}, {"add", c.add}, {"correlation", c.correlation}});
   return {{"input", r.input},
           {"predicted_ci95", pred},
           {"cannot_separate", conf},
