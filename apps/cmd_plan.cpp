@@ -53,16 +53,6 @@ api::RobotSource Robot(const RobotFlags& r) {
   return {r.robot_file, r.wheelbase_m, r.diameter_left_m, r.diameter_right_m, r.ticks_per_rev};
 }
 
-/// (name, predicted, target) of the five quantities.
-std::vector<std::tuple<const char*, std::optional<double>, std::optional<double>>> Quantities(
-    const planning::HalfWidths& h, const planning::PlanOptions& o) {
-  return {{"E_d", h.E_d, o.target_E_d},
-          {"E_b", h.E_b, o.target_E_b},
-          {"scale", h.scale, o.target_scale},
-          {"k_L", h.k_L, o.target_k},
-          {"k_R", h.k_R, o.target_k}};
-}
-
 void PrintPlan(const planning::PlanResult& r, const planning::PlanOptions& o) {
   const planning::GroundTruthModel gt = o.GroundTruth();
   const planning::PlanDesign& d = r.design;
@@ -81,7 +71,7 @@ void PrintPlan(const planning::PlanResult& r, const planning::PlanOptions& o) {
              o.timing.speed_m_s, o.timing.turn_rate_rad_s, o.timing.pause_s, o.timing.EndPause());
   fmt::print("  driving time {:.0f} s ({:.1f} min)\n", d.time_s, d.time_s / 60.0);
   fmt::print("Predicted 95 % half-widths (the estimate lies this close to the truth in 95 % of campaigns):\n");
-  for (const auto& [name, pred, target] : Quantities(r.predicted, o)) {
+  for (const auto& [name, pred, target] : api::PlanQuantities(r.predicted, o)) {
     if (!pred && !target) continue;
     fmt::print("  {:<6} {:>10}  {}{}\n", name, pred ? fmt::format("{:.3g}", *pred) : "undetermined",
                target ? fmt::format("target {:.3g}", *target) : "(not targeted)",

@@ -25,13 +25,7 @@ namespace {
 /// The calibrated robot of a `calibrate --json` file: what --ros2 used
 /// (outputs_use), else the refined result, else the classic one.
 RobotParams CalibratedRobot(const std::string& path) {
-  const std::string text = io::ReadWholeFile(path);
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path, 0, e.byte, fmt::format("not valid JSON: {}", e.what()));
-  }
+  const nlohmann::json j = ReadJsonFile(path);
   const nlohmann::json* p = nullptr;
   if (j.contains("outputs_use") && j["outputs_use"].contains("parameters")) p = &j["outputs_use"]["parameters"];
   else if (j.contains("refined") && j["refined"].contains("parameters")) p = &j["refined"]["parameters"];

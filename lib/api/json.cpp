@@ -3,9 +3,22 @@
 
 #include <cmath>
 
+#include <fmt/format.h>
+
+#include "core/errors.hpp"
 #include "core/utf8.hpp"
+#include "formats/file_text.hpp"
 
 namespace umbmark::api {
+
+nlohmann::json ReadJsonFile(const std::string& path) {
+  const std::string text = io::ReadWholeFile(path);
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(path, 0, e.byte, fmt::format("not valid JSON: {}", e.what()));
+  }
+}
 
 nlohmann::json JsonNumber(double v) {
   if (!std::isfinite(v)) return nullptr;

@@ -22,6 +22,10 @@ nlohmann::json JsonParams(const RobotParams& p);
 nlohmann::json JsonEvaluationRuns(const EvaluationSummary& s);
 nlohmann::json JsonEvaluationSummary(const EvaluationSummary& s);
 
+/// The JSON document in `path` (another command's --json output); a file that
+/// is not JSON throws InputError naming the file and the byte offset.
+nlohmann::json ReadJsonFile(const std::string& path);
+
 /// `j` as text (pretty when indent >= 0), every string and key with invalid
 /// UTF-8 bytes escaped as \xNN, so a run id read from a file never breaks
 /// the JSON writer.

@@ -21,13 +21,7 @@ namespace {
 
 /// k_L, k_R of a `fit-noise --json` file.
 WheelNoise NoiseFromJson(const std::string& path) {
-  const std::string text = io::ReadWholeFile(path);
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path, 0, e.byte, fmt::format("not valid JSON: {}", e.what()));
-  }
+  const nlohmann::json j = ReadJsonFile(path);
   auto get = [&](const char* key) {
     if (!j.is_object() || !j.contains(key) || !j[key].is_number())
       throw InputError(path, fmt::format("no number `{}` (expected the JSON of `umbmark fit-noise --json`)", key));
@@ -63,8 +57,9 @@ void ApplyTiming(const PlanTiming& t, planning::MotionTiming& timing, double& ra
   rate_hz = t.rate_hz;
 }
 
-/// (name, predicted, target) of the five quantities.
-std::vector<std::tuple<const char*, std::optional<double>, std::optional<double>>> Quantities(
+}  // namespace
+
+std::vector<std::tuple<const char*, std::optional<double>, std::optional<double>>> PlanQuantities(
     const planning::HalfWidths& h, const planning::PlanOptions& o) {
   return {{"E_d", h.E_d, o.target_E_d},
           {"E_b", h.E_b, o.target_E_b},
@@ -72,8 +67,6 @@ std::vector<std::tuple<const char*, std::optional<double>, std::optional<double>
           {"k_L", h.k_L, o.target_k},
           {"k_R", h.k_R, o.target_k}};
 }
-
-}  // namespace
 
 std::string PlanOptions::Check() const {
   if (auto e = robot.Check(); !e.empty()) return e;
@@ -105,7 +98,7 @@ PlanResult Plan(const PlanOptions& options) {
   if (auto e = o.Check(); !e.empty()) throw InvalidOptions(e);
   r.plan = planning::Plan(o);
   if (!r.plan.ok()) throw QualityGateError("umbmark plan: target cannot be met: " + r.plan.unmet);
-  for (const auto& [name, p, target] : Quantities(r.plan.predicted, o)) {
+  for (const auto& [name, p, target] : PlanQuantities(r.plan.predicted, o)) {
     if (target) {
       r.predicted_ci95[name] = p;
       r.targets[name] = *target;

@@ -11,6 +11,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -151,5 +152,10 @@ PlanCheckResult PlanCheck(const PlanCheckOptions& options);
 
 /// The command's JSON document (`plan --check --json`).
 nlohmann::json ToJson(const PlanCheckResult& result);
+
+/// (name, predicted 95 % half-width, target) of the five quantities a plan
+/// can target: E_d, E_b, scale, k_L, k_R (the k target applies to both).
+std::vector<std::tuple<const char*, std::optional<double>, std::optional<double>>> PlanQuantities(
+    const planning::HalfWidths& h, const planning::PlanOptions& o);
 
 }  // namespace umbmark::api
