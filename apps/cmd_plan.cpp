@@ -179,9 +179,12 @@ Command SetupPlan(CLI::App& parent) {
   app->add_option("--gt-sigma-theta", f->gt_sigma_theta,
                   "Ground truth heading noise per pose [rad] (default mocap 0.001, scan and tape 0.005)")
       ->check(NonNegative());
-  app->add_option("--target-E_d", f->target_E_d, "95 % half-width wanted for E_d (a fraction, e.g. 0.0005)")
+  // The contract's spelling, and the one with '-' that Python's target_E_d
+  // keyword becomes (as E_d=... becomes simulate's --E-d).
+  app->add_option("--target-E_d,--target-E-d", f->target_E_d, "95 % half-width wanted for E_d (a fraction, e.g. 0.0005)")
       ->check(Positive());
-  app->add_option("--target-E_b", f->target_E_b, "95 % half-width wanted for E_b (a fraction)")->check(Positive());
+  app->add_option("--target-E_b,--target-E-b", f->target_E_b, "95 % half-width wanted for E_b (a fraction)")
+      ->check(Positive());
   app->add_option("--target-scale", f->target_scale, "95 % half-width wanted for the overall scale (a fraction)")
       ->check(Positive());
   app->add_option("--target-k", f->target_k, "95 % half-width wanted for k_L and k_R each [m^1/2]")->check(Positive());
