@@ -4,12 +4,14 @@
 // arguments named as the long options. Each returns a Result whose
 // to_dict() is the command's JSON; a failure raises InputError (exit 1),
 // UsageError (2) or QualityGateError (3) with the command's message.
-// `calibrate` runs in this process over the library (calibrate.hpp:
-// api::Calibrate, trajectory arrays handed over in memory). The others
-// still run the `umbmark` executable with `--json -` (the same parsing,
-// checks, computation and JSON as the command line, in a process of its
-// own); their trajectory arrays (`runs=`) are checked here, with messages
-// naming the array cell, and handed over as a temporary trajectory CSV.
+// calibrate, predict, simulate, diagnose, fit_noise and summarize run in
+// this process over the library (lib/api: api::Calibrate, ...; calibrate's
+// trajectory arrays handed over in memory; inprocess.cpp). The others, and
+// those calls that write a plot, report, --ros2 or CSV file, run the
+// `umbmark` executable with `--json -` (the same parsing, checks,
+// computation and JSON as the command line, in a process of its own); their
+// trajectory arrays (`runs=`) are checked here, with messages naming the
+// array cell, and handed over as a temporary trajectory CSV.
 #include <dlfcn.h>
 #include <poll.h>
 #include <spawn.h>
