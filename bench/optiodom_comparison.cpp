@@ -336,8 +336,12 @@ int Sessions(const fs::path& root) {
                      return RunCalibrateJob(in, CalibrateJobOptions{}).umbmark.corrected;
                    }});
   cands.push_back({"plain least squares", refined(PlainLeastSquaresOptions())});
-  for (double hw : {0.0, 1.0, 4.0}) {
+  for (double hw : {0.0, 1.0, 2.0, 4.0}) {
     cands.push_back({fmt::format("refined, first_sample, heading {}", hw), refined(with(StartPose::kFirstSample, hw))});
+  }
+  for (double hw : {0.0, 1.0, 2.0, 4.0}) {
+    cands.push_back(
+        {fmt::format("refined, standstill_mean, heading {}", hw), refined(with(StartPose::kStandstillMean, hw))});
   }
   for (double hw : {1.0, 4.0}) {
     cands.push_back({fmt::format("refined, fitted, heading {}", hw), refined(with(StartPose::kFitted, hw))});

@@ -94,7 +94,7 @@ int main(int argc, char** argv) {
                    }});
   cands.push_back({"plain_least_squares", refined(PlainLeastSquaresOptions())});
   for (StartPose sp : {StartPose::kSessionFrame, StartPose::kFirstSample, StartPose::kStandstillMean}) {
-    for (double hw : {0.0, 1.0, 2.0}) {
+    for (double hw : {0.0, 1.0, 2.0, 4.0}) {
       RefineOptions o;
       o.start_pose = sp;
       o.heading_weight = hw;
