@@ -178,3 +178,62 @@ TEST_CASE("plan --check on the June square sessions: predicted E_d and E_b inter
     if (std::string(what) == "positions") CHECK(ratio_eb >= 0.5);  // with heading: 0.44 (see above)
   }
 }
+
+TEST_CASE("plan and plan --check: hostile input names the file and line, exits 1 or 2, writes nothing", "[plan][cli]") {
+  const fs::path dir = TempDir("planhostile");
+  const std::string json = Q(dir / "out.json"), motions = Q(dir / "m.json");
+  auto nothing_written = [&] { return !fs::exists(dir / "out.json") && !fs::exists(dir / "m.json"); };
+  // A return-error campaign plan --check accepts as it is.
+  auto campaign = [&](const std::string& name, const std::string& toml_extra, const std::string& bad_row) {
+    const fs::path d = dir / name;
+    fs::create_directories(d);
+    std::ofstream csv((d / "sq.csv").string());
+    csv << "run,direction,ex_m,ey_m,etheta_rad\n";
+    for (int i = 0; i < 5; ++i) {
+      csv << fmt::format("{},cw,{:.4f},{:.4f},{:.4f}\n", i + 1, 0.010 + 0.001 * i, -0.004 + 0.0007 * i, 0.01);
+      csv << fmt::format("{},ccw,{:.4f},{:.4f},{:.4f}\n", i + 6, -0.006 + 0.0009 * i, 0.005 - 0.0006 * i, -0.01);
+    }
+    csv << bad_row;
+    std::ofstream((d / "campaign.toml").string())
+        << "[robot]\nwheelbase_m = 0.4\nwheel_diameter_left_m = 0.1\nwheel_diameter_right_m = 0.1\n"
+        << "\n[[experiment]]\nkind = \"square\"\n" << toml_extra << "file = \"sq.csv\"\n";
+    return Q(d / "campaign.toml");
+  };
+  REQUIRE(RunCli("plan --check " + campaign("good", "side_m = 2\n", "") + " --kl 1e-3 --kr 1e-3").status == 0);
+
+  // A CSV row with a word for a number: file, line and column.
+  const auto word = RunCli("plan --check " + campaign("word", "side_m = 2\n", "11,cw,abc,0.0,0.0\n") + " --json " + json);
+  CHECK(word.status == 1);
+  CHECK(word.err.find("sq.csv:12:") != std::string::npos);
+  // A truncated last row.
+  const auto cut = RunCli("plan --check " + campaign("cut", "side_m = 2\n", "11,cw\n") + " --json " + json);
+  CHECK(cut.status == 1);
+  CHECK(cut.err.find("sq.csv:12:") != std::string::npos);
+  // A manifest value of the wrong type: file, line and column.
+  const auto type = RunCli("plan --check " + campaign("type", "side_m = \"two\"\n", "") + " --json " + json);
+  CHECK(type.status == 1);
+  CHECK(type.err.find("campaign.toml:8:") != std::string::npos);
+  // A robot file that is not TOML, a noise file that is not JSON.
+  std::ofstream((dir / "bad_robot.toml").string()) << "wheelbase_m = 0.4\nwheel_diameter_left_m = = 0.1\n";
+  const auto robot = RunCli("plan --robot " + Q(dir / "bad_robot.toml") + " --kl 1e-3 --kr 1e-3 --target-E_d 1e-3 "
+                            "--json " + json + " --motions " + motions);
+  CHECK(robot.status == 1);
+  CHECK(robot.err.find("bad_robot.toml:2:") != std::string::npos);
+  std::ofstream((dir / "bad_noise.json").string()) << "{\"k_L\": 0.001,\n \"k_R\": }\n";
+  const auto noise = RunCli("plan --robot " + kRobot + " --noise " + Q(dir / "bad_noise.json") +
+                            " --target-E_d 1e-3 --json " + json + " --motions " + motions);
+  CHECK(noise.status == 1);
+  CHECK(noise.err.find("bad_noise.json") != std::string::npos);
+  CHECK(noise.err.find("line 2") != std::string::npos);
+  // Not numbers where numbers belong: usage errors.
+  CHECK(RunCli("plan --robot " + kRobot + " --kl nan --kr 1e-3 --target-E_d 1e-3 --json " + json).status == 2);
+  CHECK(RunCli("plan --robot " + kRobot + " --kl 1e-3 --kr 1e-3 --target-E_d inf --json " + json).status == 2);
+  CHECK(RunCli("plan --robot " + kRobot + " --kl 1e-3 --kr 1e-3 --target-E_d 1e-3 --max-side -1 --json " + json).status == 2);
+  CHECK(RunCli("plan --check " + campaign("good", "side_m = 2\n", "") + " --motions " + motions).status == 2);
+  // --motions into a folder that does not exist: exit 1 naming it, and the JSON is not written either.
+  const auto nodir = RunCli("plan --robot " + kRobot + " --kl 1e-3 --kr 1e-3 --target-E_d 1e-3 --json " + json +
+                            " --motions " + Q(dir / "no_such_dir" / "m.json"));
+  CHECK(nodir.status == 1);
+  CHECK(nodir.err.find("no_such_dir") != std::string::npos);
+  CHECK(nothing_written());
+}
