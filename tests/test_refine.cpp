@@ -497,8 +497,10 @@ TEST_CASE("refine defaults beat plain least squares across recording sessions of
   // square sessions of 23 June, the six circular and four ivanjko sessions
   // of 25 June: paths and days the fit never saw). Reference row: plain
   // least squares (PlainLeastSquaresOptions). The defaults must do better
-  // for every square session, and by at least 0.3 mm over all 52 pairs
-  // (measured: 10.89 vs 11.33 mm).
+  // for every square session, and by at least 0.1 mm over all 52 pairs
+  // (measured: 11.17 vs 11.33 mm with first_sample, heading weight 1, the
+  // defaults since issue 30's second round; the first-round session_frame
+  // gave 10.89 here and lost on another night: docs/calibration-comparison.md).
   const std::string root = std::string(UMBMARK_SOURCE_DIR) + "/data/optiodom-2020-06/";
   const std::vector<std::string> squares = {"square/230620202042", "square/230620202144", "square/230620202258",
                                             "square/230620202317"};
@@ -532,5 +534,5 @@ TEST_CASE("refine defaults beat plain least squares across recording sessions of
     refined_sum += refined;
     plain_sum += plain;
   }
-  CHECK(refined_sum / 4.0 < plain_sum / 4.0 - 3e-4);
+  CHECK(refined_sum / 4.0 < plain_sum / 4.0 - 1e-4);
 }

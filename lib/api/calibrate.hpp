@@ -77,8 +77,8 @@ struct CalibrateOptions {
   int samples_per_run = 100;               ///< [--samples-per-run] poses per trajectory run, 2 to 100000
   std::string sampling = "per_run";        ///< [--sampling] per_run | every_sample
   /// [--start-pose] first_sample | standstill_mean | fitted | session_frame
-  std::string start_pose = "session_frame";
-  double heading_weight = 2.0;             ///< [--heading-weight] wheelbases per radian, >= 0
+  std::string start_pose = "first_sample";
+  double heading_weight = 1.0;             ///< [--heading-weight] wheelbases per radian, >= 0
   /// [--use] the calibration --ros2, --plot and --report show:
   /// recommended (held-out comparison; classic when skipped) | classic |
   /// refined (needs refine).

@@ -190,17 +190,18 @@ struct RefineOptions {
   int samples_per_run = 100;
   /// See PoseSampling. Default kPerRun.
   PoseSampling sampling = PoseSampling::kPerRun;
-  /// See StartPose. Default kSessionFrame (chosen across recording
-  /// sessions: docs/calibration-comparison.md).
-  StartPose start_pose = StartPose::kSessionFrame;
+  /// See StartPose. Default kFirstSample: the smallest worst-case loss to
+  /// plain least squares across June days, simulated frame errors and the
+  /// issue's other night (docs/calibration-comparison.md, "Second round").
+  StartPose start_pose = StartPose::kFirstSample;
   /// Metres per radian for the heading residual; <= 0 means the reference
   /// wheelbase (a heading error of 1 rad counts like a position error of
   /// one wheelbase: the displacement of a wheel contact point). Default 0.
   double heading_length_m = 0.0;
   /// Multiplies the heading residual (h = heading_weight * heading length);
-  /// 0 = position-only residual. Default 2 (chosen across recording
-  /// sessions: docs/calibration-comparison.md).
-  double heading_weight = 2.0;
+  /// 0 = position-only residual. Default 1 (the smallest worst-case loss
+  /// to plain least squares: docs/calibration-comparison.md, "Second round").
+  double heading_weight = 1.0;
   /// Robust loss per sampled pose and its scale [m]. Default Huber, 0.02 m:
   /// about twice the path residual of a calibrated small robot, so ordinary
   /// poses stay quadratic and a bump or a tracking glitch counts linearly.
