@@ -719,3 +719,22 @@ TEST_CASE("umbmark diagnose: degenerate endpoint files are warned about in the J
   CHECK(single == 2);
   CHECK(r.err.find("warning: ") != std::string::npos);
 }
+
+TEST_CASE("diagnose: the next steps say how many more squares would determine a correction the runs do not",
+          "[diagnose][advice]") {
+  // plan --check's analysis (planning/advice.hpp) on the campaign: a 0.03 %
+  // diameter-ratio error is far inside what 5 + 5 noisy squares determine
+  // (their E_d half-width is of the order of 1e-3), a 1.2 % wheelbase error
+  // far outside it. So the next steps carry calibrate's record-more sentence
+  // for E_d and none for E_b.
+  Small s = MakeSmall(81);
+  s.sim.truth.E_d = 1.0003;
+  const DiagnoseSummary d = Diagnose(Build(s), Fast());
+  INFO("baseline E_d " << d.baseline.E_d << ", E_b " << d.baseline.E_b);
+  const auto said = [&](const std::string& head) {
+    return std::any_of(d.next_steps.begin(), d.next_steps.end(),
+                       [&](const std::string& t) { return t.rfind(head, 0) == 0; });
+  };
+  CHECK(said("E_d's correction"));
+  CHECK_FALSE(said("E_b's correction"));
+}

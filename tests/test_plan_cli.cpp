@@ -4,6 +4,7 @@
 // spread between the four June square sessions.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -236,4 +237,60 @@ TEST_CASE("plan and plan --check: hostile input names the file and line, exits 1
   CHECK(nodir.status == 1);
   CHECK(nodir.err.find("no_such_dir") != std::string::npos);
   CHECK(nothing_written());
+}
+
+TEST_CASE("calibrate --json: design_advice holds plan --check's analysis as data, the same as its sentences",
+          "[plan][cli][advice]") {
+  // Return errors of 4 + 4 squares whose centres of gravity lie within
+  // their scatter: the corrections classic UMBmark finds are not
+  // determined (E_d's +0.001 % by no practical design: N = 0; E_b's -0.28 %
+  // by 23 more runs per direction). Its half-width shrinks as 1/sqrt(n) with n runs per
+  // direction, so each record_more entry's half-width after its extra runs
+  // is the closed form h sqrt(4 / (4 + N)), and its warning sentence names
+  // the same N.
+  const fs::path dir = TempDir("design_advice");
+  std::ofstream((dir / "sq.csv").string()) << "run,direction,ex_m,ey_m,etheta_rad\n"
+                                              "1,cw,0.018,-0.002,0.010\n2,cw,-0.004,0.015,-0.012\n"
+                                              "3,cw,0.014,0.017,0.006\n4,cw,-0.002,-0.004,-0.003\n"
+                                              "5,ccw,-0.005,0.001,-0.009\n6,ccw,0.015,-0.016,0.011\n"
+                                              "7,ccw,-0.001,-0.018,-0.005\n8,ccw,0.016,0.005,0.004\n";
+  // --no-heldout: outputs_use is the classic correction (with the held-out
+  // comparison the recorded parameters win on such runs: nothing to advise).
+  const auto r = RunCli("calibrate " + Q(dir / "sq.csv") + " --robot " + kRobot + " --side 0.75 --no-heldout --json -");
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  REQUIRE(j.contains("design_advice"));
+  const auto& a = j["design_advice"];
+  REQUIRE(a["available"].get<bool>());
+  REQUIRE(a["cannot_separate"].is_array());
+  REQUIRE(a["record_more"].is_array());
+  REQUIRE_FALSE(a["record_more"].empty());
+  const auto& warnings = j["warnings"];
+  for (const auto& m : a["record_more"]) {
+    const std::string q = m["quantity"];
+    INFO(q);
+    CHECK((q == "E_d" || q == "E_b"));
+    const double h = m["half_width"], after = m["half_width_after"], corr = m["correction"];
+    const int n = m["extra_runs_per_direction"];
+    CHECK(h > 0.5 * std::abs(corr));  // listed because the runs do not determine it
+    if (n > 0) {
+      CHECK(after == Approx(h * std::sqrt(4.0 / (4.0 + n))).epsilon(1e-6));
+      CHECK(after <= 0.5 * std::abs(corr) * (1.0 + 1e-9));
+      CHECK(h * std::sqrt(4.0 / (4.0 + n - 1)) > 0.5 * std::abs(corr));  // the fewest: one run less is not enough
+      CHECK(m["side_m"].get<double>() == Approx(0.75));
+      CHECK(m["time_s"].get<double>() > 0.0);
+    }
+    const std::string head = q + "'s correction";
+    const auto said = std::find_if(warnings.begin(), warnings.end(), [&](const nlohmann::json& w) {
+      return w.get<std::string>().rfind(head, 0) == 0;
+    });
+    REQUIRE(said != warnings.end());
+    if (n > 0) CHECK(said->get<std::string>().find(fmt::format("record {} more square run(s)", n)) != std::string::npos);
+  }
+  for (const auto& c : a["cannot_separate"]) CHECK(c["kind"] == "parameters");
+  // Both branches: one correction no practical design determines, one that more runs do.
+  REQUIRE(a["record_more"].size() == 2);
+  CHECK(a["record_more"][0]["extra_runs_per_direction"] == 0);
+  CHECK(a["record_more"][1]["extra_runs_per_direction"].get<int>() > 0);
 }

@@ -325,7 +325,8 @@ CalibrateUnitResult Assess(const CalibrateInput& in, FittedUnit f, const Calibra
   u.model_check = CheckCentresAgainstModel(in, s.runs, r.refined ? r.refined->refined : s.corrected,
                                            jo.refine ? jo.refine->final_turn : true);
   u.warnings = TrustWarnings(r, u.heldout, u.model_check);
-  for (auto& m : planning::AdviseCalibration(in, u.outputs_use.parameters).messages) u.warnings.push_back(std::move(m));
+  u.design_advice = planning::AdviseCalibration(in, u.outputs_use.parameters);
+  u.warnings.insert(u.warnings.end(), u.design_advice.messages.begin(), u.design_advice.messages.end());
   u.warnings.insert(u.warnings.end(), f.gate.warnings.begin(), f.gate.warnings.end());
   if (r.refined && in.trajectories && !HasInteriorGroundTruth(*in.trajectories)) {
     u.warnings.push_back("ground truth only at the first and last sample of each run: the refined fit used the "

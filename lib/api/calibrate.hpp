@@ -33,6 +33,7 @@
 #include "calibration/calibrate_job.hpp"
 #include "calibration/heldout.hpp"
 #include "core/progress.hpp"
+#include "planning/advice.hpp"
 #include "core/runs.hpp"
 
 namespace umbmark::io {
@@ -154,6 +155,10 @@ struct CalibrateUnitResult {
   ModelCheck model_check;  ///< JSON null when not available
   OutputsUse outputs_use;
   std::vector<std::string> warnings;
+  /// plan --check's analysis of the unit's square runs (JSON
+  /// `design_advice`): the parameters they confuse and the runs that would
+  /// determine outputs_use's correction; its sentences are in `warnings`.
+  planning::DesignAdvice design_advice;
   /// UMBmark's summary (estimates, centres_of_gravity), the evaluation
   /// before/after (trajectories), the refined fit and its evaluation.
   CalibrateJobResult job;

@@ -68,6 +68,25 @@ nlohmann::json JsonHeldoutSummary(const HeldoutComparison& h) {
 
 /// JSON `evaluation`: the odometry against the ground truth before and
 /// after the classic correction (trajectory input).
+/// JSON `design_advice` (formats.md): the same analysis as plan --check's
+/// cannot_separate, and record_more.
+nlohmann::json JsonDesignAdvice(const planning::DesignAdvice& a) {
+  nlohmann::json conf = nlohmann::json::array(), more = nlohmann::json::array();
+  for (const auto& c : a.confusions)
+    conf.push_back({{"what", c.what}, {"kind", c.kind}, {"add", c.add}, {"correlation", c.correlation}});
+  for (const auto& m : a.check.record_more)
+    more.push_back({{"quantity", m.quantity},
+                    {"correction", m.correction},
+                    {"half_width", m.half_width},
+                    {"extra_runs_per_direction", m.extra_runs_per_direction},
+                    {"half_width_after", m.half_width_after},
+                    {"time_s", m.time_s},
+                    {"side_m", m.side_m}});
+  nlohmann::json j = {{"available", a.available}, {"cannot_separate", conf}, {"record_more", more}};
+  if (!a.available) j["note"] = a.note;
+  return j;
+}
+
 nlohmann::json JsonAfterCorrection(const AfterCorrection& a) {
   return {{"before", JsonEvaluationSummary(a.before)},
           {"after", JsonEvaluationSummary(a.after)},
@@ -137,6 +156,7 @@ nlohmann::json ToJson(const CalibrateUnitResult& u) {
                       {"why", u.outputs_use.why},
                       {"scale_source", u.outputs_use.scale_source}};
   j["warnings"] = u.warnings;
+  j["design_advice"] = JsonDesignAdvice(u.design_advice);
   if (r.evaluation) j["evaluation"] = JsonAfterCorrection(*r.evaluation);
   return j;
 }

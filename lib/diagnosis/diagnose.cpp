@@ -7,6 +7,7 @@
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <utility>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -552,7 +553,9 @@ namespace {
 /// `plan --check`'s analysis of the campaign (planning/advice.hpp), with
 /// the baseline's wheel noise: the effects its runs cannot tell apart and
 /// the smallest addition that separates each, added to `indistinguishable`
-/// (not for an effect the verdict names: the fits told it apart).
+/// (not for an effect the verdict names: the fits told it apart); and, in
+/// `next_steps`, how many more square runs would determine the baseline's
+/// E_d, E_b correction where these runs do not (calibrate's sentence).
 void AddDesignAdvice(const CampaignData& c, DiagnoseSummary& s) {
   std::vector<planning::CheckExperiment> x;
   for (std::size_t i = 0; i < c.experiments.size() && i < c.files.size(); ++i)
@@ -561,7 +564,11 @@ void AddDesignAdvice(const CampaignData& c, DiagnoseSummary& s) {
   planning::CheckOptions o;
   if (s.baseline.k_L > 0.0 && s.baseline.k_R > 0.0) o.noise = WheelNoise{s.baseline.k_L, s.baseline.k_R};
   if (c.ground_truth) o.ground_truth = planning::GroundTruthModel{true, c.ground_truth->sigma_xy_m, c.ground_truth->sigma_theta_rad};
-  for (const planning::Confusion& k : planning::Advise(c.robot, x, o, {}).check.cannot_separate) {
+  for (const auto& [E, into] : {std::pair{s.baseline.E_d, &o.correction_E_d}, std::pair{s.baseline.E_b, &o.correction_E_b}})
+    if (std::isfinite(E) && E > 0.0 && E != 1.0) *into = E;
+  const planning::DesignAdvice a = planning::Advise(c.robot, x, o, {});
+  for (const planning::RecordMore& m : a.check.record_more) s.next_steps.push_back(planning::RecordMoreMessage(m));
+  for (const planning::Confusion& k : a.check.cannot_separate) {
     const auto named = [&](const std::string& w) {
       return std::find(s.verdict_effects.begin(), s.verdict_effects.end(), w) != s.verdict_effects.end();
     };

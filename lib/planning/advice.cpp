@@ -26,7 +26,10 @@ DesignAdvice Advise(const RobotParams& robot, const std::vector<CheckExperiment>
   }
   a.available = true;
   for (const Confusion& c : a.check.cannot_separate)
-    if (std::find(kinds.begin(), kinds.end(), c.kind) != kinds.end()) a.messages.push_back(ConfusionMessage(c));
+    if (std::find(kinds.begin(), kinds.end(), c.kind) != kinds.end()) {
+      a.confusions.push_back(c);
+      a.messages.push_back(ConfusionMessage(c));
+    }
   for (const RecordMore& m : a.check.record_more) a.messages.push_back(RecordMoreMessage(m));
   return a;
 }

@@ -28,6 +28,8 @@ struct DesignAdvice {
   bool available = false;
   std::string note;  ///< why the analysis did not run (available false)
   CheckResult check;
+  /// check.cannot_separate of the kinds asked for: what `messages` says.
+  std::vector<Confusion> confusions;
   /// For a person, in this order: the confusions of the kinds asked for
   /// (ConfusionMessage), then the record_more sentences (RecordMoreMessage).
   std::vector<std::string> messages;
