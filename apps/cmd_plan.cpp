@@ -9,9 +9,11 @@
 // The command's logic is api::Plan / api::PlanCheck (lib/api/plan.hpp); this
 // file parses, calls them and prints.
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
+#include <system_error>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -126,12 +128,27 @@ int RunCheck(const PlanFlags& f) {
   return 0;
 }
 
+/// --json and --motions are written one after the other: a folder that
+/// does not exist is refused before either is written (and before the text),
+/// so a failed command leaves no output behind.
+void CheckOutputFolders(const std::vector<std::pair<const char*, std::string>>& outputs) {
+  for (const auto& [flag, path] : outputs) {
+    if (path.empty() || path == "-") continue;
+    const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+    std::error_code ec;
+    if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
+      throw InputError(path, fmt::format("{}: the folder '{}' does not exist; nothing was written", flag,
+                                         parent.string()));
+  }
+}
+
 int RunPlan(const PlanFlags& f) {
   if (!f.check.empty()) return RunCheck(f);
   RegisterInputs(f.noise_json.empty() ? std::vector<std::string>{} : std::vector<std::string>{f.noise_json}, &f.robot);
   CommandOutputs().AddOutput("--json", f.json.path);
   CommandOutputs().AddOutput("--motions", f.motions);
   CommandOutputs().Check();
+  CheckOutputFolders({{"--json", f.json.path}, {"--motions", f.motions}});
   api::PlanOptions o;
   o.robot = Robot(f.robot);
   o.noise = Noise(f);

@@ -237,6 +237,13 @@ TEST_CASE("plan and plan --check: hostile input names the file and line, exits 1
   CHECK(nodir.status == 1);
   CHECK(nodir.err.find("no_such_dir") != std::string::npos);
   CHECK(nothing_written());
+  // The other way round: --json into a missing folder leaves no motions file either.
+  const auto nojson = RunCli("plan --robot " + kRobot + " --kl 1e-3 --kr 1e-3 --target-E_d 1e-3 --json " +
+                             Q(dir / "no_such_dir" / "out.json") + " --motions " + motions);
+  CHECK(nojson.status == 1);
+  CHECK(nojson.err.find("no_such_dir") != std::string::npos);
+  CHECK(nojson.out.empty());
+  CHECK(nothing_written());
 }
 
 TEST_CASE("calibrate --json: design_advice holds plan --check's analysis as data, the same as its sentences",
