@@ -6,6 +6,7 @@
 #   0   core                          data types, angles, poses, errors
 #   1   stats, kinematics, scan       numerics; wheel travel -> pose; scan registration
 #   2   model                         the true robot and its controller
+#   2.5 effects                       one file per unmodelled effect (simulation and diagnosis use them)
 #   3   error_models, evaluation      noise propagation; return errors
 #   3.1 output, report                the file rooms: atomic writes, output sets, locks;
 #                                     SVG plots and HTML pages
@@ -28,7 +29,7 @@
 # Usage: check_layers.sh [repo root]   (exit 0 clean, 1 on a violation)
 set -euo pipefail
 root=${1:-$(cd "$(dirname "$0")/.." && pwd)}
-declare -A rank=([core]=0 [stats]=10 [kinematics]=10 [scan]=10 [model]=20 [error_models]=30 [evaluation]=30
+declare -A rank=([core]=0 [stats]=10 [kinematics]=10 [scan]=10 [model]=20 [effects]=25 [error_models]=30 [evaluation]=30
   [output]=31 [report]=31 [formats]=32 [ros2]=33 [ground_truth]=34 [import]=35
   [calibration]=40 [simulation]=40 [diagnosis]=50 [planning]=45 [api]=55 [apps]=60)
 declare -A file_room=([output]=1 [report]=1 [formats]=1 [ros2]=1 [ground_truth]=1 [import]=1)

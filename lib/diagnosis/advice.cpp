@@ -9,16 +9,20 @@
 #include <fmt/ranges.h>
 
 #include "diagnosis/diagnose.hpp"
+#include "effects/registry.hpp"
 
 namespace umbmark::diag {
 
 namespace {
 /// Scale and unit an engineer reads a parameter in.
 std::pair<double, const char*> ParamUnit(const std::string& name, const std::string& effect) {
-  // stop_slide: d [s^2/m] and a [s^2/rad] in their own units; its shape
-  // (arc, back) is a pure number.
-  if (effect == "stop_slide" && (name == "arc" || name == "back")) return {1.0, ""};
-  if (effect == "stop_slide" || name == "d") return {1.0, name == "a" ? " s^2/rad" : " s^2/m"};
+  // An effect's own reading of its parameter (where a name means two
+  // things: a slide's d and a, an asymmetry's a), else by the name.
+  if (const effects::Effect* e = effects::Find(effect)) {
+    const auto own = e->ParamUnit(name);
+    if (own.first > 0.0) return own;
+  }
+  if (name == "d") return {1.0, " s^2/m"};
   if (name == "dx" || name == "dy" || name == "sigma" || name == "sigma_xy") return {1e3, " mm"};
   if (name == "kappa" || name == "sigma_theta") return {1e3, " mrad"};
   if (name == "tau" || name == "tau_sd") return {1e3, " ms"};
@@ -102,78 +106,17 @@ std::vector<std::string> MissingDesign(const CampaignData& c) {
 }
 
 
+/// The campaign and baseline numbers an effect's advice needs.
+effects::AdviceContext AdviceOf(const CampaignData& c, const DiagnoseSummary& s) {
+  return {c.robot, s.baseline.E_d, s.baseline.E_b, s.baseline.runs};
+}
+
 /// The concrete change for one named effect, in the numbers the explanation
 /// fitted (the same values as its table, the JSON and the simulate command):
-/// what to set on the robot, in the motion capture or in the simulation.
+/// what to set on the robot, in the motion capture or in the simulation
+/// (each effect's own, Effect::ConcreteChange).
 std::string ConcreteChange(const ExplanationStep& step, const CampaignData& c, const DiagnoseSummary& s) {
-  const auto p = [&](const char* k) {
-    const auto it = step.params.find(k);
-    return it == step.params.end() ? 0.0 : it->second;
-  };
-  const RobotParams& robot = c.robot;
-  // The baseline's E_d, E_b turned into wheel diameters (contract: c_L =
-  // 2 / (E_d + 1), c_R = 2 / (1 / E_d + 1)) and the wheelbase E_b b.
-  const double cl = 2.0 / (s.baseline.E_d + 1.0), cr = 2.0 / (1.0 / s.baseline.E_d + 1.0);
-  switch (step.effect) {
-    case sim::EffectKind::kScaleError: {
-      const double f = 1.0 + p("s");
-      return fmt::format(
-          "Wheel diameters: both wheels are {:.2f}% {} than the model's. Set wheel_diameter_left_m = {:.5f} and "
-          "wheel_diameter_right_m = {:.5f} (the diameters x (1 + s) = x {:.5f}, with the fitted ratio E_d = {:.5f}; "
-          "now {:.5f} / {:.5f}), wheelbase_m = {:.5f} (E_b = {:.5f}); or re-measure the wheels on a tape-measured "
-          "straight run.",
-          100.0 * std::abs(p("s")), p("s") >= 0.0 ? "larger" : "smaller", cl * robot.wheel_diameter_left_m * f,
-          cr * robot.wheel_diameter_right_m * f, f, s.baseline.E_d, robot.wheel_diameter_left_m,
-          robot.wheel_diameter_right_m, s.baseline.E_b * robot.wheelbase_m, s.baseline.E_b);
-    }
-    case sim::EffectKind::kGtOffset:
-      return fmt::format(
-          "Motion capture: the tracked point is at (dx, dy) = ({:+.1f}, {:+.1f}) mm from the axle midpoint in the "
-          "robot frame (x forward, y left). Enter that offset as the marker's position in the rigid body (move the "
-          "rigid body's origin by ({:+.1f}, {:+.1f}) mm, onto the axle midpoint), or subtract it from the recorded "
-          "poses.",
-          1e3 * p("dx"), 1e3 * p("dy"), -1e3 * p("dx"), -1e3 * p("dy"));
-    case sim::EffectKind::kTimeOffset:
-      return fmt::format(
-          "Clock: the ground truth {} the encoders by {:.1f} ms (a sample stamped t shows the pose at t {} {:.1f} ms). "
-          "Shift the ground-truth timestamps by {:+.1f} ms (or the encoders' by {:+.1f} ms), or synchronise the two "
-          "clocks.",
-          p("tau") >= 0.0 ? "lags" : "leads", 1e3 * std::abs(p("tau")), p("tau") >= 0.0 ? "-" : "+",
-          1e3 * std::abs(p("tau")), -1e3 * p("tau"), 1e3 * p("tau"));
-    case sim::EffectKind::kRunTimeOffset:
-      return fmt::format(
-          "Clock per run: each run's ground truth is offset from its encoders by a different amount (sd {:.0f} ms "
-          "over the runs). Synchronise the clocks at the start of every recording (e.g. align on the first motion).",
-          1e3 * p("tau_sd"));
-    case sim::EffectKind::kTurnScrub:
-      return fmt::format(
-          "Spot turns turn {:.1f}% less than the wheels say (k = {:.4f}): the wheels scrub. For spot turns the "
-          "effective wheelbase is {:.5f} m (wheelbase / (1 - k)); model it as turn_scrub in the simulation, or "
-          "turn while driving.",
-          100.0 * p("k"), p("k"), s.baseline.E_b * robot.wheelbase_m / (1.0 - p("k")));
-    case sim::EffectKind::kDirectionAsymmetry:
-      return fmt::format("Driving backward the wheels travel {:.2f}% {} per turn than forward: calibrate the backward "
-                         "direction separately (or check for backlash in the gears).",
-                         100.0 * std::abs(p("a")), p("a") >= 0.0 ? "more" : "less");
-    case sim::EffectKind::kCastorKick:
-      return fmt::format("Castor: the heading jumps by {:.1f} mrad at every start from standstill (sign with the drive "
-                         "direction). Check the castor's swivel and play, or start more gently.",
-                         1e3 * p("kappa"));
-    case sim::EffectKind::kCastorSwivel:
-      return fmt::format("Swivel castor: after a spot turn the heading jumps by {:.1f} mrad (with the turn's sign) at "
-                         "the next start. A castor with less trail or play, or a short straight creep after turns.",
-                         1e3 * p("kappa"));
-    case sim::EffectKind::kParameterDrift:
-      return fmt::format("The right wheel's diameter drifts by {:.3g}% per run ({:.2g}% over the {} runs): tyre wear, "
-                         "pressure or temperature. Re-calibrate between sessions, or let the wheels warm up first.",
-                         100.0 * p("r"), 100.0 * p("r") * std::max(0, s.baseline.runs - 1), s.baseline.runs);
-    case sim::EffectKind::kStopSlide:
-      return fmt::format("Stops: the chassis slides on after the wheels stop (d = {:.3g} s^2/m: {:.1f} mm at 0.5 m/s). "
-                         "Ramp the speed down before stops, or add grip.",
-                         p("d"), 1e3 * p("d") * 0.25);
-    default:
-      return {};
-  }
+  return effects::Of(step.effect).ConcreteChange(step.params, AdviceOf(c, s));
 }
 }  // namespace
 
@@ -265,56 +208,10 @@ std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSu
 namespace {
 
 /// One named effect as a plain statement with the explained model's numbers.
-std::string PlainProblem(const ExplanationStep& step) {
-  const auto p = [&](const char* k) {
-    const auto it = step.params.find(k);
-    return it == step.params.end() ? 0.0 : it->second;
-  };
-  switch (step.effect) {
-    case sim::EffectKind::kScaleError:
-      return fmt::format("both wheels are {:.2f}% {} than the model says", 100.0 * std::abs(p("s")),
-                         p("s") >= 0.0 ? "larger" : "smaller");
-    case sim::EffectKind::kGtOffset:
-      return fmt::format("the motion capture tracks a point ({:+.1f}, {:+.1f}) mm from the axle midpoint", 1e3 * p("dx"),
-                         1e3 * p("dy"));
-    case sim::EffectKind::kTimeOffset:
-      return fmt::format("the ground truth's clock {} the encoders' by {:.0f} ms", p("tau") >= 0.0 ? "lags" : "leads",
-                         1e3 * std::abs(p("tau")));
-    case sim::EffectKind::kRunTimeOffset:
-      return fmt::format("each recording's ground-truth clock is offset differently (by about {:.0f} ms)",
-                         1e3 * p("tau_sd"));
-    case sim::EffectKind::kTurnScrub:
-      return fmt::format("spot turns turn {:.1f}% less than the wheels say (the wheels scrub)", 100.0 * p("k"));
-    case sim::EffectKind::kDirectionAsymmetry:
-      return fmt::format("driving backward the wheels travel {:.2f}% {} than forward", 100.0 * std::abs(p("a")),
-                         p("a") >= 0.0 ? "more" : "less");
-    case sim::EffectKind::kCastorKick:
-      return fmt::format("the castor turns the robot by {:.1f} mrad at every start", 1e3 * std::abs(p("kappa")));
-    case sim::EffectKind::kCastorSwivel:
-      return fmt::format("the swivel castor turns the robot by {:.1f} mrad as it starts after a spot turn",
-                         1e3 * std::abs(p("kappa")));
-    case sim::EffectKind::kParameterDrift:
-      return fmt::format("the right wheel's diameter changes by {:.3g}% from run to run", 100.0 * p("r"));
-    case sim::EffectKind::kStopSlide:
-      return fmt::format("the robot slides on after its wheels stop (d = {:.3g} s^2/m)", p("d"));
-    case sim::EffectKind::kStandstillMotion:
-      return fmt::format("the robot still moves as it comes to rest (about {:.1f} mm, {:.1f} mrad)",
-                         1e3 * p("sigma_xy"), 1e3 * p("sigma_theta"));
-    case sim::EffectKind::kMotionNoiseFloor:
-      return fmt::format("every start and stop adds about {:.2f} mm of wheel travel error", 1e3 * p("sigma"));
-    case sim::EffectKind::kBumpOutliers:
-      return fmt::format("the wheels hit bumps or slip ({:.2g} per metre, {:.1f} mm each)", p("rate"),
-                         1e3 * p("sigma"));
-    case sim::EffectKind::kCorrelatedNoise:
-      return fmt::format("the two wheels' errors are correlated (rho = {:.2f})", p("rho"));
-    default:
-      return fmt::format("{} is off", sim::EffectToString(step.effect));
-  }
-}
+std::string PlainProblem(const ExplanationStep& step) { return effects::Of(step.effect).PlainProblem(step.params); }
 
-bool OfTheRecording(sim::EffectKind k) {
-  return k == sim::EffectKind::kGtOffset || k == sim::EffectKind::kTimeOffset || k == sim::EffectKind::kRunTimeOffset;
-}
+/// A fault of the recording (marker, clocks) rather than of the robot.
+bool OfTheRecording(sim::EffectKind k) { return effects::Of(k).Class() == effects::EffectClass::kMeasurement; }
 
 }  // namespace
 

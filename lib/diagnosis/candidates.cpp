@@ -13,6 +13,7 @@
 #include "diagnosis/plausibility.hpp"
 #include "diagnosis/run_block.hpp"
 #include "core/parallel_for.hpp"
+#include "effects/registry.hpp"
 #include "stats/distributions.hpp"
 
 namespace umbmark::diag {
@@ -61,37 +62,21 @@ std::vector<int> FittedParams(sim::EffectKind effect, const std::vector<Candidat
   return EffectParams(effect, c);
 }
 
-/// A typical size of each effect parameter (the realistic ranges of the
-/// blind benchmark): an effect is distinguishable from E_d, E_b on a
-/// campaign when such an effect would stand 3 standard errors out.
+/// A typical size of each effect parameter (its effect's, Parameter::typical:
+/// the realistic ranges of the blind benchmark; 1 where the effect gives
+/// none): an effect is distinguishable from E_d, E_b on a campaign when
+/// such an effect would stand 3 standard errors out.
 double TypicalMagnitude(int param) {
-  switch (param) {
-    case kParamScale: return 0.01;
-    case kParamScrub: return 0.03;
-    case kParamAsym: return 0.01;
-    case kParamKappa: return 0.005;
-    case kParamDrift: return 1e-4;
-    case kParamDx:
-    case kParamDy: return 0.01;
-    case kParamTau: return 0.02;
-    // castor_swivel: as castor_kick; stop_slide: 8 mm after a leg at 0.35
-    // m/s (d = 0.065 s^2/m, a friction coefficient of 0.8), 10 mrad after a
-    // spot turn at 1 rad/s.
-    case kParamSwivel: return 0.005;
-    case kParamSlideD: return 0.065;
-    case kParamSlideA: return 0.01;
-    // Its shape: a coast along the arc (1), a backward coast 30 % longer.
-    case kParamSlideArc: return 1.0;
-    case kParamSlideBack: return 0.3;
-    default: return 1.0;
-  }
+  for (const auto& d : sim::EffectCatalogue())
+    for (const int q : EffectParams(d.kind))
+      if (q == param) {
+        const double typical = effects::Of(d.kind).TypicalSize(ParamName(param));
+        return typical > 0.0 ? typical : 1.0;
+      }
+  return 1.0;
 }
 
-bool IsNoiseEffect(sim::EffectKind k) {
-  return k == sim::EffectKind::kCorrelatedNoise || k == sim::EffectKind::kBumpOutliers ||
-         k == sim::EffectKind::kStandstillMotion || k == sim::EffectKind::kMotionNoiseFloor ||
-         k == sim::EffectKind::kRunTimeOffset || k == sim::EffectKind::kWheelNoiseError;
-}
+bool IsNoiseEffect(sim::EffectKind k) { return effects::Of(k).Random(); }
 
 void EnableNoiseEffect(sim::EffectKind k, PieceNoiseFitOptions& o) {
   if (k == sim::EffectKind::kCorrelatedNoise) o.correlated = true;

@@ -13,6 +13,7 @@
 #include <fmt/ranges.h>
 
 #include "core/errors.hpp"
+#include "diagnosis/campaign_scale.hpp"
 #include "diagnosis/advice.hpp"
 #include "diagnosis/baseline.hpp"
 #include "diagnosis/candidates.hpp"
@@ -513,9 +514,14 @@ DiagnoseSummary DiagnoseCampaign(const CampaignData& recorded, const DiagnoseOpt
   timer.Lap("candidate effects and cross-validation");
 
   // 4-5. Significance and verdict.
-  Verdict v = DecideVerdict(fits, out.score_p_value, out.null_quantile_alpha,
-                            VerdictOptions{options.alpha, options.min_heldout_shrink, options.full_shrink,
-                                           options.likelihood_tests, options.negligible});
+  VerdictOptions vo;
+  vo.alpha = options.alpha;
+  vo.min_heldout_shrink = options.min_heldout_shrink;
+  vo.full_shrink = options.full_shrink;
+  vo.likelihood_tests = options.likelihood_tests;
+  vo.negligible = options.negligible;
+  vo.campaign = CampaignScaleOf(c, options.negligible);
+  Verdict v = DecideVerdict(fits, out.score_p_value, out.null_quantile_alpha, vo);
   out.p_value = v.p_value;
   out.tests_p_value = v.tests_p_value;
   out.tests = v.tests;

@@ -9,10 +9,12 @@
 #include <fmt/format.h>
 
 #include "core/angles.hpp"
+#include "diagnosis/campaign_scale.hpp"
 #include "diagnosis/mean_fit.hpp"
 #include "diagnosis/plausibility.hpp"
 #include "diagnosis/run_block.hpp"
 #include "core/parallel_for.hpp"
+#include "effects/registry.hpp"
 
 namespace umbmark::diag {
 
@@ -367,42 +369,9 @@ void Size(const CampaignData& c, const MeanModel& model, const BaselineFit& base
 
 }  // namespace
 
-std::string PracticalFloor(sim::EffectKind effect, const std::map<std::string, double>& params, double negligible) {
-  const double scale = negligible / 0.25;
-  // A parameter not given has no known size: never below the floor.
-  auto get = [&](const char* k) {
-    const auto it = params.find(k);
-    return it == params.end() ? std::numeric_limits<double>::infinity() : std::abs(it->second);
-  };
-  if (!(scale > 0.0)) return {};
-  switch (effect) {
-    case sim::EffectKind::kTimeOffset:
-      if (get("tau") < 1.5e-3 * scale)
-        return fmt::format("a clock offset of {:.2f} ms (below {:.2g} ms: under half a millimetre at walking "
-                           "speed)", 1e3 * get("tau"), 1.5 * scale);
-      break;
-    case sim::EffectKind::kRunTimeOffset:
-      if (get("tau_sd") < 1.5e-3 * scale)
-        return fmt::format("per-run clock offsets of {:.2f} ms (below {:.2g} ms)", 1e3 * get("tau_sd"), 1.5 * scale);
-      break;
-    case sim::EffectKind::kScaleError:
-      if (get("s") < 3e-4 * scale)
-        return fmt::format("a common diameter error of {:.3f} % (below {:.2g} %: under 0.3 mm per metre)",
-                           100.0 * get("s"), 0.03 * scale);
-      break;
-    case sim::EffectKind::kGtOffset:
-      if (std::hypot(get("dx"), get("dy")) < 3e-4 * scale)
-        return fmt::format("a marker {:.2f} mm off the axle midpoint (below {:.2g} mm)",
-                           1e3 * std::hypot(get("dx"), get("dy")), 0.3 * scale);
-      break;
-    case sim::EffectKind::kCastorKick:
-    case sim::EffectKind::kCastorSwivel:
-      if (get("kappa") < 3e-4 * scale)
-        return fmt::format("heading kicks of {:.2f} mrad (below {:.2g} mrad)", 1e3 * get("kappa"), 0.3 * scale);
-      break;
-    default: break;
-  }
-  return {};
+std::string PracticalFloor(sim::EffectKind effect, const std::map<std::string, double>& params,
+                           const effects::CampaignScale& campaign) {
+  return effects::Of(effect).PracticalFloor(params, campaign);
 }
 
 namespace {
@@ -429,9 +398,10 @@ void SizeSteps(const CampaignData& c, const MeanModel& model, const BaselineFit&
   ex.noise = current.noise;
   ex.bases = last_bases;
   const PieceScatter scatter = Scatter(c, last_bases, current.noise);
+  const effects::CampaignScale campaign = CampaignScaleOf(c, negligible);
   for (ExplanationStep& s : ex.steps) {
     Size(c, model, b, last_bases, scatter, current, s.effect, s);
-    s.practical_floor = PracticalFloor(s.effect, s.params, negligible);
+    s.practical_floor = PracticalFloor(s.effect, s.params, campaign);
     s.negligible = s.relative_size < negligible || !s.practical_floor.empty();
   }
 }

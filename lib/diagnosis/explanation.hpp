@@ -29,11 +29,14 @@
 // wheel further off. Below `negligible` (default 0.25: a quarter of the noise) an
 // effect is negligible: reported, never named in the verdict, however
 // significant. Beside that relative rule, mismatches every robot has are
-// negligible whatever the noise (PracticalFloor, issue 21: a 1 ms clock at
-// 0.3 m/s is 0.3 mm): a clock offset |tau| or tau_sd below 1.5 ms, a
-// common diameter error |s| below 0.03 %, a marker within 0.3 mm of the
-// axle midpoint, a castor kick or swivel below 0.3 mrad; the floors scale
-// with `negligible` / 0.25 (0 switches them off with the relative rule).
+// negligible whatever the noise (PracticalFloor, each effect's own, as a
+// pose size at the campaign's speeds and distances): a clock offset |tau|
+// or tau_sd that moves the pose by less than 0.3 mm at the campaign's
+// typical speed and 0.3 mrad at its typical turn rate, a common diameter
+// error that adds less than 0.3 mm over a typical motion, a marker within
+// 0.3 mm of the axle midpoint, a castor kick or swivel below 0.3 mrad; the
+// floors scale with `negligible` / 0.25 (0 switches them off with the
+// relative rule). At 2 m/s a 1.4 ms clock is 2.8 mm: not negligible.
 #pragma once
 
 #include <map>
@@ -41,6 +44,7 @@
 #include <vector>
 
 #include "diagnosis/candidates.hpp"
+#include "effects/effect.hpp"
 
 namespace umbmark::diag {
 
@@ -95,9 +99,12 @@ struct ExplanationStep {
 };
 
 /// Why an effect with these fitted parameters is too small to matter
-/// whatever the noise (see the file comment), or empty. `negligible`: the
-/// option (the floors scale with negligible / 0.25).
-std::string PracticalFloor(sim::EffectKind effect, const std::map<std::string, double>& params, double negligible);
+/// whatever the noise (see the file comment), or empty: the effect's own
+/// floor (Effect::PracticalFloor), a pose size at the campaign's speeds and
+/// distances (`campaign`, campaign_scale.hpp; the floors scale with its
+/// negligible / 0.25).
+std::string PracticalFloor(sim::EffectKind effect, const std::map<std::string, double>& params,
+                           const effects::CampaignScale& campaign);
 
 struct Explanation {
   std::vector<ExplanationStep> steps;  ///< in the order added

@@ -2,7 +2,8 @@
 // wheel-noise correlation at +-1 or a castor kick of several degrees is
 // not a cause but a symptom (the effect soaked up something else). Used by
 // the candidates' likelihood-ratio tests (an impossible fit is not
-// evidence), the explanation's naming and the report.
+// evidence), the explanation's naming and the report. Each effect's rule
+// is in its own file (lib/effects/<name>.cpp).
 #pragma once
 
 #include <map>

@@ -34,8 +34,9 @@ void Significance(const CandidateFits& fits, double score_p_value, const Verdict
     for (const Candidate& cd : fits.candidates)
       if (cd.tested) {
         ++out.tests;
-        const bool negligible =
-            !PracticalFloor(cd.effect, cd.params, options.negligible).empty() || !cd.clock.supported;
+        effects::CampaignScale campaign = options.campaign;
+        campaign.negligible = options.negligible;
+        const bool negligible = !PracticalFloor(cd.effect, cd.params, campaign).empty() || !cd.clock.supported;
         if (!cd.impossible && !negligible) min_p = std::min(min_p, cd.lr_p_value);
       }
     out.tests_p_value = std::min(1.0, out.tests * min_p);

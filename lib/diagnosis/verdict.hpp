@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "diagnosis/candidates.hpp"
+#include "effects/effect.hpp"
 
 namespace umbmark::diag {
 
@@ -42,6 +43,9 @@ struct VerdictOptions {
   /// floor (explanation.hpp PracticalFloor) is no evidence of a gap that
   /// matters. Default 0.25.
   double negligible = 0.25;
+  /// The campaign's speeds and distances for those floors (its negligible
+  /// is this struct's). Default: CampaignScale's.
+  effects::CampaignScale campaign;
   /// A mechanism at the starts and stops of motions (castor_kick,
   /// castor_swivel, stop_slide) that closes at least this fraction of the
   /// held-out gap alone outranks a qualifying noise effect even when it

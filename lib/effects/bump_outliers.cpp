@@ -1,0 +1,57 @@
+// bump_outliers (contract): per wheel, Poisson bumps with `rate` per metre
+// of travel, each adding N(0, sigma^2) m of travel.
+#include <fmt/format.h>
+
+#include "effects/effect.hpp"
+
+namespace umbmark::effects {
+namespace {
+
+class BumpOutliers final : public Effect {
+ public:
+  BumpOutliers()
+      : Effect({.name = "bump_outliers",
+                .kind = EffectKind::kBumpOutliers,
+                .order = 4,
+                .effect_class = EffectClass::kNoise,
+                .random = true,
+                .definition =
+                    "per wheel, Poisson bumps with `rate` per metre of travel, each adding N(0, sigma^2) m of travel",
+                .parameters = {{"rate", &Effects::bump_rate, "1/m"}, {"sigma", &Effects::bump_sigma, "m"}}}) {}
+
+  // Bumps need both a rate and a size.
+  bool Active(const Effects& e) const override { return e.bump_rate > 0.0 && e.bump_sigma > 0.0; }
+
+  std::string Unphysical(const Params& p, int /*runs*/, const Params& /*se*/) const override {
+    return NoisePerEventTooLarge(p, "sigma");
+  }
+
+  // No bumps, or bumps of no size.
+  std::string NullFit(const Params& p) const override {
+    const auto r = p.find("rate"), sg = p.find("sigma");
+    if (r == p.end() || sg == p.end()) return {};
+    if (r->second <= 1e-6)
+      return "fitted at rate = 0: it adds nothing, so what its fit gains is the other noise refitted beside it";
+    if (sg->second <= 1e-6)
+      return "fitted at sigma = 0: it adds nothing, so what its fit gains is the other noise refitted beside it";
+    return {};
+  }
+
+  std::string PlainProblem(const Params& p) const override {
+    return fmt::format("the wheels hit bumps or slip ({:.2g} per metre, {:.1f} mm each)", Get(p, "rate"),
+                       1e3 * Get(p, "sigma"));
+  }
+
+ protected:
+  std::string Range(const Effects& e) const override {
+    if (e.bump_rate < 0.0) return fmt::format("bump_outliers.rate = {} must be >= 0", e.bump_rate);
+    if (e.bump_sigma < 0.0) return fmt::format("bump_outliers.sigma = {} must be >= 0", e.bump_sigma);
+    if (e.bump_rate > 1000.0) return fmt::format("bump_outliers.rate = {} must be <= 1000 per metre", e.bump_rate);
+    return {};
+  }
+};
+
+}  // namespace
+}  // namespace umbmark::effects
+
+UMBMARK_EFFECT(BumpOutliers)

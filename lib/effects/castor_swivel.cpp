@@ -1,0 +1,67 @@
+// castor_swivel (contract): at the start of a straight or arc motion that
+// follows a spot turn the heading jumps kappa x the turn's sign (ccw +1, cw
+// -1); after a reversal of the drive direction +-kappa with equal
+// probability.
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "effects/effect.hpp"
+
+namespace umbmark::effects {
+namespace {
+
+// A swivel castor's kick of at most 0.5 rad (29 deg).
+constexpr double kMaxSwivelKappa = 0.5;
+
+class CastorSwivel final : public Effect {
+ public:
+  CastorSwivel()
+      : Effect({.name = "castor_swivel",
+                .kind = EffectKind::kCastorSwivel,
+                .order = 13,
+                .effect_class = EffectClass::kMechanism,
+                .definition = "at the start of a straight or arc motion after a spot turn the heading jumps by kappa "
+                              "times the turn's sign (ccw +1, cw -1); after a reversal of the drive direction by "
+                              "+kappa or -kappa with equal probability",
+                // As castor_kick.
+                .parameters = {{"kappa", &Effects::swivel_kappa, "rad", 0.005}}}) {}
+
+  // The range first: it catches NaN with the allowed range.
+  std::string Check(const Effects& e) const override {
+    if (!(std::abs(e.swivel_kappa) <= kMaxSwivelKappa))
+      return fmt::format("castor_swivel.kappa = {} must be in [-{}, {}] rad", e.swivel_kappa, kMaxSwivelKappa,
+                         kMaxSwivelKappa);
+    return Effect::Check(e);
+  }
+
+  std::string PracticalFloor(const Params& p, const CampaignScale& c) const override {
+    if (!(c.negligible > 0.0) || !(Size(p, "kappa") < c.FloorRad())) return {};
+    return fmt::format("heading kicks of {:.2f} mrad (below {:.2g} mrad)", 1e3 * Size(p, "kappa"), 1e3 * c.FloorRad());
+  }
+
+  std::string Unphysical(const Params& p, int /*runs*/, const Params& /*se*/) const override {
+    const double kappa = Get(p, "kappa");
+    if (std::abs(kappa) > 0.05)
+      return fmt::format("a swivel kick of {:.0f} mrad ({:.1f} deg) after every spot turn: far beyond what a castor "
+                         "swings the robot",
+                         1e3 * kappa, kappa * 180.0 / 3.14159265358979);
+    return {};
+  }
+
+  std::string ConcreteChange(const Params& p, const AdviceContext& /*c*/) const override {
+    return fmt::format("Swivel castor: after a spot turn the heading jumps by {:.1f} mrad (with the turn's sign) at "
+                       "the next start. A castor with less trail or play, or a short straight creep after turns.",
+                       1e3 * Get(p, "kappa"));
+  }
+
+  std::string PlainProblem(const Params& p) const override {
+    return fmt::format("the swivel castor turns the robot by {:.1f} mrad as it starts after a spot turn",
+                       1e3 * std::abs(Get(p, "kappa")));
+  }
+};
+
+}  // namespace
+}  // namespace umbmark::effects
+
+UMBMARK_EFFECT(CastorSwivel)

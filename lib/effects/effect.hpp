@@ -1,0 +1,159 @@
+// One interface for every unmodelled effect (issue 28 item 4): the
+// contract's fourteen (interface.md "Effects"), the two outside effects of
+// the blind benchmark and the three parameter errors of `diagnose
+// --baseline`. Each effect is one file lib/effects/<name>.cpp holding a
+// class derived from Effect and a UMBMARK_EFFECT(Class) line that registers
+// it (registry.hpp): its contract name, parameters and their ranges, class,
+// typical size, practical floor at the campaign's own speeds, physical
+// plausibility and advice with the fitted numbers.
+//
+// Layer 2.5 (scripts/check_layers.sh): includes core, kinematics and model
+// only, so that both the simulator and the diagnosis can use it.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "core/robot.hpp"
+#include "effects/values.hpp"
+
+namespace umbmark::effects {
+
+/// What an effect is: a property of the robot's motion (mechanism), of the
+/// recording (measurement), or a random scatter (noise).
+enum class EffectClass { kMechanism, kMeasurement, kNoise };
+
+/// One parameter: its contract name, its field in Effects, its unit and a
+/// typical size (the realistic ranges of the blind benchmark; 0: none).
+struct Parameter {
+  std::string_view name;
+  double Effects::*field = nullptr;
+  std::string_view unit;
+  double typical = 0.0;
+};
+
+/// Fitted or given parameter values by contract name.
+using Params = std::map<std::string, double>;
+
+/// The campaign's own speeds and distances, which turn a parameter into a
+/// pose size (the practical floors, docs/diagnosis.md "Practical floors").
+/// The defaults give the fixed floors of before (a 1.5 ms clock at 0.2
+/// m/s and 0.2 rad/s is 0.3 mm and 0.3 mrad; 0.03 % over 1 m is 0.3 mm).
+struct CampaignScale {
+  /// Typical driving speed [m/s] (median of the moving samples' |v|).
+  double speed_mps = 0.2;
+  /// Typical turn rate [rad/s] (median of the turning samples' |w|).
+  double turn_rate_radps = 0.2;
+  /// Typical length of one leg [m] (median over the straight and arc
+  /// motions between two standstills).
+  double motion_length_m = 1.0;
+  /// DiagnoseOptions::negligible; the floors scale with negligible / 0.25
+  /// (0 switches them off).
+  double negligible = 0.25;
+
+  /// The pose floors [m, rad]: 0.3 mm and 0.3 mrad at the default
+  /// negligible, scaled by negligible / 0.25.
+  double FloorM() const { return 3e-4 * negligible / 0.25; }
+  double FloorRad() const { return 3e-4 * negligible / 0.25; }
+};
+
+/// What the advice needs of the campaign and its baseline model.
+struct AdviceContext {
+  RobotParams robot;       ///< the campaign's nominal robot
+  double E_d = 1.0;        ///< the baseline's diameter ratio
+  double E_b = 1.0;        ///< the baseline's wheelbase factor
+  int runs = 0;            ///< runs in the campaign
+};
+
+/// Everything an effect is that needs no code.
+struct Descriptor {
+  std::string_view name;      ///< contract name (JSON key, --effect NAME)
+  /// The built-in kind (transitional, values.hpp); none for an effect added
+  /// at run time.
+  std::optional<EffectKind> kind;
+  /// Position in the contract's table (the catalogue order: contract
+  /// effects 0-13, outside effects 100+, parameter errors 200+).
+  int order = 0;
+  EffectClass effect_class = EffectClass::kMechanism;
+  /// Fitted as a variance component (a random effect per event or run),
+  /// not as a mean shift.
+  bool random = false;
+  bool in_contract = true;
+  /// A parameter error of a given model (`diagnose --baseline`): named by
+  /// the diagnosis only, never simulated.
+  bool parameter_error = false;
+  std::string_view definition;
+  std::vector<Parameter> parameters;
+};
+
+class Effect {
+ public:
+  explicit Effect(Descriptor d) : d_(std::move(d)) {}
+  virtual ~Effect() = default;
+  Effect(const Effect&) = delete;
+  Effect& operator=(const Effect&) = delete;
+
+  const Descriptor& Describe() const { return d_; }
+  std::string_view Name() const { return d_.name; }
+  EffectClass Class() const { return d_.effect_class; }
+  bool Random() const { return d_.random; }
+  bool Simulated() const { return !d_.parameter_error; }
+  const std::vector<Parameter>& Parameters() const { return d_.parameters; }
+  /// The typical size of parameter `name` (0 when it has none).
+  double TypicalSize(std::string_view name) const;
+
+  /// Empty when the effect's values in `e` are valid, else a message
+  /// naming the field ("NAME.PARAM = v must be ..."). Default: every
+  /// parameter finite, then Range.
+  virtual std::string Check(const Effects& e) const;
+  /// Whether the effect is present in `e`. Default: a parameter non-zero.
+  virtual bool Active(const Effects& e) const;
+
+  /// Why fitted values this small are negligible whatever the noise (in
+  /// words with the number and the floor), or empty. Default: never.
+  virtual std::string PracticalFloor(const Params& /*p*/, const CampaignScale& /*s*/) const { return {}; }
+  /// Why fitted values are physically impossible or implausible (a symptom,
+  /// not a cause), or empty. `runs`: the campaign's; `se`: standard errors.
+  virtual std::string Unphysical(const Params& /*p*/, int /*runs*/, const Params& /*se*/) const { return {}; }
+  /// Why a random effect fitted at zero explains nothing, or empty.
+  virtual std::string NullFit(const Params& /*p*/) const { return {}; }
+  /// The concrete change to make, with the fitted numbers, or empty.
+  virtual std::string ConcreteChange(const Params& /*p*/, const AdviceContext& /*c*/) const { return {}; }
+  /// The effect as a plain statement with the numbers. Default: "NAME is off".
+  virtual std::string PlainProblem(const Params& p) const;
+  /// How a fitted parameter reads: {factor, unit} (value x factor, unit),
+  /// e.g. {1e3, " mm"}; {0, ""} leaves it to the generic reading.
+  virtual std::pair<double, const char*> ParamUnit(std::string_view /*param*/) const { return {0.0, ""}; }
+
+ protected:
+  /// Effect-specific range checks after the finite check (default: none).
+  virtual std::string Range(const Effects& /*e*/) const { return {}; }
+  /// A fitted parameter, 0 when absent.
+  static double Get(const Params& p, const char* name);
+  /// A fitted parameter's magnitude, +inf when absent (never below a floor).
+  static double Size(const Params& p, const char* name);
+  /// "N mm of noise per event (KEY): ..." when parameter `key` is over 50 mm.
+  static std::string NoisePerEventTooLarge(const Params& p, const char* key);
+  /// The null-fit sentence when every parameter of `zero` is present and at
+  /// most its value in magnitude ("fitted at a = 0, b = 0: ..."), else empty.
+  static std::string FittedAtZero(const Params& p, const std::vector<std::pair<const char*, double>>& zero);
+
+ private:
+  Descriptor d_;
+};
+
+}  // namespace umbmark::effects
+
+/// Registers a built-in effect (one line at the end of its file; the build
+/// collects these lines into the registry's list, registry.hpp).
+#define UMBMARK_EFFECT(Class)                                              \
+  namespace umbmark::effects::registered {                                 \
+  const ::umbmark::effects::Effect& Class##Instance() {                    \
+    static const Class instance;                                           \
+    return instance;                                                       \
+  }                                                                        \
+  }

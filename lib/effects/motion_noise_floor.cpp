@@ -1,0 +1,44 @@
+// motion_noise_floor (contract): every motion between two standstills adds
+// N(0, sigma^2) m to each wheel's true travel, whatever its length (the
+// simulator: half the variance as the motion starts, half as it stops).
+#include <fmt/format.h>
+
+#include "effects/effect.hpp"
+
+namespace umbmark::effects {
+namespace {
+
+class MotionNoiseFloor final : public Effect {
+ public:
+  MotionNoiseFloor()
+      : Effect({.name = "motion_noise_floor",
+                .kind = EffectKind::kMotionNoiseFloor,
+                .order = 10,
+                .effect_class = EffectClass::kNoise,
+                .random = true,
+                .definition = "every motion between two standstills adds N(0, sigma^2) m to each wheel's true travel, "
+                              "independently of its length",
+                .parameters = {{"sigma", &Effects::floor_sigma, "m"}}}) {}
+
+  std::string Unphysical(const Params& p, int /*runs*/, const Params& /*se*/) const override {
+    return NoisePerEventTooLarge(p, "sigma");
+  }
+
+  std::string NullFit(const Params& p) const override { return FittedAtZero(p, {{"sigma", 1e-6}}); }
+
+  std::string PlainProblem(const Params& p) const override {
+    return fmt::format("every start and stop adds about {:.2f} mm of wheel travel error", 1e3 * Get(p, "sigma"));
+  }
+
+ protected:
+  std::string Range(const Effects& e) const override {
+    if (!(e.floor_sigma >= 0.0 && e.floor_sigma < 1.0))
+      return fmt::format("motion_noise_floor.sigma = {} must be in [0, 1) m", e.floor_sigma);
+    return {};
+  }
+};
+
+}  // namespace
+}  // namespace umbmark::effects
+
+UMBMARK_EFFECT(MotionNoiseFloor)
