@@ -98,6 +98,12 @@ Command SetupDiagnose(CLI::App& parent) {
                   "pose spread of the pieces they act on (median per piece type, the type widened most) by less "
                   "than this fraction, are negligible, never the verdict (default 0.25)")
       ->check(CLI::NonNegativeNumber);
+  app->add_flag_callback(
+      "--fit-ground-truth-noise", [opts] { opts->o.diag.baseline_fit.ground_truth = diag::GroundTruthNoiseSource::kFitted; },
+      "Fit the ground truth's noise with the wheel noise on the pieces (before issue 28; an unmodelled effect can "
+      "widen it) instead of taking the scatter inside the standstills (default), when the manifest states none");
+  app->add_flag("--monotone-shrink,!--no-monotone-shrink", d.keep_heldout_shrink,
+                "A step of the explanation may not lower the cumulative held-out shrink (default: off)");
   app->add_option("--max-effects", d.max_explanation_effects, "Most effects in the stepwise explanation (default 4)")
       ->check(CLI::Range(1, 12));
   app->add_option("--seed", d.seed, "Seed of the null simulations (default 1)")->check(SeedValidator());

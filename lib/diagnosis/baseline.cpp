@@ -55,19 +55,55 @@ BaselineStart StartBaseline(const CampaignData& c, bool use_refine) {
   return s;
 }
 
+const char* GroundTruthNoiseSourceToString(GroundTruthNoiseSource g) {
+  return g == GroundTruthNoiseSource::kStandstills ? "standstills" : "fitted";
+}
+
+std::string BaselineFitOptions::Check() const {
+  if (rounds < 1) return fmt::format("rounds = {} must be >= 1", rounds);
+  if (std::string e = standstill.Check(); !e.empty()) return "standstill." + e;
+  return {};
+}
+
+void StartGroundTruthNoise(const CampaignData& c, const BaselineFitOptions& options, BaselineFit& b,
+                           NoiseParams& noise) {
+  b.ground_truth_known = c.ground_truth.has_value();
+  b.standstill = MeasureStandstillNoise(c, options.standstill);
+  // Floors: 1 micrometre / 1 microradian keep noise-free ground truth usable.
+  b.noise_fit.min_sigma_xy2 = 1e-12;
+  b.noise_fit.min_sigma_theta2 = 1e-12;
+  b.noise_fit.fit_ground_truth = false;
+  if (b.ground_truth_known) {
+    b.ground_truth_source = "manifest";
+    noise.sxy2 = std::max(c.ground_truth->sigma_xy_m * c.ground_truth->sigma_xy_m, 1e-12);
+    noise.sth2 = std::max(c.ground_truth->sigma_theta_rad * c.ground_truth->sigma_theta_rad, 1e-12);
+  } else if (options.ground_truth == GroundTruthNoiseSource::kStandstills && b.standstill.measured) {
+    b.ground_truth_source = "standstills";
+    noise.sxy2 = b.standstill.sigma_xy_m * b.standstill.sigma_xy_m;
+    noise.sth2 = b.standstill.sigma_theta_rad * b.standstill.sigma_theta_rad;
+  } else {
+    b.ground_truth_source = "fitted";
+    b.noise_fit.fit_ground_truth = true;
+    noise.sxy2 = 1e-8;
+    noise.sth2 = 1e-6;
+  }
+}
+
+void FitPiecesGroundTruth(const CampaignData& c, BaselineFit& b) {
+  if (b.ground_truth_source != "standstills") return;
+  PieceNoiseFitOptions o = b.noise_fit;
+  o.fit_ground_truth = true;
+  const NoiseParams n = FitPieceNoise(b.eps, b.bases, c.pieces, {}, b.noise, o);
+  b.pieces_sigma_xy_m = std::sqrt(n.sxy2);
+  b.pieces_sigma_theta_rad = std::sqrt(n.sth2);
+}
+
 BaselineFit FitBaseline(const CampaignData& c, const MeanModel& model, const BaselineStart& start,
                         const BaselineFitOptions& options) {
   BaselineFit b;
   ParamVector p = start.p;
   NoiseParams noise;
-  b.ground_truth_known = c.ground_truth.has_value();
-  const bool gt_known = b.ground_truth_known;
-  b.noise_fit.fit_ground_truth = !gt_known;
-  // Floors: 1 micrometre / 1 microradian keep noise-free ground truth usable.
-  noise.sxy2 = gt_known ? std::max(c.ground_truth->sigma_xy_m * c.ground_truth->sigma_xy_m, 1e-12) : 1e-8;
-  noise.sth2 = gt_known ? std::max(c.ground_truth->sigma_theta_rad * c.ground_truth->sigma_theta_rad, 1e-12) : 1e-6;
-  b.noise_fit.min_sigma_xy2 = 1e-12;
-  b.noise_fit.min_sigma_theta2 = 1e-12;
+  StartGroundTruthNoise(c, options, b, noise);
   std::vector<double> eps;
   model.Residuals(p, eps);
   b.bases = ComputeBases(c, model, p);
@@ -99,6 +135,7 @@ BaselineFit FitBaseline(const CampaignData& c, const MeanModel& model, const Bas
   b.W = Whiteners(b.bases, c.pieces, noise);
   // Jacobian at the final point for the null refits and cross-validation.
   b.D = model.Jacobian(p, BaselineParams(), b.eps);
+  FitPiecesGroundTruth(c, b);
   return b;
 }
 

@@ -30,21 +30,15 @@ ParamVector GivenParams(const RobotParams& recorded, const RobotParams& given) {
   return p;
 }
 
-BaselineFit FitGivenBaseline(const CampaignData& c, const MeanModel& model, const GivenModel& given) {
+BaselineFit FitGivenBaseline(const CampaignData& c, const MeanModel& model, const GivenModel& given,
+                             const BaselineFitOptions& options) {
   BaselineFit b;
   b.free.clear();
   b.given = true;
   b.p = GivenParams(c.robot, given.params);
-  b.ground_truth_known = c.ground_truth.has_value();
-  b.noise_fit.fit_ground_truth = !b.ground_truth_known;
-  b.noise_fit.fit_wheel_noise = !given.noise_given;
-  b.noise_fit.min_sigma_xy2 = 1e-12;
-  b.noise_fit.min_sigma_theta2 = 1e-12;
   NoiseParams noise;
-  // Floors as in the default baseline: 1 micrometre / 1 microradian.
-  noise.sxy2 = b.ground_truth_known ? std::max(c.ground_truth->sigma_xy_m * c.ground_truth->sigma_xy_m, 1e-12) : 1e-8;
-  noise.sth2 =
-      b.ground_truth_known ? std::max(c.ground_truth->sigma_theta_rad * c.ground_truth->sigma_theta_rad, 1e-12) : 1e-6;
+  StartGroundTruthNoise(c, options, b, noise);
+  b.noise_fit.fit_wheel_noise = !given.noise_given;
   if (given.noise_given) {
     // A wheel given as noise-free keeps a tiny variance: the covariances
     // must stay invertible.
@@ -55,6 +49,7 @@ BaselineFit FitGivenBaseline(const CampaignData& c, const MeanModel& model, cons
   b.bases = ComputeBases(c, model, b.p);
   b.noise = FitPieceNoise(b.eps, b.bases, c.pieces, {}, noise, b.noise_fit);
   b.W = Whiteners(b.bases, c.pieces, b.noise);
+  FitPiecesGroundTruth(c, b);
   b.D = Eigen::MatrixXd(static_cast<Eigen::Index>(b.eps.size()), 0);
   b.cov = Eigen::MatrixXd(0, 0);
   b.notes.push_back(fmt::format(

@@ -58,7 +58,9 @@ ParamVector GivenParams(const RobotParams& recorded, const RobotParams& given);
 
 /// The baseline of the given model (nothing of the mean fitted; see the
 /// file comment). `free` is empty.
-BaselineFit FitGivenBaseline(const CampaignData& c, const MeanModel& model, const GivenModel& given);
+/// options: where the ground truth's noise comes from (baseline.hpp).
+BaselineFit FitGivenBaseline(const CampaignData& c, const MeanModel& model, const GivenModel& given,
+                             const BaselineFitOptions& options = {});
 
 /// Parameter errors that are candidates for this given model: wheelbase and
 /// diameter ratio always, wheel noise when k_L, k_R are given.

@@ -44,6 +44,7 @@ std::string DiagnoseOptions::Check() const {
   if (max_explanation_effects < 1)
     return fmt::format("max_explanation_effects = {} must be >= 1", max_explanation_effects);
   if (where_top < 0) return fmt::format("where_top = {} must be >= 0", where_top);
+  if (auto e = baseline_fit.Check(); !e.empty()) return "baseline_fit." + e;
   if (given) {
     if (auto e = given->Check(); !e.empty()) return "given model: " + e;
   }
@@ -94,6 +95,10 @@ BaselineSummary Summarise(const CampaignData& c, const BaselineStart& start, con
   bs.sigma_xy_m = std::sqrt(b.noise.sxy2);
   bs.sigma_theta_rad = std::sqrt(b.noise.sth2);
   bs.ground_truth_estimated = !b.ground_truth_known;
+  bs.ground_truth_source = b.ground_truth_source;
+  bs.standstill = b.standstill;
+  bs.pieces_sigma_xy_m = b.pieces_sigma_xy_m;
+  bs.pieces_sigma_theta_rad = b.pieces_sigma_theta_rad;
   bs.start = start.description;
   bs.pieces = static_cast<int>(c.pieces.size());
   bs.runs = static_cast<int>(c.runs.size());
@@ -139,7 +144,8 @@ struct StopChoice {
 
 BaselineFit FitStart(const CampaignData& c, const MeanModel& model, const BaselineStart& start,
                      const DiagnoseOptions& options) {
-  return options.given ? FitGivenBaseline(c, model, *options.given) : FitBaseline(c, model, start, BaselineFitOptions{});
+  return options.given ? FitGivenBaseline(c, model, *options.given, options.baseline_fit)
+                       : FitBaseline(c, model, start, options.baseline_fit);
 }
 
 StopChoice ChooseStopModel(const CampaignData& recorded, const BaselineStart& start, const DiagnoseOptions& options) {
@@ -276,6 +282,7 @@ void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit
     eo.negligible = options.negligible;
     eo.threads = options.threads;
     eo.gap = options.gap;
+    eo.keep_heldout_shrink = options.keep_heldout_shrink;
     eo.progress = StageProgress(options.progress, 700.0, 1000.0, 1000.0);
     std::vector<sim::EffectKind> first;
     if (const auto k = sim::EffectFromString(out.verdict)) first.push_back(*k);
@@ -307,27 +314,55 @@ void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit
         out.notes.push_back(std::move(n));
 }
 
-/// The ground-truth noise of the baseline (fitted, or the manifest's)
-/// against the standstill scatter (standstill_noise.hpp): a warning when
-/// either sd is more than twice or less than half the scatter (beyond the
-/// scatter's own sampling error of about 20 % at its fewest 30 differences).
+/// The ground-truth noise against the standstill scatter
+/// (standstill_noise.hpp): a warning when one sd is more than twice or less
+/// than half the scatter (beyond the scatter's own sampling error of about
+/// 20 % at its fewest 30 differences). Source "standstills": the sigmas the
+/// pieces would fit with the wheel noise; else the baseline's own (fitted,
+/// or the manifest's).
 std::string StandstillDisagreement(const BaselineSummary& b) {
   const StandstillNoise& s = b.standstill;
   if (!s.measured) return {};
+  const bool used = b.ground_truth_source == "standstills";
+  const double xy = used ? b.pieces_sigma_xy_m : b.sigma_xy_m, th = used ? b.pieces_sigma_theta_rad : b.sigma_theta_rad;
   auto off = [](double a, double ref) { return ref > 0.0 && (a > 2.0 * ref || a < 0.5 * ref); };
-  const bool xy = off(b.sigma_xy_m, s.sigma_xy_m), th = off(b.sigma_theta_rad, s.sigma_theta_rad);
-  if (!xy && !th) return {};
-  return fmt::format(
-      "the ground truth's noise {} ({:.3g} mm, {:.3g} mrad) is {:.2g} x / {:.2g} x the scatter measured inside the "
-      "standstills ({:.3g} mm, {:.3g} mrad, from {} sample-to-sample differences at least {:.1f} s after a stop): {}",
-      b.ground_truth_estimated ? "fitted to the pieces" : "stated in the manifest", 1e3 * b.sigma_xy_m,
-      1e3 * b.sigma_theta_rad, b.sigma_xy_m / s.sigma_xy_m, b.sigma_theta_rad / s.sigma_theta_rad,
-      1e3 * s.sigma_xy_m, 1e3 * s.sigma_theta_rad, s.differences, StandstillNoiseOptions{}.settle_s,
-      b.ground_truth_estimated
+  if (!off(xy, s.sigma_xy_m) && !off(th, s.sigma_theta_rad)) return {};
+  const std::string what =
+      used ? "fitted to the pieces with the wheel noise, the ground truth's noise would be"
+           : (b.ground_truth_source == "fitted" ? "the ground truth's noise fitted to the pieces" : "the ground truth's noise stated in the manifest");
+  const std::string advice =
+      used ? "the pieces hold something the standstills do not (an effect along the pieces or at the stops, or capture "
+             "noise that grows with speed); the baseline keeps the standstill scatter, so the gap test sees it"
+      : b.ground_truth_source == "fitted"
           ? "the fit takes in something that is not measurement noise (an effect at the stops or along the pieces), "
             "which the gap test then cannot see; state the motion capture's noise in the manifest ([ground_truth] "
             "sigma_xy_m, sigma_theta_rad) and diagnose again"
-          : "check the manifest's [ground_truth] values");
+          : "check the manifest's [ground_truth] values";
+  return fmt::format(
+      "{} {:.3g} mm, {:.3g} mrad: {:.2g} x / {:.2g} x the scatter measured inside the standstills ({:.3g} mm, {:.3g} "
+      "mrad, from {} sample-to-sample differences at least {:.1f} s after a stop): {}",
+      what, 1e3 * xy, 1e3 * th, xy / s.sigma_xy_m, th / s.sigma_theta_rad, 1e3 * s.sigma_xy_m, 1e3 * s.sigma_theta_rad,
+      s.differences, StandstillNoiseOptions{}.settle_s, advice);
+}
+
+/// What the standstill scatter's estimate rests on, when it is more than a
+/// plain sample-to-sample sd: correlation over samples, a drift, a floor.
+std::string StandstillNote(const BaselineSummary& b) {
+  const StandstillNoise& s = b.standstill;
+  if (!s.measured || b.ground_truth_source != "standstills") return {};
+  std::vector<std::string> parts;
+  if (s.lag_xy > 1 || s.lag_theta > 1)
+    parts.push_back(fmt::format("the capture noise is correlated over samples: the sample-to-sample scatter ({:.3g} mm, "
+                                "{:.3g} mrad) levels off at lags of {} and {} samples ({:.3g} mm, {:.3g} mrad)",
+                                1e3 * s.lag1_sigma_xy_m, 1e3 * s.lag1_sigma_theta_rad, s.lag_xy, s.lag_theta,
+                                1e3 * s.sigma_xy_m, 1e3 * s.sigma_theta_rad));
+  if (!s.plateau_xy || !s.plateau_theta)
+    parts.push_back("the scatter still grows at the longest lag measured (a drift inside the standstills): it is an "
+                    "upper end of the capture noise");
+  if (s.floored_xy || s.floored_theta)
+    parts.push_back("the standstills are (nearly) noise-free: the noise is raised to its floor of 0.01 mm / 0.01 mrad");
+  if (parts.empty()) return {};
+  return "ground truth's noise taken from the standstills: " + fmt::format("{}", fmt::join(parts, "; "));
 }
 
 /// Stage 1b: faults of single runs (run_faults.hpp), first pass: the
@@ -480,8 +515,8 @@ DiagnoseSummary DiagnoseCampaign(const CampaignData& recorded, const DiagnoseOpt
   const ReturnCheck returns = CheckReturns(c, model, base);
   out.baseline = Summarise(c, start, base, returns);
   out.baseline.given = options.given;
-  out.baseline.standstill = MeasureStandstillNoise(c);
   if (std::string w = StandstillDisagreement(out.baseline); !w.empty()) out.warnings.push_back(std::move(w));
+  if (std::string n = StandstillNote(out.baseline); !n.empty()) out.notes.push_back(std::move(n));
   timer.Lap("baseline predictions");
 
   // 2. Where, and the gap's null distribution.

@@ -105,6 +105,13 @@ struct DiagnoseOptions {
   double negligible = 0.25;
   /// Most effects in the stepwise explanation (>= 1). Default 4.
   int max_explanation_effects = 4;
+  /// A step of the explanation may not lower the cumulative held-out shrink
+  /// (ExplanationOptions::keep_heldout_shrink). Default false.
+  bool keep_heldout_shrink = false;
+  /// The baseline's fit: where the ground truth's noise comes from when the
+  /// manifest does not state it (baseline.hpp; default the standstill
+  /// scatter, `ground_truth = kFitted` for the fit before issue 28).
+  BaselineFitOptions baseline_fit;
   /// Effects to try (empty: the contract's fourteen; with `given`, also its
   /// parameter errors).
   std::vector<sim::EffectKind> effects;
@@ -134,9 +141,15 @@ struct BaselineSummary {
   double k_L = 0.0, k_R = 0.0;
   double sigma_xy_m = 0.0, sigma_theta_rad = 0.0;
   bool ground_truth_estimated = false;
+  /// Where sigma_xy_m, sigma_theta_rad come from: "manifest",
+  /// "standstills" (the scatter below) or "fitted" (with the wheel noise).
+  std::string ground_truth_source;
   /// The ground truth's noise measured inside standstills, where no
   /// candidate effect reaches it (standstill_noise.hpp).
   StandstillNoise standstill;
+  /// Source "standstills": the sigmas the pieces would fit with the wheel
+  /// noise (a warning when far from the scatter) [m], [rad]; else 0.
+  double pieces_sigma_xy_m = 0.0, pieces_sigma_theta_rad = 0.0;
   std::string start;  ///< where E_d, E_b started (refine or nominal)
   std::vector<ReturnPrediction> returns;
   std::vector<GrowthRow> growth;

@@ -187,12 +187,24 @@ nlohmann::json BaselineJson(const BaselineSummary& b) {
           {"sigma_xy_m", Num(b.sigma_xy_m)},
           {"sigma_theta_rad", Num(b.sigma_theta_rad)},
           {"ground_truth_noise_estimated", b.ground_truth_estimated},
+          {"ground_truth_noise_source", b.ground_truth_source},
           {"standstill_scatter",
            b.standstill.measured ? nlohmann::json{{"sigma_xy_m", Num(b.standstill.sigma_xy_m)},
                                                   {"sigma_theta_rad", Num(b.standstill.sigma_theta_rad)},
+                                                  {"lag1_sigma_xy_m", Num(b.standstill.lag1_sigma_xy_m)},
+                                                  {"lag1_sigma_theta_rad", Num(b.standstill.lag1_sigma_theta_rad)},
+                                                  {"plateau_lag_xy", b.standstill.lag_xy},
+                                                  {"plateau_lag_theta", b.standstill.lag_theta},
+                                                  {"plateau", b.standstill.plateau_xy && b.standstill.plateau_theta},
+                                                  {"floored", b.standstill.floored_xy || b.standstill.floored_theta},
                                                   {"differences", b.standstill.differences},
                                                   {"standstills", b.standstill.standstills}}
                                  : nlohmann::json(nullptr)},
+          {"ground_truth_noise_fitted_to_pieces",
+           b.ground_truth_source == "standstills"
+               ? nlohmann::json{{"sigma_xy_m", Num(b.pieces_sigma_xy_m)},
+                                {"sigma_theta_rad", Num(b.pieces_sigma_theta_rad)}}
+               : nlohmann::json(nullptr)},
           {"start", b.start},
           {"return_error_noise_fit",
            b.return_fit ? nlohmann::json{{"k_L", Num(b.return_k_L)},
@@ -229,15 +241,22 @@ void RunFaultSection(TextReport& o, const DiagnoseSummary& s) {
 void BaselineSection(TextReport& o, const DiagnoseSummary& s) {
   const BaselineSummary& b = s.baseline;
   o.line("1. Baseline (E_d, E_b, k_L, k_R; ground-truth noise " +
-         std::string(b.ground_truth_estimated ? "estimated" : "as stated in the manifest") + ")");
+         std::string(b.ground_truth_source == "standstills" ? "from the scatter inside the standstills"
+                     : b.ground_truth_estimated            ? "fitted with the wheel noise"
+                                                           : "as stated in the manifest") +
+         ")");
   o.line(fmt::format("  E_d = {:.6f}   E_b = {:.6f}   k_L = {:.3g} m^1/2   k_R = {:.3g} m^1/2", b.E_d, b.E_b, b.k_L, b.k_R));
   o.line(fmt::format("  ground truth: sigma_xy = {:.3g} mm, sigma_theta = {:.3g} mrad; start: {}", 1e3 * b.sigma_xy_m,
                      1e3 * b.sigma_theta_rad, b.start));
   if (b.standstill.measured)
     o.line(fmt::format("  ground truth's scatter inside standstills: sigma_xy = {:.3g} mm, sigma_theta = {:.3g} mrad ({} "
-                       "sample-to-sample differences in {} standstills)",
+                       "sample-to-sample differences in {} standstills; plateau at lags {} and {} samples)",
                        1e3 * b.standstill.sigma_xy_m, 1e3 * b.standstill.sigma_theta_rad, b.standstill.differences,
-                       b.standstill.standstills));
+                       b.standstill.standstills, b.standstill.lag_xy, b.standstill.lag_theta));
+  if (b.ground_truth_source == "standstills")
+    o.line(fmt::format("  fitted to the pieces with the wheel noise instead: sigma_xy = {:.3g} mm, sigma_theta = {:.3g} "
+                       "mrad (not used)",
+                       1e3 * b.pieces_sigma_xy_m, 1e3 * b.pieces_sigma_theta_rad));
   for (const auto& w : s.warnings) o.line("  WARNING: " + w);
   o.line(fmt::format("  {} runs, {} pieces", b.runs, b.pieces));
   if (b.return_fit)

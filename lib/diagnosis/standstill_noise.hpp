@@ -1,20 +1,39 @@
 // The ground truth's own noise, measured where no candidate effect reaches
-// it: sample-to-sample differences of the ground-truth pose inside
-// standstills (every interval still by the encoders), away from the stop
-// that begins them (settle_s: a clock offset, a slide, a settling or
-// standstill_motion act there) and from the start that ends them (a castor
-// kick may lead the first count by a sample). With white measurement noise
-// of sd sigma per sample, a difference has sd sqrt(2) sigma; the sd is taken
-// robustly (1.4826 x the median absolute deviation), so a nudge within a
-// standstill does not inflate it.
+// it: differences of the ground-truth pose inside standstills (every
+// interval still by the encoders), away from the stop that begins them
+// (settle_s: a clock offset, a slide, a settling or standstill_motion act
+// there) and from the start that ends them (a castor kick may lead the first
+// count by a sample). The baseline takes it as the ground truth's noise when
+// the manifest does not state one (baseline.hpp), so an effect the baseline
+// leaves out cannot widen the noise the gap test judges it against.
 //
-// Why: fitted together with the wheel noise on the pieces, the ground
-// truth's noise absorbs part of any effect the baseline leaves out (on a
-// real campaign 1.64 mm / 8.4 mrad fitted against 0.54 mm / 3.3 mrad of
-// standstill scatter; 13.8 mm with a 30 mm marker offset injected), and the
-// gap test then finds less. The standstill scatter cannot move with an
-// effect of the list. Mocap noise correlated over a few samples makes it an
-// underestimate; it is the lower end of what the ground truth can be.
+// Estimator (the structure function's plateau). For a stationary capture
+// noise e_i of sd sigma and autocorrelation r(k), a difference over k
+// samples has
+//   D(k) = Var(e_{i+k} - e_i) = 2 sigma^2 (1 - r(k)).
+// White noise: D(k) = 2 sigma^2 at every lag. Noise correlated over a few
+// samples (a capture system's filter): r(1) > 0, so the sample-to-sample
+// difference underestimates sigma by sqrt(1 - r(1)); D rises with k and
+// levels off at 2 sigma^2 once r(k) ~ 0. So sigma(k) = sqrt(D(k) / 2) is
+// measured at lags k = 1, 2, 4, ... (max_lag), each robustly (1.4826 x the
+// median absolute deviation of the differences, so a nudge inside a
+// standstill does not inflate it), and the estimate is sigma(2k) for the
+// first lag k whose doubling raises it by no more than plateau_tolerance
+// (the plateau; for white noise sigma(2) ~ sigma(1)). Example: AR(1) noise
+// with r(1) = 0.8, r(k) = 0.8^k: sigma(1) = 0.45 sigma, sigma(2) = 0.60,
+// sigma(4) = 0.77, sigma(8) = 0.91, sigma(16) = 0.99 sigma; the first
+// doubling within 15 % is 8 -> 16, so the estimate is sigma(16). Lags are
+// used while they have min_differences. A drift inside the standstills (no
+// plateau up to the longest lag) leaves the largest lag's value, reported
+// as `plateau = false`: then sigma is an upper end (a single usable lag is
+// reported the same way: the correlation was not checked).
+//
+// Floor: a physics engine's ground truth (or a noise-free simulation) has
+// standstills without any scatter (sigma 0), and a noise of 0 would make a
+// standstill piece's covariance singular and every micrometre of numerical
+// jitter a gap. The estimate is raised to floor_xy_m / floor_theta_rad
+// (0.01 mm / 0.01 mrad, below any motion capture's noise; the 5th decimal of
+// a pose in metres) and `floored` says so.
 #pragma once
 
 #include <string>
@@ -28,16 +47,35 @@ struct StandstillNoiseOptions {
   double settle_s = 0.5;
   /// Samples before the next motion's first count left out (>= 0). Default 1.
   int lead_samples = 1;
-  /// Fewest differences per component for a measurement (>= 3). Default 30.
+  /// Fewest differences per component and lag for a measurement (>= 3).
+  /// Default 30 (the robust sd's sampling error is then about 20 %).
   int min_differences = 30;
+  /// Longest lag of the structure function [samples] (>= 1; 1 is the plain
+  /// sample-to-sample estimate). Default 16 (0.8 s at 20 Hz).
+  int max_lag = 16;
+  /// A doubling of the lag that raises sigma by at most this fraction is
+  /// the plateau (> 0). Default 0.15.
+  double plateau_tolerance = 0.15;
+  /// Floors of the estimate [m], [rad] (>= 0). Default 1e-5 each.
+  double floor_xy_m = 1e-5, floor_theta_rad = 1e-5;
 
   std::string Check() const;
 };
 
 struct StandstillNoise {
-  bool measured = false;  ///< enough differences (min_differences)
+  bool measured = false;  ///< enough differences at lag 1 (min_differences)
+  /// Per-sample sd at the plateau, floored [m], [rad].
   double sigma_xy_m = 0.0, sigma_theta_rad = 0.0;
-  int differences = 0;  ///< heading differences used (position: twice as many values, x and y)
+  /// The sample-to-sample estimate (lag 1), unfloored [m], [rad].
+  double lag1_sigma_xy_m = 0.0, lag1_sigma_theta_rad = 0.0;
+  /// Lag of the plateau [samples], per component.
+  int lag_xy = 1, lag_theta = 1;
+  /// The structure function levelled off (false: still rising at the
+  /// longest lag measured, sigma is an upper end).
+  bool plateau_xy = true, plateau_theta = true;
+  /// Raised to the floor (noise-free standstills).
+  bool floored_xy = false, floored_theta = false;
+  int differences = 0;  ///< heading differences at lag 1 (position: twice as many values, x and y)
   int standstills = 0;  ///< standstills that contributed
 };
 
