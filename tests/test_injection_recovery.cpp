@@ -215,13 +215,13 @@ TEST_CASE("diagnose names and sizes effects injected into a real session", "[dia
     // Issue 28: under the baseline, run 1 of the circles stood out by its
     // clock (z = 13.9 against 11.4) and was left out as faulty, though the
     // clock acts on every run; under the explained model it does not stand
-    // out, and the note says so.
+    // out, and the note says so. With the ground truth's noise from the
+    // standstills (issue 28 item 2) the screen suspects no run at all: no
+    // run is left out and no note speaks of one.
     const auto j = DiagnoseS1({"time_offset:tau=-0.06"}, 102);
     INFO(j["notes"].dump());
     CHECK(j["run_faults"].empty());
-    bool cleared = false;
-    for (const auto& n : j["notes"]) cleared = cleared || n.get<std::string>().rfind("no faulty run:", 0) == 0;
-    CHECK(cleared);
+    for (const auto& n : j["notes"]) CHECK(n.get<std::string>().find("left out of every fit") == std::string::npos);
   }
   SECTION("scale_error s = +1.5 %: named, s within 25 %") {
     const auto j = DiagnoseS1({"scale_error:s=0.015"}, 108);

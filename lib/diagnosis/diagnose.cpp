@@ -351,7 +351,8 @@ std::string StandstillNote(const BaselineSummary& b) {
   const StandstillNoise& s = b.standstill;
   if (!s.measured || b.ground_truth_source != "standstills") return {};
   std::vector<std::string> parts;
-  if (s.lag_xy > 1 || s.lag_theta > 1)
+  const double tol = 1.0 + StandstillNoiseOptions{}.plateau_tolerance;
+  if (s.sigma_xy_m > tol * s.lag1_sigma_xy_m || s.sigma_theta_rad > tol * s.lag1_sigma_theta_rad)
     parts.push_back(fmt::format("the capture noise is correlated over samples: the sample-to-sample scatter ({:.3g} mm, "
                                 "{:.3g} mrad) levels off at lags of {} and {} samples ({:.3g} mm, {:.3g} mrad)",
                                 1e3 * s.lag1_sigma_xy_m, 1e3 * s.lag1_sigma_theta_rad, s.lag_xy, s.lag_theta,
