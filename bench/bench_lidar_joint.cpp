@@ -11,7 +11,12 @@
 // fitted clock puts them). Median 95 % half-widths show
 // whether an interval is still useful.
 //   bench_lidar_joint BAGS MINUTES [FIRST_SEED] [--upside-down] [--quiet]
-//                     [--one-way] [--no-gyro-offset]
+//                     [--one-way] [--no-gyro-offset] [--sweep FRACTION] [--stamp-end]
+//                     [--no-deskew]
+// --sweep times the beams over that share of the scan period (motion
+// distortion; time_increment set) and --stamp-end stamps each scan at its
+// last ray (the clock's truth is then the offset plus the sweep);
+// --no-deskew registers the sweeps as if instantaneous.
 // --one-way registers each keyframe pair one way only and --no-gyro-offset
 // fits the gyro's scale and bias alone (the fit before both were added).
 // bench/lidar_joint_bench.sh runs 200 five-minute bags and a 10-minute one.
@@ -59,12 +64,16 @@ int main(int argc, char** argv) {
   const int bags = std::atoi(argv[1]);
   const double minutes = std::atof(argv[2]);
   const std::uint64_t first = argc > 3 && argv[3][0] != '-' ? std::strtoull(argv[3], nullptr, 10) : 1;
-  bool upside = false, quiet = false, one_way = false, no_gyro_offset = false;
+  bool upside = false, quiet = false, one_way = false, no_gyro_offset = false, stamp_end = false, no_deskew = false;
+  double sweep = 0.0;
   for (int i = 3; i < argc; ++i) {
     if (std::strcmp(argv[i], "--one-way") == 0) one_way = true;
     if (std::strcmp(argv[i], "--no-gyro-offset") == 0) no_gyro_offset = true;
     if (std::strcmp(argv[i], "--upside-down") == 0) upside = true;
     if (std::strcmp(argv[i], "--quiet") == 0) quiet = true;
+    if (std::strcmp(argv[i], "--stamp-end") == 0) stamp_end = true;
+    if (std::strcmp(argv[i], "--no-deskew") == 0) no_deskew = true;
+    if (std::strcmp(argv[i], "--sweep") == 0 && i + 1 < argc) sweep = std::atof(argv[i + 1]);
   }
   Stat st[] = {{"wheelbase", "%", 100.0}, {"D_left", "%", 100.0},   {"D_right", "%", 100.0}, {"mount x", "mm", 1e3},
                {"mount y", "mm", 1e3},    {"mount yaw", "deg", Rad2Deg(1.0)}, {"clock", "ms", 1e3}, {"gyro scale", "%", 100.0},
@@ -79,6 +88,10 @@ int main(int argc, char** argv) {
     c.seed = first + static_cast<std::uint64_t>(b);
     c.minutes = minutes;
     c.upside_down = upside;
+    c.sweep_fraction = sweep;
+    c.stamp_at_end = stamp_end;
+    // The clock's truth: header stamp minus the first ray's time.
+    const double clock_truth = c.time_offset_s + (stamp_end ? sweep / c.scan_hz * (c.beams - 1) / c.beams : 0.0);
     double t0 = CpuSeconds();
     const testing::LidarSimBag bag = testing::SimulateLidarDrive(c);
     sim_s += CpuSeconds() - t0;
@@ -92,6 +105,7 @@ int main(int argc, char** argv) {
     try {
       calibration::LidarCalibrationOptions options;
       options.pairs.symmetric = !one_way;
+      options.pairs.deskew = !no_deskew;
       options.gyro_time_offset = !no_gyro_offset;
       const auto r = calibration::CalibrateLidar(in, options);
       fit_s += CpuSeconds() - t0;
@@ -100,7 +114,7 @@ int main(int argc, char** argv) {
       const double tb = c.wheelbase_m, tl = c.c_left * 0.066, tr = c.c_right * 0.066;
       const double err[9] = {r.parameters.wheelbase_m / tb - 1, r.parameters.wheel_diameter_left_m / tl - 1,
                              r.parameters.wheel_diameter_right_m / tr - 1, r.mount.x - c.mount.x, r.mount.y - c.mount.y,
-                             WrapAngle(r.mount.theta - c.mount.theta), r.time_offset_s - c.time_offset_s,
+                             WrapAngle(r.mount.theta - c.mount.theta), r.time_offset_s - clock_truth,
                              r.gyro_scale ? *r.gyro_scale / c.gyro_scale - 1 : 0.0,
                              r.gyro_bias_rad_s ? *r.gyro_bias_rad_s - c.gyro_bias : 0.0};
       const double half[9] = {1.96 * sd(0) / tb, 1.96 * sd(1) / tl, 1.96 * sd(2) / tr, 1.96 * sd(3), 1.96 * sd(4),
@@ -108,7 +122,7 @@ int main(int argc, char** argv) {
       for (int i = 0; i < 9; ++i) st[i].Add(err[i], half[i]);
       // The sample averages the next millisecond (-0.5 ms), seen through the
       // fitted scan clock (its error shifts every integration window alike).
-      const double gyro_offset_truth = -0.0005 + (r.time_offset_s - c.time_offset_s);
+      const double gyro_offset_truth = -0.0005 + (r.time_offset_s - clock_truth);
       if (r.gyro_time_offset_s) st[9].Add(*r.gyro_time_offset_s - gyro_offset_truth, 1.96 * r.gyro_time_offset_sd);
       const auto& lp = r.linear.params;
       const double lin[6] = {100 * (lp.wheelbase_m / tb - 1), 100 * (lp.c_left / c.c_left - 1), 100 * (lp.c_right / c.c_right - 1),

@@ -103,7 +103,7 @@ TEST_CASE("calibrate-lidar: an upside-down lidar, a late scan clock and a gyro f
   CHECK_THAT(yaml, Contains("static_transform_publisher") && Contains("--frame-id base_link --child-frame-id laser"));
 }
 
-TEST_CASE("calibrate-lidar: a namespaced /tf_static that agrees, and --distance-m") {
+TEST_CASE("calibrate-lidar: a namespaced /tf_static that agrees, found with --tf-static") {
   const auto truth = nlohmann::json::parse(Slurp((kLidar / "README-truth.json").string()))["drive_ns.mcap"];
   const auto r = RunCli("calibrate-lidar " + Q(kLidar / "drive_ns.mcap") + " --scan /scan --wheels /joint_states --tf-static "
                         "/robot1/tf_static --robot " + Q(kLidar / "robot.toml") + " --json -");

@@ -115,6 +115,36 @@ TEST_CASE("a five-minute drive recovers the wheels, mount, clock and gyro within
   }
 }
 
+TEST_CASE("sweeping scans (time_increment) are deskewed: the clock is the first ray's, stamped at either end") {
+  // Each beam is cast from where the lidar is at its own time over the whole
+  // 0.1 s period (up to 3 cm and 0.12 rad of motion within a scan).
+  // Registered as instantaneous, a scan sits at its mid-sweep and the fitted
+  // clock is off by about half the sweep; deskewed, it is the first ray's
+  // (the stamp offset, plus the sweep when the driver stamps the last ray).
+  for (const bool at_end : {false, true}) {
+    testing::LidarSimConfig c;
+    c.seed = 21;
+    c.minutes = 1.0;
+    c.sweep_fraction = 1.0;
+    c.stamp_at_end = at_end;
+    const testing::LidarSimBag bag = testing::SimulateLidarDrive(c);
+    REQUIRE(bag.scans.front().time_increment == Approx(0.1 / 360));
+    const double truth = c.time_offset_s + (at_end ? 0.1 * 359.0 / 360.0 : 0.0);
+    INFO("stamped at the " << (at_end ? "last" : "first") << " ray");
+    const LidarCalibration r = CalibrateLidar(InputOf(bag, c));
+    CHECK(r.time_offset_s == Approx(truth).margin(0.005));
+    CHECK(r.parameters.wheelbase_m == Approx(c.wheelbase_m).epsilon(0.003));
+    CHECK(r.mount.x == Approx(c.mount.x).margin(0.005));
+    CHECK(r.mount.y == Approx(c.mount.y).margin(0.005));
+    if (!at_end) {
+      LidarCalibrationOptions raw;
+      raw.pairs.deskew = false;
+      const LidarCalibration s = CalibrateLidar(InputOf(bag, c), raw);
+      CHECK(s.time_offset_s - truth < -0.03);  // the mid-sweep, 50 ms after the first ray
+    }
+  }
+}
+
 TEST_CASE("seeded Monte Carlo: the 95 % intervals hold the truth as often as they say") {
   // 12 two-minute drives (seeds 1000-1011), 7 quantities each = 84 checks.
   // With right intervals the count inside is Binomial(84, 0.95): mean 79.8,

@@ -375,7 +375,11 @@ Pose2 FirstToLast(const LidarCalibrationInput& in, const PairResult& pr, const L
     if (k > 0 && (a.t_ns + margin > first_motion || b.t_ns - margin < last_motion)) break;
     ++tried;
     const scan::ScanModel model(a);
-    const scan::MatchResult m = scan::MatchScan(model, scan::ScanPoints(b), chain, o.pairs.match);
+    // Every pair counts here: a far registration pairs too few points without
+    // the background beside the edges (skip_shadow_edges).
+    scan::MatchOptions match = o.pairs.match;
+    match.skip_shadow_edges = false;
+    const scan::MatchResult m = scan::MatchScan(model, scan::ScanPoints(b), chain, match);
     const bool ok = m.pairs >= o.pairs.min_points && m.PairedFraction() >= o.pairs.min_paired_fraction &&
                     scan::UndeterminedDirections(m.information, m.pairs, 0.0, o.pairs.max_dilution).empty() &&
                     std::hypot(m.pose.x - chain.x, m.pose.y - chain.y) <= 0.3 &&

@@ -289,6 +289,8 @@ std::string LidarJointOptions::Validate() const {
                                 std::pair{"prior_yaw_sd_rad", prior_yaw_sd_rad}, std::pair{"prior_offset_sd_s", prior_offset_sd_s},
                                 std::pair{"max_offset_s", max_offset_s}, std::pair{"outlier_chi2", outlier_chi2}})
     if (!(v > 0.0) || !std::isfinite(v)) return fmt::format("{} = {}: must be a finite number > 0", name, v);
+  if (!(registration_scale_sd >= 0.0 && registration_scale_sd < 0.1))
+    return fmt::format("registration_scale_sd = {}: must be in [0, 0.1)", registration_scale_sd);
   if (rounds < 1) return fmt::format("rounds = {}: must be >= 1", rounds);
   if (max_iterations < 1) return fmt::format("max_iterations = {}: must be >= 1", max_iterations);
   return {};
@@ -483,7 +485,12 @@ LidarJointFit FitLidarJoint(const std::vector<WheelTravelSample>& wheels, const 
   Eigen::SelfAdjointEigenSolver<Mat7> es(meat);
   meat = es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).asDiagonal() * es.eigenvectors().transpose();
   const Mat7 hinv = h.inverse();
-  const Mat7 cov = hinv * meat * hinv;
+  Mat7 cov = hinv * meat * hinv;
+  // Model error: a common scale error e of the registrations moves every
+  // length by e times itself (the clock and the yaw are scale-free).
+  Vec7 lengths = Vec7::Zero();
+  for (const int i : {kCLeft, kCRight, kWheelbase, kMountX, kMountY}) lengths(i) = p(i);
+  cov += o.registration_scale_sd * o.registration_scale_sd * lengths * lengths.transpose();
   for (int r = 0; r < kLidarParams; ++r)
     for (int c = 0; c < kLidarParams; ++c) fit.covariance[static_cast<std::size_t>(r * kLidarParams + c)] = cov(r, c);
   fit.measurements = costs.size();

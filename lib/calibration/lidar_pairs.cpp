@@ -61,15 +61,24 @@ PairResult RegisterScanPairs(const std::vector<scan::LaserScan>& scans, const Pa
   PairResult out;
   std::unique_ptr<scan::ScanModel> model;
   std::size_t kf = 0;
+  scan::LaserScan kf_scan;                 // the keyframe as registered (deskewed)
   Pose2 lidar0_T_kf, kf_T_prev, velocity;  // velocity: prev_T_cur of the last step
   for (std::size_t j = 0; j < scans.size(); ++j) {
-    const scan::LaserScan& s = scans[j];
+    const bool sweeping = o.deskew && scans[j].time_increment != 0.0 && scans[j].ranges.size() > 1 && j > 0;
+    // The motion over the sweep from a step's motion (constant velocity).
+    const double sweep_share =
+        sweeping ? std::abs(scans[j].time_increment) * static_cast<double>(scans[j].ranges.size() - 1) /
+                       std::max(1e-3, static_cast<double>(scans[j].t_ns - scans[j - 1].t_ns) * 1e-9)
+                 : 0.0;
+    auto over_sweep = [&](const Pose2& step) { return Pose2{sweep_share * step.x, sweep_share * step.y, sweep_share * step.theta}; };
+    scan::LaserScan s = sweeping ? scan::Deskew(scans[j], over_sweep(velocity)) : scans[j];
     ++out.scans;
     // Scan j becomes the keyframe; the velocity is kept unless tracking was lost.
     auto restart = [&](bool keep_velocity) {
       model = std::make_unique<scan::ScanModel>(s);
       if (model->usable() < o.min_points) model.reset();
       kf = j;
+      kf_scan = s;
       kf_T_prev = {};
       if (!keep_velocity) velocity = {};
     };
@@ -77,8 +86,12 @@ PairResult RegisterScanPairs(const std::vector<scan::LaserScan>& scans, const Pa
       restart(false);
       continue;
     }
-    const std::vector<scan::Point2> points = scan::ScanPoints(s);
-    const scan::MatchResult m = scan::MatchScan(*model, points, Compose(kf_T_prev, velocity), o.match);
+    scan::MatchResult m = scan::MatchScan(*model, scan::ScanPoints(s), Compose(kf_T_prev, velocity), o.match);
+    if (sweeping && m.pairs >= o.min_points) {
+      // Second pass: deskewed by the step this registration gives.
+      s = scan::Deskew(scans[j], over_sweep(Compose(Inverse(kf_T_prev), m.pose)));
+      m = scan::MatchScan(*model, scan::ScanPoints(s), m.pose, o.match);
+    }
     if (m.pairs < o.min_points) {
       ++out.lost;
       lidar0_T_kf = Compose(lidar0_T_kf, Compose(kf_T_prev, velocity));  // dead reckoning over the gap
@@ -96,7 +109,7 @@ PairResult RegisterScanPairs(const std::vector<scan::LaserScan>& scans, const Pa
     p.t_a_ns = scans[kf].t_ns;
     p.t_b_ns = s.t_ns;
     p.lidar_a_T_lidar_b = m.pose;
-    const std::size_t old_kf = kf;
+    const scan::LaserScan old_kf_scan = std::move(kf_scan);
     p.covariance = m.Covariance();
     p.pairs = m.pairs;
     p.lidar0_T_lidar_a = lidar0_T_kf;
@@ -106,7 +119,7 @@ PairResult RegisterScanPairs(const std::vector<scan::LaserScan>& scans, const Pa
       p.open_direction_rad = WrapAngle(lidar0_T_kf.theta + OpenDirection(p.covariance));
     lidar0_T_kf = Compose(lidar0_T_kf, m.pose);
     restart(true);
-    if (o.symmetric && model) p.lidar_a_T_lidar_b = Symmetrised(*model, scans[old_kf], m.pose, o);
+    if (o.symmetric && model) p.lidar_a_T_lidar_b = Symmetrised(*model, old_kf_scan, m.pose, o);
     out.pairs.push_back(std::move(p));
   }
   out.lidar0_T_lidar_last = Compose(lidar0_T_kf, kf_T_prev);

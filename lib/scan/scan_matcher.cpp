@@ -68,10 +68,23 @@ ScanModel::ScanModel(const LaserScan& scan)
   full_circle_ = static_cast<double>(n) * std::abs(scan.angle_increment) >= 2.0 * kPi - 1.5 * std::abs(scan.angle_increment);
   points_.assign(n, {kNaN, kNaN});
   normals_.assign(n, {kNaN, kNaN});
+  std::vector<double> ranges(n, kNaN);
+  shadow_.assign(n, 0);
   for (std::size_t i = 0; i < n; ++i) {
     if (!scan.Valid(i)) continue;
     const double a = scan.angle_min + static_cast<double>(i) * scan.angle_increment;
     points_[i] = {scan.ranges[i] * std::cos(a), scan.ranges[i] * std::sin(a)};
+    ranges[i] = scan.ranges[i];
+  }
+  // Shadow edges: beams beside a beam more than 0.1 m nearer (see MatchOptions).
+  for (std::size_t i = 0; i < n; ++i) {
+    if (std::isnan(ranges[i])) continue;
+    for (long d : {-2L, -1L, 1L, 2L}) {
+      long j = static_cast<long>(i) + d;
+      if (full_circle_) j = (j % static_cast<long>(n) + static_cast<long>(n)) % static_cast<long>(n);
+      if (j < 0 || j >= static_cast<long>(n)) continue;
+      if (ranges[static_cast<std::size_t>(j)] < ranges[i] - 0.1) shadow_[i] = 1;
+    }
   }
   // A normal from the scatter of the neighbours near the point (a line fit).
   const auto ni = static_cast<long>(n);
@@ -145,7 +158,8 @@ struct MatchKernel {
   };
 
   // The nearest model point with a normal among the beams around q's bearing.
-  static bool Pair1(const ScanModel& model, const Point2& q, int search, double max_d, Point2& m, Point2& n) {
+  static bool Pair1(const ScanModel& model, const Point2& q, int search, double max_d, Point2& m, Point2& n,
+                    const MatchOptions& o) {
     const auto nb = static_cast<long>(model.points_.size());
     const double bearing = FastAtan2(q.y, q.x);
     const double rel = model.full_circle_ ? WrapAngle(bearing - model.angle_min_) : bearing - model.angle_min_;
@@ -159,6 +173,7 @@ struct MatchKernel {
       if (j < 0 || j >= nb) continue;
       const Point2& p = model.points_[static_cast<std::size_t>(j)];
       if (std::isnan(model.normals_[static_cast<std::size_t>(j)].x)) continue;
+      if (o.skip_shadow_edges && model.shadow_[static_cast<std::size_t>(j)]) continue;
       const double d2 = (p.x - q.x) * (p.x - q.x) + (p.y - q.y) * (p.y - q.y);
       if (d2 < best) {
         best = d2;
@@ -186,7 +201,7 @@ struct MatchKernel {
       for (const Point2& p : pts) {
         const Point2 q{res.pose.x + c * p.x - s * p.y, res.pose.y + s * p.x + c * p.y};
         Point2 m, n;
-        if (!Pair1(model, q, o.search_beams, o.max_pair_distance_m, m, n)) continue;
+        if (!Pair1(model, q, o.search_beams, o.max_pair_distance_m, m, n, o)) continue;
         const double r = n.x * (q.x - m.x) + n.y * (q.y - m.y);
         if (std::abs(r) <= gate) pairs.push_back({q, m, n, r});
       }
@@ -235,7 +250,7 @@ struct MatchKernel {
     for (const Point2& p : pts) {
       const Point2 q{res.pose.x + c * p.x - s * p.y, res.pose.y + s * p.x + c * p.y};
       Point2 m, n;
-      if (!Pair1(model, q, o.search_beams, o.max_pair_distance_m, m, n)) continue;
+      if (!Pair1(model, q, o.search_beams, o.max_pair_distance_m, m, n, o)) continue;
       const double r = n.x * (q.x - m.x) + n.y * (q.y - m.y);
       if (std::abs(r) > gate) continue;
       const double lx = q.x - res.pose.x, ly = q.y - res.pose.y;

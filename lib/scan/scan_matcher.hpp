@@ -42,6 +42,7 @@ class ScanModel {
   friend struct MatchKernel;
   std::vector<Point2> points_;   ///< per beam; NaN when no return
   std::vector<Point2> normals_;  ///< per beam; NaN when no line fits the neighbours
+  std::vector<unsigned char> shadow_;  ///< per beam: next to a beam nearer by more than 0.1 m (an occluder's edge behind)
   double angle_min_ = 0.0, angle_increment_ = 0.0;
   bool full_circle_ = false;
   std::size_t usable_ = 0;
@@ -58,6 +59,12 @@ struct MatchOptions {
   double huber_k = 1.345;         ///< Huber threshold in robust standard deviations
   double min_noise_m = 0.001;     ///< floor of the robust residual scale
   double tolerance_m = 1e-7;      ///< stop when the step moves a point at 1 m less than this
+  /// No pairs with model points within 2 beams of a beam more than 0.1 m
+  /// nearer (the background beside an occluder's edge, where the other scan
+  /// sees the surface the occluder hides). Off by default (the squares
+  /// import's accuracy was measured without it); calibrate-lidar's
+  /// registrations turn it on (lidar_pairs.hpp).
+  bool skip_shadow_edges = false;
   /// Empty when valid, else a message naming the bad field.
   std::string Validate() const;
 };

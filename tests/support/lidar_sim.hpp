@@ -7,7 +7,9 @@
 // a 2-D lidar at a chosen mounting pose (possibly upside down: beam angles
 // mirrored) returns ranges with Gaussian noise and 1 % dropouts, its header
 // stamps off by a chosen clock offset; a gyro reads scale * rate + bias +
-// noise. Scans are instantaneous (taken at the first ray's time).
+// noise. Scans are instantaneous (taken at the first ray's time) unless
+// sweep_fraction says otherwise (each beam cast at its own time, the header
+// stamp at the first ray or, stamp_at_end, the last).
 //
 //   room (metres, origin at its centre):  8 x 6 walls, a niche, a cupboard,
 //   a table with four legs, two pillars, a sofa; the robot stays in
@@ -19,6 +21,7 @@
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "calibration/lidar_joint.hpp"
@@ -52,6 +55,14 @@ struct LidarSimConfig {
   /// Drive: "ordinary" (mixed), "straight" (back and forth, no turns but the
   /// reversals in place... none: the robot drives straight back and forth).
   bool turns = true;
+  /// Sweep timing: 0 = instantaneous scans (every beam at the first ray's
+  /// time, time_increment 0); else the beams are cast one after another
+  /// over this fraction of the scan period from where the lidar is at each
+  /// beam's own time (motion distortion), and time_increment says so.
+  double sweep_fraction = 0.0;
+  /// Header stamp at the sweep's last ray instead of its first (a driver
+  /// convention); time_offset_s stays the first ray's stamp offset.
+  bool stamp_at_end = false;
   bool corridor = false;  ///< a 2.4 m wide corridor whose ends are beyond the range instead of the room
 };
 
@@ -216,6 +227,17 @@ inline LidarSimBag SimulateLidarDrive(const LidarSimConfig& c) {
   const auto wheel_every = static_cast<std::size_t>(0.02 / dt), gyro_every = static_cast<std::size_t>(0.01 / dt);
   const auto scan_every = static_cast<std::size_t>(std::lround(1.0 / c.scan_hz / dt));
   const std::vector<Segment> room = FurnishedRoom(c.corridor);
+  const double beam_s = c.sweep_fraction / c.scan_hz / c.beams;  // time_increment
+  auto lidar_at = [&](double t_s) {  // lidar pose t_s seconds after the start (poses so far)
+    const double f = std::min(t_s / dt, static_cast<double>(bag.truth.size() - 1));
+    const auto k0 = static_cast<std::size_t>(f);
+    const std::size_t k1 = std::min(k0 + 1, bag.truth.size() - 1);
+    const double u = f - static_cast<double>(k0);
+    const Pose2& a = bag.truth[k0];
+    const Pose2& b = bag.truth[k1];
+    return Compose(Pose2{a.x + u * (b.x - a.x), a.y + u * (b.y - a.y), a.theta + u * WrapAngle(b.theta - a.theta)}, c.mount);
+  };
+  std::vector<std::pair<std::size_t, int>> sweeping;  // (scan, next beam): cast as the poses arrive
   for (std::size_t i = 0; i <= steps; ++i) {
     const std::int64_t t_ns = t0 + static_cast<std::int64_t>(i) * 1'000'000;
     if (i % wheel_every == 0) {
@@ -229,15 +251,28 @@ inline LidarSimBag SimulateLidarDrive(const LidarSimConfig& c) {
     const double rate = i < steps ? w[i] : 0.0;
     if (i % gyro_every == 0) bag.gyro.push_back({t_ns, c.gyro_scale * rate + c.gyro_bias + c.gyro_sd * n01(rng)});
     if (i % scan_every == 37 % scan_every) {
-      const Pose2 lidar = Compose(p, c.mount);
       scan::LaserScan s;
-      s.t_ns = t_ns + static_cast<std::int64_t>(std::llround(c.time_offset_s * 1e9));
+      s.t_ns = t_ns + static_cast<std::int64_t>(std::llround((c.time_offset_s + (c.stamp_at_end ? beam_s * (c.beams - 1) : 0.0)) * 1e9));
       s.angle_min = -kPi;
       s.angle_increment = 2.0 * kPi / c.beams;
       s.range_min = 0.1;
       s.range_max = c.range_max_m;
-      s.ranges.resize(static_cast<std::size_t>(c.beams));
-      for (int b = 0; b < c.beams; ++b) {
+      s.time_increment = beam_s;
+      s.scan_time = 1.0 / c.scan_hz;
+      s.ranges.assign(static_cast<std::size_t>(c.beams), std::numeric_limits<float>::quiet_NaN());
+      bag.scans.push_back(std::move(s));
+      sweeping.emplace_back(bag.scans.size() - 1, 0);
+    }
+    // Beams whose time has come (all at once without a sweep), cast from
+    // the lidar's pose then; random numbers drawn in beam order.
+    for (auto& [j, next] : sweeping) {
+      scan::LaserScan& s = bag.scans[j];
+      const double first_s = static_cast<double>(s.t_ns - t0) * 1e-9 - c.time_offset_s - (c.stamp_at_end ? beam_s * (c.beams - 1) : 0.0);
+      for (; next < c.beams; ++next) {
+        const int b = next;
+        const double tb = first_s + b * beam_s;
+        if (tb > static_cast<double>(i) * dt + 1e-12) break;
+        const Pose2 lidar = lidar_at(tb);
         const double beam = s.angle_min + b * s.angle_increment;
         const double a = lidar.theta + (c.upside_down ? -beam : beam);
         double r = CastRay(room, lidar.x, lidar.y, a);
@@ -245,8 +280,9 @@ inline LidarSimBag SimulateLidarDrive(const LidarSimConfig& c) {
         else r += c.range_sd_m * n01(rng);
         s.ranges[static_cast<std::size_t>(b)] = static_cast<float>(r);
       }
-      bag.scans.push_back(std::move(s));
     }
+    sweeping.erase(std::remove_if(sweeping.begin(), sweeping.end(), [&](const auto& js) { return js.second >= c.beams; }),
+                   sweeping.end());
     if (i == steps) break;
     // True motion over the ms (wheel speeds from the commanded v, w).
     const double dl = (v[i] - 0.5 * w[i] * c.wheelbase_m) * dt, dr = (v[i] + 0.5 * w[i] * c.wheelbase_m) * dt;
