@@ -2,6 +2,7 @@
 #include "diagnosis/verdict.hpp"
 
 #include "diagnosis/explanation.hpp"
+#include "effects/registry.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -101,19 +102,18 @@ std::vector<std::size_t> Rank(const CandidateFits& fits, const Qualifies& qualif
     return ca.evidence > cb.evidence;
   });
   // A noise effect on top yields to a qualifying mechanism where motions
-  // start or stop (castor_kick, castor_swivel, stop_slide; possible
-  // values): kicks or slides that vary from start to start also read as
-  // bumps (DART's swivel castors), but bumps have no turn's or drive's sign.
-  // (Clocks are not noise effects here: a clock the moving samples support
-  // outranks a slide by evidence, as the ground truth lags on through a
-  // stop by v tau.)
+  // start or stop (each effect says whether it is one: Descriptor::
+  // at_motion_starts / at_motion_stops, the castor's kicks and the coast at
+  // stops; possible values): kicks or slides that vary from start to start
+  // also read as bumps (DART's swivel castors), but bumps have no turn's or
+  // drive's sign. (Clocks are not noise effects here: a clock the moving
+  // samples support outranks a slide by evidence, as the ground truth lags
+  // on through a stop by v tau.)
   auto start_stop = [](const Candidate& cd) {
-    return (cd.effect == sim::EffectKind::kCastorKick || cd.effect == sim::EffectKind::kCastorSwivel ||
-            cd.effect == sim::EffectKind::kStopSlide) && !cd.impossible;
+    const effects::Descriptor& d = effects::Of(cd.effect).Describe();
+    return (d.at_motion_starts || d.at_motion_stops) && !cd.impossible;
   };
-  auto pure_noise = [](const Candidate& cd) {
-    return IsNoiseEffect(cd.effect) && cd.effect != sim::EffectKind::kRunTimeOffset;
-  };
+  auto pure_noise = [](const Candidate& cd) { return effects::Of(cd.effect).PureNoise(); };
   auto promote_first = [&](auto&& which) {
     for (std::size_t k = 1; k < rank.size(); ++k)
       if (which(fits.candidates[rank[k]])) {
@@ -132,15 +132,12 @@ std::vector<std::size_t> Rank(const CandidateFits& fits, const Qualifies& qualif
         return start_stop(cd) && usable(cd) && cd.evidence > 0.0 && cd.heldout_shrink >= mechanism_shrink;
       });
   }
-  // A slide on top yields to a qualifying clock the moving samples support:
-  // the slide cannot explain those samples, the clock explains the stops
-  // too.
-  if (!rank.empty() && fits.candidates[rank.front()].effect == sim::EffectKind::kStopSlide &&
-      promote_first([&](const Candidate& cd) {
-        return qualifies(cd) &&
-               (cd.effect == sim::EffectKind::kTimeOffset || cd.effect == sim::EffectKind::kRunTimeOffset) &&
-               cd.clock.checked && cd.clock.supported;
-      }))
+  // A mechanism at the stops on top (a slide) yields to a qualifying clock
+  // the moving samples support (a clock is what the moving-sample check
+  // applies to, Candidate::clock): the slide cannot explain those samples,
+  // the clock explains the stops too.
+  if (!rank.empty() && effects::Of(fits.candidates[rank.front()].effect).Describe().at_motion_stops &&
+      promote_first([&](const Candidate& cd) { return qualifies(cd) && cd.clock.checked && cd.clock.supported; }))
     promoted = false;
   return rank;
 }
@@ -218,6 +215,18 @@ void Decide(const CandidateFits& fits, double score_p_value, double null_quantil
   }
 }
 
+/// The part of a candidate's note from the effect it is "indistinguishable
+/// from" on, when that is an effect (the registry knows its name), else
+/// empty.
+std::string OtherEffectInNote(const std::string& note) {
+  static constexpr std::string_view kFrom = "indistinguishable from ";
+  const std::size_t at = note.find(kFrom);
+  if (at == std::string::npos) return {};
+  const std::string rest = note.substr(at + kFrom.size());
+  const std::size_t end = rest.find_first_not_of("abcdefghijklmnopqrstuvwxyz_");
+  return effects::Find(rest.substr(0, end)) != nullptr ? rest : std::string();
+}
+
 /// What the data cannot tell apart: effects from the baseline, or from
 /// each other (footprints, or held-out evidence).
 void Indistinguishable(const CandidateFits& fits, const VerdictOptions& options, Verdict& out) {
@@ -226,9 +235,9 @@ void Indistinguishable(const CandidateFits& fits, const VerdictOptions& options,
       out.indistinguishable.push_back(fmt::format("{} cannot be told apart from the baseline with these experiments: {}",
                                                   sim::EffectToString(cd.effect),
                                                   cd.note.substr(cd.note.find("indistinguishable"))));
-    else if (!cd.identifiable && cd.note.find("indistinguishable from wheel_noise_error") != std::string::npos)
+    else if (const std::string other = OtherEffectInNote(cd.note); !cd.identifiable && !other.empty())
       out.indistinguishable.push_back(fmt::format("{} cannot be told apart from {}", sim::EffectToString(cd.effect),
-                                                  cd.note.substr(cd.note.find("wheel_noise_error"))));
+                                                  other));
     else if (cd.weak && sim::EffectToString(cd.effect) != out.verdict)
       out.indistinguishable.push_back(
           fmt::format("{} can hardly be told apart from the baseline with these experiments: {}",

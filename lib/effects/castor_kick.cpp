@@ -16,6 +16,7 @@ class CastorKick final : public Effect {
                 .kind = EffectKind::kCastorKick,
                 .order = 3,
                 .effect_class = EffectClass::kMechanism,
+                .at_motion_starts = true,
                 .definition = "at every start from standstill the true heading jumps by kappa (forward) or -kappa "
                               "(backward); spot turns excluded",
                 .parameters = {{"kappa", &Effects::castor_kappa, "rad", 0.005}}}) {}

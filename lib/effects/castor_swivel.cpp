@@ -21,6 +21,7 @@ class CastorSwivel final : public Effect {
                 .kind = EffectKind::kCastorSwivel,
                 .order = 13,
                 .effect_class = EffectClass::kMechanism,
+                .at_motion_starts = true,
                 .definition = "at the start of a straight or arc motion after a spot turn the heading jumps by kappa "
                               "times the turn's sign (ccw +1, cw -1); after a reversal of the drive direction by "
                               "+kappa or -kappa with equal probability",

@@ -86,6 +86,13 @@ struct Descriptor {
   /// A parameter error of a given model (`diagnose --baseline`): named by
   /// the diagnosis only, never simulated.
   bool parameter_error = false;
+  /// A mechanism that acts once where a motion starts (a castor's kick) or
+  /// stops (a coast): the verdict lets a qualifying one outrank a noise
+  /// effect that takes its start-to-start scatter, and lets a stop's one
+  /// yield to a clock the moving samples support (docs/diagnosis.md, "The
+  /// verdict's rule").
+  bool at_motion_starts = false;
+  bool at_motion_stops = false;
   std::string_view definition;
   std::vector<Parameter> parameters;
 };
@@ -102,6 +109,9 @@ class Effect {
   EffectClass Class() const { return d_.effect_class; }
   bool Random() const { return d_.random; }
   bool Simulated() const { return !d_.parameter_error; }
+  /// A random scatter of the robot or its sensors (class noise, fitted as a
+  /// variance): not a clock of the recording.
+  bool PureNoise() const { return d_.random && d_.effect_class == EffectClass::kNoise; }
   const std::vector<Parameter>& Parameters() const { return d_.parameters; }
   /// The typical size of parameter `name` (0 when it has none).
   double TypicalSize(std::string_view name) const;
@@ -125,6 +135,15 @@ class Effect {
   virtual std::string ConcreteChange(const Params& /*p*/, const AdviceContext& /*c*/) const { return {}; }
   /// The effect as a plain statement with the numbers. Default: "NAME is off".
   virtual std::string PlainProblem(const Params& p) const;
+  /// Simulation: multiplies the true left and right wheel's size (any
+  /// quantity proportional to it: metres per tick, diameter) in run
+  /// `run_index` (0-based, campaign order) by what the effect makes of it.
+  /// The simulator applies every effect in catalogue order. Default: none.
+  virtual void TrueWheels(const Effects& /*e*/, int /*run_index*/, double& /*left*/, double& /*right*/) const {}
+  /// Simulation: why a campaign of `runs` runs cannot have these values
+  /// (e.g. a drift that shrinks a wheel to nothing), or empty.
+  virtual std::string CheckCampaign(const Effects& /*e*/, int /*runs*/) const { return {}; }
+
   /// How a fitted parameter reads: {factor, unit} (value x factor, unit),
   /// e.g. {1e3, " mm"}; {0, ""} leaves it to the generic reading.
   virtual std::pair<double, const char*> ParamUnit(std::string_view /*param*/) const { return {0.0, ""}; }

@@ -34,6 +34,16 @@ class ParameterDrift final : public Effect {
                        100.0 * r, 100.0 * r * std::max(0, c.runs - 1), c.runs);
   }
 
+  void TrueWheels(const Effects& e, int run_index, double& /*left*/, double& right) const override {
+    right *= 1.0 + e.drift_r * static_cast<double>(run_index);
+  }
+
+  std::string CheckCampaign(const Effects& e, int runs) const override {
+    if (!(1.0 + e.drift_r * static_cast<double>(std::max(0, runs - 1)) > 0.0))
+      return fmt::format("parameter_drift.r = {} makes the right wheel diameter <= 0 by run {}", e.drift_r, runs - 1);
+    return {};
+  }
+
   std::string PlainProblem(const Params& p) const override {
     return fmt::format("the right wheel's diameter changes by {:.3g}% from run to run", 100.0 * Get(p, "r"));
   }

@@ -52,6 +52,11 @@ class ScaleError final : public Effect {
         c.robot.wheel_diameter_right_m, c.E_b * c.robot.wheelbase_m, c.E_b);
   }
 
+  void TrueWheels(const Effects& e, int /*run_index*/, double& left, double& right) const override {
+    left *= 1.0 + e.scale_s;
+    right *= 1.0 + e.scale_s;
+  }
+
   std::string PlainProblem(const Params& p) const override {
     return fmt::format("both wheels are {:.2f}% {} than the model says", 100.0 * std::abs(Get(p, "s")),
                        Get(p, "s") >= 0.0 ? "larger" : "smaller");

@@ -25,6 +25,7 @@ class StopSlide final : public Effect {
                 .kind = EffectKind::kStopSlide,
                 .order = 12,
                 .effect_class = EffectClass::kMechanism,
+                .at_motion_stops = true,
                 .definition = "at every stop after a straight or arc motion at speed v the chassis coasts on along "
                               "its last direction of travel by d v^2 m while the encoders read still; after a spot "
                               "turn at rate w it turns on by a w^2 rad",

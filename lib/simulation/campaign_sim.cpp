@@ -9,6 +9,7 @@
 
 #include "core/angles.hpp"
 #include "core/errors.hpp"
+#include "effects/registry.hpp"
 #include "evaluation/return_error.hpp"
 #include "kinematics/odometry.hpp"
 #include "model/true_robot.hpp"
@@ -294,14 +295,12 @@ SimulatedCampaign SimulateCampaign(const Manifest& manifest, const CampaignSimOp
   const std::vector<std::vector<PlannedRun>> plans = PlanCampaign(manifest, options, free_templates);
   int total = 0;
   for (const auto& l : plans) total += static_cast<int>(l.size());
-  const double last_drift = 1.0 + options.effects.drift_r * static_cast<double>(std::max(0, total - 1));
-  if (!(last_drift > 0.0))
-    throw InvalidOptions(fmt::format("simulate: parameter_drift.r = {} makes the right wheel diameter <= 0 by run {}",
-                                     options.effects.drift_r, total - 1));
+  for (const effects::Effect* fx : effects::All())
+    if (const std::string why = fx->CheckCampaign(options.effects, total); !why.empty())
+      throw InvalidOptions("simulate: " + why);
 
   const CampaignTruth& tr = options.truth;
   const double c_L = CorrectionLeft(tr.E_d), c_R = CorrectionRight(tr.E_d);
-  const double scale = 1.0 + options.effects.scale_s;
   GroundTruthNoise gt;
   if (options.ground_truth)
     gt = *options.ground_truth;
@@ -333,9 +332,12 @@ SimulatedCampaign SimulateCampaign(const Manifest& manifest, const CampaignSimOp
     TrajectoryData data;
     data.path = ex.file;
     for (const PlannedRun& pr : plans[e]) {
-      const double drift = 1.0 + options.effects.drift_r * static_cast<double>(run_index);
-      truth.true_per_tick_left = truth.nominal_per_tick_left * c_L * scale;
-      truth.true_per_tick_right = truth.nominal_per_tick_right * c_R * scale * drift;
+      // The effects that change the true wheels (each effect's TrueWheels).
+      truth.true_per_tick_left = truth.nominal_per_tick_left * c_L;
+      truth.true_per_tick_right = truth.nominal_per_tick_right * c_R;
+      for (const effects::Effect* fx : effects::All())
+        fx->TrueWheels(options.effects, static_cast<int>(run_index), truth.true_per_tick_left,
+                       truth.true_per_tick_right);
       SimulatedRun sr = SimulateLoggedRun(pr.plan, truth, options.seed, run_index, pr.id, pr.direction);
       out.bumps[e].push_back(sr.bumps_left + sr.bumps_right);
       data.runs.push_back(std::move(sr.run));
@@ -357,7 +359,9 @@ nlohmann::json CampaignTruthJson(const SimulatedCampaign& campaign, const Campai
   const CampaignTruth& tr = options.truth;
   const RobotParams& robot = campaign.manifest.robot;
   const double c_L = CorrectionLeft(tr.E_d), c_R = CorrectionRight(tr.E_d);
-  const double scale = 1.0 + options.effects.scale_s;
+  // Run 0's true wheels: the corrections times what the effects make of them.
+  double true_c_L = c_L, true_c_R = c_R;
+  for (const effects::Effect* fx : effects::All()) fx->TrueWheels(options.effects, 0, true_c_L, true_c_R);
   nlohmann::json effects = nlohmann::json::array();
   for (EffectKind k : options.effects.ActiveKinds()) {
     const EffectDescriptor& d = Describe(k);
@@ -384,8 +388,8 @@ nlohmann::json CampaignTruthJson(const SimulatedCampaign& campaign, const Campai
             {"c_R", c_R},
             {"true_robot_run0",
              {{"wheelbase_m", tr.E_b * robot.wheelbase_m},
-              {"wheel_diameter_left_m", c_L * scale * robot.wheel_diameter_left_m},
-              {"wheel_diameter_right_m", c_R * scale * robot.wheel_diameter_right_m}}}}},
+              {"wheel_diameter_left_m", true_c_L * robot.wheel_diameter_left_m},
+              {"wheel_diameter_right_m", true_c_R * robot.wheel_diameter_right_m}}}}},
           {"effects", effects},
           {"ground_truth",
            {{"sigma_xy_m", campaign.ground_truth_noise.sigma_xy_m},

@@ -1,0 +1,112 @@
+// Adding an effect touches its own file (issue 28 item 4): a dummy effect
+// defined only here, registered at run time, is found by name by the
+// registry and the diagnosis' plausibility and floors, and the simulator's
+// library path (sim::SimulateCampaign) applies it with no other file
+// touched. Reference: its closed form. A left wheel (1 - w) the size of the
+// right one on a straight leg of nominal wheel travel L turns the robot by
+// w L / b (b the wheelbase) while the odometry, driven by the same ticks,
+// says straight.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <memory>
+#include <variant>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "diagnosis/plausibility.hpp"
+#include "effects/registry.hpp"
+#include "simulation/campaign_sim.hpp"
+
+using namespace umbmark;
+using Catch::Matchers::WithinRel;
+
+namespace {
+
+/// A worn left tyre: the left wheel is (1 - w) times its size, in every run.
+class LeftTyreWear final : public effects::Effect {
+ public:
+  explicit LeftTyreWear(double w)
+      : Effect({.name = "left_tyre_wear",
+                .kind = std::nullopt,
+                .order = 50,
+                .effect_class = effects::EffectClass::kMechanism,
+                .definition = "the left wheel is (1 - w) times its size",
+                .parameters = {}}),
+        w_(w) {}
+  void TrueWheels(const effects::Effects& /*e*/, int /*run*/, double& left, double& /*right*/) const override {
+    left *= 1.0 - w_;
+  }
+  std::string Unphysical(const effects::Params& p, int /*runs*/, const effects::Params& /*se*/) const override {
+    return Get(p, "w") > 0.2 ? fmt::format("a tyre worn by {:.0f} %: flat", 100.0 * Get(p, "w")) : std::string();
+  }
+  std::string PracticalFloor(const effects::Params& p, const effects::CampaignScale& c) const override {
+    return Size(p, "w") * c.motion_length_m < c.FloorM() ? "worn by less than 0.3 mm per leg" : std::string();
+  }
+
+ private:
+  double w_;
+};
+
+const TrajectoryRun& FirstBackAndForthRun(const sim::SimulatedCampaign& c) {
+  REQUIRE(c.data.size() == 2);
+  REQUIRE(std::holds_alternative<TrajectoryData>(c.data[1]));
+  REQUIRE_FALSE(std::get<TrajectoryData>(c.data[1]).runs.empty());
+  return std::get<TrajectoryData>(c.data[1]).runs.front();
+}
+
+}  // namespace
+
+TEST_CASE("effects: a dummy effect added at run time is simulated and judged by name") {
+  RobotParams r;
+  r.wheelbase_m = 0.3;
+  r.wheel_diameter_left_m = r.wheel_diameter_right_m = 0.1;
+  r.ticks_per_rev = 4096;
+  sim::CampaignSimOptions o;
+  o.seed = 5;
+  o.square_runs_per_direction = 1;
+  o.back_and_forth_runs = 1;
+  o.truth.k_L = o.truth.k_R = 0.0;  // noise-free: the closed form holds exactly
+  const double L = 2.0, w = 0.01;
+  const Manifest m = sim::StandardCampaignManifest(r, 1.0, L, GroundTruthNoise{});
+  const sim::SimulatedCampaign before = sim::SimulateCampaign(m, o);
+  const nlohmann::json truth0 = sim::CampaignTruthJson(before, o).at("truth").at("true_robot_run0");
+
+  const std::size_t n = effects::All().size();
+  effects::Register(std::make_unique<LeftTyreWear>(w));
+  REQUIRE(effects::All().size() == n + 1);
+  const effects::Effect* e = effects::Find("left_tyre_wear");
+  REQUIRE(e != nullptr);
+  // Catalogue order: after the contract's fourteen effects (order 50).
+  CHECK(effects::All()[14] == e);
+  // The diagnosis asks the effect by name.
+  CHECK(diag::UnphysicalFit("left_tyre_wear", {{"w", 0.3}}, 10) == "a tyre worn by 30 %: flat");
+  CHECK(diag::UnphysicalFit("left_tyre_wear", {{"w", 0.01}}, 10).empty());
+
+  // The simulator applies it: the truth's left wheel (closed form), and the
+  // ground truth of the first straight leg turns by w L / b.
+  const sim::SimulatedCampaign after = sim::SimulateCampaign(m, o);
+  const nlohmann::json truth = sim::CampaignTruthJson(after, o).at("truth").at("true_robot_run0");
+  CHECK_THAT(truth.at("wheel_diameter_left_m").get<double>(),
+             WithinRel((1.0 - w) * truth0.at("wheel_diameter_left_m").get<double>(), 1e-12));
+  CHECK(truth.at("wheel_diameter_right_m").get<double>() == truth0.at("wheel_diameter_right_m").get<double>());
+  double turned[2] = {0.0, 0.0};
+  for (int k = 0; k < 2; ++k) {
+    const TrajectoryRun& run = FirstBackAndForthRun(k == 0 ? before : after);
+    // The first sample with the nominal travel of the leg (the encoders
+    // count the same ticks with and without the dummy).
+    REQUIRE(run.ticks_left.size() == run.t_s.size());
+    REQUIRE(run.gt_theta_rad.size() == run.t_s.size());
+    const double per_tick = r.MetresPerTickLeft();
+    std::size_t end = 0;
+    while (end + 1 < run.t_s.size() &&
+           0.5 * per_tick * static_cast<double>(run.ticks_left[end] + run.ticks_right[end]) < L - 1e-3)
+      ++end;
+    turned[k] = run.gt_theta_rad[end] - run.gt_theta_rad[0];
+  }
+  // Without it the leg is straight up to the controller's last tick (0.15
+  // mrad measured); with it the robot turns by w L / b = 66.7 mrad.
+  CHECK(std::abs(turned[0]) < 1e-3);
+  CHECK_THAT(turned[1] - turned[0], WithinRel(w * L / r.wheelbase_m, 0.02));
+}
