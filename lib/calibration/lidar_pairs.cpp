@@ -1,6 +1,7 @@
 // Keyframe registration of a drive's scans (see lidar_pairs.hpp).
 #include "calibration/lidar_pairs.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -87,10 +88,17 @@ PairResult RegisterScanPairs(const std::vector<scan::LaserScan>& scans, const Pa
       continue;
     }
     scan::MatchResult m = scan::MatchScan(*model, scan::ScanPoints(s), Compose(kf_T_prev, velocity), o.match);
-    if (sweeping && m.pairs >= o.min_points) {
-      // Second pass: deskewed by the step this registration gives.
-      s = scan::Deskew(scans[j], over_sweep(Compose(Inverse(kf_T_prev), m.pose)));
-      m = scan::MatchScan(*model, scan::ScanPoints(s), m.pose, o.match);
+    const Pose2 skew_used = over_sweep(velocity), skew_now = over_sweep(Compose(Inverse(kf_T_prev), m.pose));
+    const bool changed = std::hypot(skew_now.x - skew_used.x, skew_now.y - skew_used.y) > 5e-4 ||
+                         std::abs(skew_now.theta - skew_used.theta) > 5e-4;
+    if (sweeping && m.pairs >= o.min_points && changed) {
+      // Second pass, where the step differs from the last one by more than
+      // 0.5 mm or 0.5 mrad over the sweep: deskewed by the step this
+      // registration gives, from its pose, within the gate it ended with.
+      s = scan::Deskew(scans[j], skew_now);
+      scan::MatchOptions near = o.match;
+      near.initial_gate_m = std::max(o.match.min_gate_m, std::min(o.match.initial_gate_m, 6.0 * m.residual_sd_m));
+      m = scan::MatchScan(*model, scan::ScanPoints(s), m.pose, near);
     }
     if (m.pairs < o.min_points) {
       ++out.lost;

@@ -65,7 +65,10 @@ struct PairOptions {
   bool symmetric = true;
   /// A scan whose beams are timed (time_increment != 0) is deskewed to its
   /// first ray (scan/laser_scan.hpp, Deskew) by the tracked velocity: first
-  /// the last step's, then, registered, the step it gives (a second pass).
+  /// the last step's, then, registered, the step it gives (a second pass,
+  /// when that moves the sweep's end by over 0.5 mm or 0.5 mrad: a single
+  /// pass feeds its own error back into the next scan's velocity and
+  /// oscillates).
   bool deskew = true;
   /// The scan matcher's defaults, but no pairs with the background beside an
   /// occluder's edge: on 30 simulated drives in a furnished room (seeds

@@ -162,7 +162,11 @@ struct MatchKernel {
                     const MatchOptions& o) {
     const auto nb = static_cast<long>(model.points_.size());
     const double bearing = FastAtan2(q.y, q.x);
-    const double rel = model.full_circle_ ? WrapAngle(bearing - model.angle_min_) : bearing - model.angle_min_;
+    double rel = bearing - model.angle_min_;
+    if (model.full_circle_) {  // into [-pi, pi) without libm's remainder (a tenth of the run time)
+      while (rel >= kPi) rel -= 2.0 * kPi;
+      while (rel < -kPi) rel += 2.0 * kPi;
+    }
     long centre = std::lround(rel / model.angle_increment_);
     if (model.full_circle_) centre = (centre % nb + nb) % nb;
     double best = max_d * max_d;
