@@ -6,7 +6,8 @@
 #      truth (target 93-97 %);
 #   2. the same for 50 drives with the lidar upside down (seeds 5001..);
 #   3. one 10-minute drive (6,000 scans) pinned to one core: CPU seconds of
-#      registration + fit (target <= 10 s).
+#      registration + fit (target <= 10 s), with instantaneous scans and with
+#      full-period sweeps (deskewed).
 #   bench/lidar_joint_bench.sh [BUILD_DIR]     env: BAGS (200)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -21,3 +22,5 @@ echo "== 50 five-minute drives, lidar upside down"
 "${pin[@]}" "$build/bench_lidar_joint" 50 5 5001 --upside-down --quiet
 echo "== one 10-minute drive (6,000 scans), one core"
 "${pin[@]}" "$build/bench_lidar_joint" 1 10 9001
+echo "== the same drive with full-period sweeps (time_increment set: deskewed), one core"
+"${pin[@]}" "$build/bench_lidar_joint" 1 10 9001 --sweep 1
