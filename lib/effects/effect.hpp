@@ -140,6 +140,17 @@ class Effect {
   /// `run_index` (0-based, campaign order) by what the effect makes of it.
   /// The simulator applies every effect in catalogue order. Default: none.
   virtual void TrueWheels(const Effects& /*e*/, int /*run_index*/, double& /*left*/, double& /*right*/) const {}
+  /// Simulation: how much later than its stamp a ground-truth sample of
+  /// this run shows the true pose [s] (a clock offset), summed over the
+  /// effects; `draw` gives one N(0, 1) number of the run's own clock stream
+  /// (call it only when needed: the stream is the run's). Default: 0.
+  virtual double GroundTruthDelay(const Effects& /*e*/, double (*draw)(void*), void* /*state*/) const {
+    (void)draw;
+    return 0.0;
+  }
+  /// Simulation: adds to the point the ground truth reports, in the robot
+  /// frame (dx, dy [m]), and to its heading (dtheta [rad]). Default: none.
+  virtual void GroundTruthPoint(const Effects& /*e*/, double& /*dx*/, double& /*dy*/, double& /*dtheta*/) const {}
   /// Simulation: why a campaign of `runs` runs cannot have these values
   /// (e.g. a drift that shrinks a wheel to nothing), or empty.
   virtual std::string CheckCampaign(const Effects& /*e*/, int /*runs*/) const { return {}; }

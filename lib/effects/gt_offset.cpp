@@ -42,6 +42,11 @@ class GtOffset final : public Effect {
         1e3 * dx, 1e3 * dy, -1e3 * dx, -1e3 * dy);
   }
 
+  void GroundTruthPoint(const Effects& e, double& dx, double& dy, double& /*dtheta*/) const override {
+    dx += e.gt_dx;
+    dy += e.gt_dy;
+  }
+
   std::string PlainProblem(const Params& p) const override {
     return fmt::format("the motion capture tracks a point ({:+.1f}, {:+.1f}) mm from the axle midpoint",
                        1e3 * Get(p, "dx"), 1e3 * Get(p, "dy"));

@@ -23,6 +23,10 @@ class GtYawMisalignment final : public Effect {
                 .definition = "(outside the contract) ground-truth heading = true heading + delta; position right",
                 .parameters = {{"delta", &Effects::yaw_delta, "rad"}}}) {}
 
+  void GroundTruthPoint(const Effects& e, double& /*dx*/, double& /*dy*/, double& dtheta) const override {
+    dtheta += e.yaw_delta;
+  }
+
  protected:
   std::string Range(const Effects& e) const override {
     if (!(std::abs(e.yaw_delta) < 1.0))

@@ -46,6 +46,11 @@ class RunTimeOffset final : public Effect {
         1e3 * Get(p, "tau_sd"));
   }
 
+  // This run's tau_i ~ N(0, tau_sd^2), one draw per run.
+  double GroundTruthDelay(const Effects& e, double (*draw)(void*), void* state) const override {
+    return e.run_tau_sd > 0.0 ? e.run_tau_sd * draw(state) : 0.0;
+  }
+
   std::string PlainProblem(const Params& p) const override {
     return fmt::format("each recording's ground-truth clock is offset differently (by about {:.0f} ms)",
                        1e3 * Get(p, "tau_sd"));

@@ -40,6 +40,10 @@ class TimeOffset final : public Effect {
         1e3 * tau);
   }
 
+  double GroundTruthDelay(const Effects& e, double (*/*draw*/)(void*), void* /*state*/) const override {
+    return e.time_tau;
+  }
+
   std::string PlainProblem(const Params& p) const override {
     return fmt::format("the ground truth's clock {} the encoders' by {:.0f} ms", Get(p, "tau") >= 0.0 ? "lags" : "leads",
                        1e3 * std::abs(Get(p, "tau")));

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
+#include "effects/registry.hpp"
 #include "model/true_robot.hpp"
 #include "simulation/rng.hpp"
 
@@ -146,13 +147,16 @@ Pose2 PoseAt(const std::vector<StepRecord>& steps, double time, double wheelbase
 }
 
 /// What the logger writes at the sample times: encoder counts (or nominal
-/// travel) and ground truth with gt_offset, time_offset, gt_yaw_misalignment
-/// and measurement noise (from gt_rng); run_tau: this run's
-/// run_time_offset tau_i, added to time_offset's tau.
+/// travel) and ground truth with the effects' point and heading
+/// (Effect::GroundTruthPoint) and measurement noise (from gt_rng); delay:
+/// the ground truth's clock for this run (Effect::GroundTruthDelay, summed).
 void WriteLog(const std::vector<double>& ts, const std::vector<Pose2>& sample_pose,
               const std::vector<double> (&sample_p)[2], const std::vector<StepRecord>& steps, const RunTruth& truth,
-              double run_tau, NormalSource& gt_rng, TrajectoryRun& run) {
-  const Effects& fx = truth.effects;
+              double delay, NormalSource& gt_rng, TrajectoryRun& run) {
+  // The point and heading the ground truth reports (each effect's
+  // GroundTruthPoint: a marker off the axle, a rigid body's yaw).
+  double gt_dx = 0.0, gt_dy = 0.0, gt_dtheta = 0.0;
+  for (const effects::Effect* e : effects::All()) e->GroundTruthPoint(truth.effects, gt_dx, gt_dy, gt_dtheta);
   const std::size_t n = ts.size();
   run.t_s = ts;
   run.lines.assign(n, 0);
@@ -174,13 +178,12 @@ void WriteLog(const std::vector<double>& ts, const std::vector<Pose2>& sample_po
       run.dist_left_m[j] = sample_p[0][j];
       run.dist_right_m[j] = sample_p[1][j];
     }
-    const double shift = fx.time_tau + run_tau;
-    const Pose2 q = shift != 0.0 ? PoseAt(steps, ts[j] - shift, truth.true_wheelbase_m) : sample_pose[j];
+    const Pose2 q = delay != 0.0 ? PoseAt(steps, ts[j] - delay, truth.true_wheelbase_m) : sample_pose[j];
     const double c = std::cos(q.theta), s = std::sin(q.theta);
     const double nx = gt_rng.Next(), ny = gt_rng.Next(), nt = gt_rng.Next();
-    run.gt_x_m[j] = q.x + c * fx.gt_dx - s * fx.gt_dy + truth.gt_sigma_xy_m * nx;
-    run.gt_y_m[j] = q.y + s * fx.gt_dx + c * fx.gt_dy + truth.gt_sigma_xy_m * ny;
-    run.gt_theta_rad[j] = q.theta + fx.yaw_delta + truth.gt_sigma_theta_rad * nt;
+    run.gt_x_m[j] = q.x + c * gt_dx - s * gt_dy + truth.gt_sigma_xy_m * nx;
+    run.gt_y_m[j] = q.y + s * gt_dx + c * gt_dy + truth.gt_sigma_xy_m * ny;
+    run.gt_theta_rad[j] = q.theta + gt_dtheta + truth.gt_sigma_theta_rad * nt;
   }
 }
 
@@ -515,14 +518,19 @@ SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::
   NormalSource gt_rng(StreamSeed(seed, run_index, kCampaignStreamGroundTruth));
   NormalSource run_time_rng(StreamSeed(seed, run_index, kCampaignStreamRunTime));
   // run_time_offset: this run's tau_i.
-  const double run_tau = truth.effects.run_tau_sd > 0.0 ? truth.effects.run_tau_sd * run_time_rng.Next() : 0.0;
+  // The ground truth's clock: each effect's GroundTruthDelay (a constant
+  // offset, this run's own draw from run_time_rng).
+  double delay = 0.0;
+  for (const effects::Effect* e : effects::All())
+    delay += e->GroundTruthDelay(
+        truth.effects, [](void* rng) { return static_cast<NormalSource*>(rng)->Next(); }, &run_time_rng);
   SimulatedRun out;
   out.run.run = run_id;
   out.run.direction = direction;
   RunExecutor exec(plan, truth, seed, run_index, ts, out);
   exec.Execute();
   out.true_pose = exec.sample_pose();
-  WriteLog(ts, exec.sample_pose(), exec.sample_p(), exec.steps(), truth, run_tau, gt_rng, out.run);
+  WriteLog(ts, exec.sample_pose(), exec.sample_p(), exec.steps(), truth, delay, gt_rng, out.run);
   return out;
 }
 
