@@ -139,6 +139,30 @@ TEST_CASE("unexplained: the report says what to look at and which experiment to 
   CHECK(j["candidates"][0].contains("unphysical"));
 }
 
+TEST_CASE("unexplained: the back-and-forth advice says squares confuse only when there are squares alone",
+          "[diagnose][report]") {
+  // Issue 28: "Add back_and_forth ... which squares alone confuse" appeared
+  // for sessions without squares (free paths, circles).
+  const auto advice = [](std::vector<ExperimentKind> kinds) {
+    CampaignData c;
+    c.path = "campaign.toml";
+    for (ExperimentKind k : kinds) c.experiments.push_back({k, "e.csv", 0.75, 0.0, false, 5});
+    DiagnoseSummary s;
+    s.verdict = "unexplained";
+    std::string back_forth;
+    for (const auto& step : AdviseNextSteps(c, s))
+      if (step.rfind("Add a back_and_forth experiment", 0) == 0) back_forth = step;
+    return back_forth;
+  };
+  const std::string squares = advice({ExperimentKind::kSquare});
+  CHECK(squares.find("which squares alone confuse") != std::string::npos);
+  const std::string free = advice({ExperimentKind::kFree});
+  REQUIRE_FALSE(free.empty());
+  CHECK(free.find("squares") == std::string::npos);
+  CHECK(advice({ExperimentKind::kSquare, ExperimentKind::kFree}).find("squares alone") == std::string::npos);
+  CHECK(advice({ExperimentKind::kSquare, ExperimentKind::kBackAndForth}).empty());  // it has one: no advice
+}
+
 TEST_CASE("diagnose --plot/--report: residuals per experiment with band, the largest ringed", "[diagnose][report][cli]") {
   using testing::Q;
   const auto dir = testing::TempDir("diagnose-report");

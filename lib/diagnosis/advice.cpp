@@ -90,9 +90,14 @@ std::vector<std::string> MissingDesign(const CampaignData& c) {
     arcs |= p.type == PieceType::kArc;
   }
   std::vector<std::string> out;
+  // Say "squares alone confuse" only of a campaign of squares alone (issue
+  // 28: the sentence appeared for sessions without squares).
+  const bool squares_only = square && !free_path;
   if (!back_forth)
-    out.push_back("Add a back_and_forth experiment (drive a straight line out and back, 10 runs): it separates "
-                  "direction_asymmetry, scale_error and castor_kick, which squares alone confuse.");
+    out.push_back(fmt::format("Add a back_and_forth experiment (drive a straight line out and back, 10 runs): driving "
+                              "the same line forwards and backwards "
+                              "separates direction_asymmetry, scale_error and castor_kick{}.",
+                              squares_only ? ", which squares alone confuse" : ""));
   if (!square)
     out.push_back("Add squares in both directions (UMBmark, 5+ runs each): they pin E_d and E_b, so the other "
                   "effects stand out against a well-determined baseline.");
