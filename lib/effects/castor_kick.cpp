@@ -23,8 +23,7 @@ class CastorKick final : public Effect {
 
   // A heading kick is a pose size already: below the heading floor.
   std::string PracticalFloor(const Params& p, const CampaignScale& c) const override {
-    if (!(c.negligible > 0.0) || !(Size(p, "kappa") < c.FloorRad())) return {};
-    return fmt::format("heading kicks of {:.2f} mrad (below {:.2g} mrad)", 1e3 * Size(p, "kappa"), 1e3 * c.FloorRad());
+    return HeadingJumpFloor(p, c, "kappa");
   }
 
   std::string Unphysical(const Params& p, int /*runs*/, const Params& /*se*/) const override {

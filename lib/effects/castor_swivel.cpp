@@ -37,8 +37,7 @@ class CastorSwivel final : public Effect {
   }
 
   std::string PracticalFloor(const Params& p, const CampaignScale& c) const override {
-    if (!(c.negligible > 0.0) || !(Size(p, "kappa") < c.FloorRad())) return {};
-    return fmt::format("heading kicks of {:.2f} mrad (below {:.2g} mrad)", 1e3 * Size(p, "kappa"), 1e3 * c.FloorRad());
+    return HeadingJumpFloor(p, c, "kappa");
   }
 
   std::string Unphysical(const Params& p, int /*runs*/, const Params& /*se*/) const override {

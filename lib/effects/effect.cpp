@@ -41,6 +41,11 @@ double Effect::Size(const Params& p, const char* name) {
   return it == p.end() ? std::numeric_limits<double>::infinity() : std::abs(it->second);
 }
 
+std::string Effect::HeadingJumpFloor(const Params& p, const CampaignScale& c, const char* name) {
+  if (!(c.negligible > 0.0) || !(Size(p, name) < c.FloorRad())) return {};
+  return fmt::format("heading kicks of {:.2f} mrad (below {:.2g} mrad)", 1e3 * Size(p, name), 1e3 * c.FloorRad());
+}
+
 std::string Effect::NoisePerEventTooLarge(const Params& p, const char* key) {
   if (!p.count(key) || !(Get(p, key) > 0.05)) return {};
   return fmt::format("{:.0f} mm of noise per event ({}): larger than any slip or settling; a ground-truth glitch or a "

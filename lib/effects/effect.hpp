@@ -166,6 +166,9 @@ class Effect {
   static double Get(const Params& p, const char* name);
   /// A fitted parameter's magnitude, +inf when absent (never below a floor).
   static double Size(const Params& p, const char* name);
+  /// The practical floor of a heading jump (parameter `name`, rad): it is a
+  /// pose size already, so below the heading floor it is negligible.
+  static std::string HeadingJumpFloor(const Params& p, const CampaignScale& c, const char* name);
   /// "N mm of noise per event (KEY): ..." when parameter `key` is over 50 mm.
   static std::string NoisePerEventTooLarge(const Params& p, const char* key);
   /// The null-fit sentence when every parameter of `zero` is present and at
