@@ -334,6 +334,7 @@ Case MakeCase(const std::string& truth, std::uint64_t seed, double arc_fraction,
       case sim::EffectKind::kWheelbaseError:
       case sim::EffectKind::kDiameterRatioError:
       case sim::EffectKind::kWheelNoiseError: break;  // baseline mode: the base_* classes
+      case sim::EffectKind::kFirstRunTime: break;  // an effect added at run time: none here
     }
   }
   if (truth.rfind("base_", 0) == 0) MakeBaselineCase(g, c);

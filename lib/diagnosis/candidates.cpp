@@ -31,7 +31,8 @@ std::vector<int> EffectParams(sim::EffectKind k) {
     case sim::EffectKind::kCastorSwivel: return {kParamSwivel};
     case sim::EffectKind::kWheelbaseError: return {kParamEb};
     case sim::EffectKind::kDiameterRatioError: return {kParamEd};
-    default: return {};
+    // Any other effect predicts through the interface or is a noise effect.
+    default: return RunTimeParams(effects::Of(k));
   }
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/angles.hpp"
+#include "effects/registry.hpp"
 #include "kinematics/diff_drive.hpp"
 #include "model/true_robot.hpp"
 
@@ -18,9 +19,36 @@ ParamVector NominalParams() {
 }
 
 const char* ParamName(int index) {
-  static const char* names[kNumParams] = {"E_d", "E_b", "s", "k", "a", "kappa", "r", "dx",
-                                                    "dy",  "tau", "kappa", "d", "a", "arc", "back"};
-  return index >= 0 && index < kNumParams ? names[index] : "?";
+  static const char* names[kParamRunTime0] = {"E_d", "E_b", "s", "k", "a", "kappa", "r", "dx",
+                                              "dy",  "tau", "kappa", "d", "a", "arc", "back"};
+  if (index >= 0 && index < kParamRunTime0) return names[index];
+  for (const RunTimeSlots& rt : RunTimeEffects())
+    if (index >= rt.first && index < rt.first + rt.count)
+      return rt.effect->Parameters()[static_cast<std::size_t>(index - rt.first)].name.data();
+  return "?";
+}
+
+std::vector<RunTimeSlots> RunTimeEffects() {
+  std::vector<RunTimeSlots> out;
+  int next = kParamRunTime0;
+  for (const effects::Effect* e : effects::All()) {
+    if (!e->PredictsMean()) continue;
+    const int n = static_cast<int>(e->Parameters().size());
+    if (n == 0 || next + n > kNumParams) continue;
+    out.push_back({e, next, n});
+    next += n;
+  }
+  return out;
+}
+
+std::vector<int> RunTimeParams(const effects::Effect& effect) {
+  for (const RunTimeSlots& rt : RunTimeEffects())
+    if (rt.effect == &effect) {
+      std::vector<int> out(static_cast<std::size_t>(rt.count));
+      for (int k = 0; k < rt.count; ++k) out[static_cast<std::size_t>(k)] = rt.first + k;
+      return out;
+    }
+  return {};
 }
 
 namespace {
@@ -69,7 +97,7 @@ TrueFactors Factors(const ParamVector& p, double wheelbase) {
 
 }  // namespace
 
-MeanModel::MeanModel(const CampaignData& campaign) : campaign_(campaign) {
+MeanModel::MeanModel(const CampaignData& campaign) : campaign_(campaign), run_time_(RunTimeEffects()) {
   observed_.resize(campaign.pieces.size());
   pieces_of_run_.resize(campaign.runs.size());
   for (std::size_t j = 0; j < campaign.pieces.size(); ++j) {
@@ -84,11 +112,18 @@ MeanModel::MeanModel(const CampaignData& campaign) : campaign_(campaign) {
 
 namespace {
 
+/// A run's own factors of the true left and right wheel: parameter_drift
+/// of the right wheel and the run-time effects' PredictWheels (1, 1 without).
+struct RunFactors {
+  double left = 1.0, right = 1.0;
+};
+
 /// True wheel travel of a nominal step (dl, dr): diameters, scale,
-/// backward asymmetry, drift of the right wheel.
-inline void TrueTravel(const TrueFactors& f, double drift, double dl, double dr, double& l, double& r) {
-  l = dl * f.c_L * f.scale * (dl < 0.0 ? f.back : 1.0);
-  r = dr * f.c_R * f.scale * drift * (dr < 0.0 ? f.back : 1.0);
+/// backward asymmetry, the run's own factors (parameter_drift of the right
+/// wheel; a left factor of 1 multiplies exactly).
+inline void TrueTravel(const TrueFactors& f, const RunFactors& run, double dl, double dr, double& l, double& r) {
+  l = dl * f.c_L * f.scale * run.left * (dl < 0.0 ? f.back : 1.0);
+  r = dr * f.c_R * f.scale * run.right * (dr < 0.0 ? f.back : 1.0);
 }
 
 inline double HeadingFactor(const TrueFactors& f, signed char cls) {
@@ -115,9 +150,9 @@ double CoastProgress(double rate, double k, double tau) {
 /// down -- a rigid body on two locked wheels whose contacts both slide
 /// forward (v > w b / 2), so that their friction forces cancel in torque
 /// (DART: 2.1-2.6). A backward coast is (1 + slide_back) times d v^2.
-Pose2 Slide(const DiagRun::Stop& st, const TrueFactors& f, double drift, Pose2 q, double tau0, double tau1) {
+Pose2 Slide(const DiagRun::Stop& st, const TrueFactors& f, const RunFactors& wheels, Pose2 q, double tau0, double tau1) {
   double vl, vr;
-  TrueTravel(f, drift, st.rate_left, st.rate_right, vl, vr);
+  TrueTravel(f, wheels, st.rate_left, st.rate_right, vl, vr);
   if (st.cls == static_cast<signed char>(sim::MotionClass::kTurn)) {
     const double w = (vr - vl) / f.wheelbase;
     q.theta += CoastProgress(w, f.slide_a, tau1) - CoastProgress(w, f.slide_a, tau0);
@@ -137,26 +172,27 @@ Pose2 Slide(const DiagRun::Stop& st, const TrueFactors& f, double drift, Pose2 q
 /// kick between them), else the interval's one step within its active
 /// window (after the castor kicks of its start, before the slide of its
 /// stop).
-Pose2 AdvanceInterval(const DiagRun& r, std::size_t i, const TrueFactors& f, double drift, Pose2 q, double u) {
+Pose2 AdvanceInterval(const DiagRun& r, std::size_t i, const TrueFactors& f, const RunFactors& wheels, Pose2 q,
+                      double u) {
   const double dl = r.left[i + 1] - r.left[i], dr = r.right[i + 1] - r.right[i];
   double l, rr;
   if (const int jx = r.junction_of.empty() ? -1 : r.junction_of[i]; jx >= 0) {
     const DiagRun::Junction& j = r.junctions[static_cast<std::size_t>(jx)];
     const double fa = j.time_fraction;
     const double ua = fa > 0.0 ? std::min(1.0, u / fa) : 1.0;
-    TrueTravel(f, drift, ua * j.left_m, ua * j.right_m, l, rr);
+    TrueTravel(f, wheels, ua * j.left_m, ua * j.right_m, l, rr);
     q = TrueStep(q, l, rr, f.wheelbase, HeadingFactor(f, j.class_a));
     if (u <= fa) return q;
     if (!r.swivel.empty() && r.swivel[i] != 0) q.theta += f.swivel * r.swivel[i];
     const double ub = fa < 1.0 ? std::min(1.0, (u - fa) / (1.0 - fa)) : 1.0;
-    TrueTravel(f, drift, ub * (dl - j.left_m), ub * (dr - j.right_m), l, rr);
+    TrueTravel(f, wheels, ub * (dl - j.left_m), ub * (dr - j.right_m), l, rr);
     return TrueStep(q, l, rr, f.wheelbase, HeadingFactor(f, j.class_b));
   }
   if (r.kick[i] != 0) q.theta += f.kappa * r.kick[i];
   if (!r.swivel.empty() && r.swivel[i] != 0) q.theta += f.swivel * r.swivel[i];
   const double w0 = r.window_start[i], w1 = r.window_end[i];
   const double frac = u >= 1.0 ? 1.0 : u <= w0 || w1 <= w0 ? 0.0 : std::min(1.0, (u - w0) / (w1 - w0));
-  TrueTravel(f, drift, frac * dl, frac * dr, l, rr);
+  TrueTravel(f, wheels, frac * dl, frac * dr, l, rr);
   q = TrueStep(q, l, rr, f.wheelbase, HeadingFactor(f, r.interval_class[i]));
   if (f.slide_d == 0.0 && f.slide_a == 0.0) return q;
   // stop_slide: the coast from the wheels' stop (at the end of the stop
@@ -164,25 +200,34 @@ Pose2 AdvanceInterval(const DiagRun& r, std::size_t i, const TrueFactors& f, dou
   const double dt = r.t[i + 1] - r.t[i], t_now = r.t[i] + std::min(u, 1.0) * dt;
   if (const int stop = r.stop_of.empty() ? -1 : r.stop_of[i]; stop >= 0 && frac >= 1.0) {
     const DiagRun::Stop& st = r.stops[static_cast<std::size_t>(stop)];
-    q = Slide(st, f, drift, q, 0.0, t_now - st.t_stop);
+    q = Slide(st, f, wheels, q, 0.0, t_now - st.t_stop);
   }
   if (const int coast = r.coast_of.empty() ? -1 : r.coast_of[i]; coast >= 0) {
     const DiagRun::Stop& st = r.stops[static_cast<std::size_t>(coast)];
-    q = Slide(st, f, drift, q, r.t[i] - st.t_stop, t_now - st.t_stop);
+    q = Slide(st, f, wheels, q, r.t[i] - st.t_stop, t_now - st.t_stop);
   }
   return q;
 }
 
 }  // namespace
 
+void MeanModel::RunWheels(int run, const ParamVector& p, double& left, double& right) const {
+  const DiagRun& r = campaign_.runs[run];
+  left = 1.0;
+  right = 1.0 + p[kParamDrift] * r.campaign_index;
+  for (const RunTimeSlots& rt : run_time_)
+    rt.effect->PredictWheels(&p[static_cast<std::size_t>(rt.first)], r.campaign_index, left, right);
+}
+
 void MeanModel::ReplayRun(int run, const ParamVector& p, std::vector<Pose2>& poses) const {
   const DiagRun& r = campaign_.runs[run];
   const TrueFactors f = Factors(p, campaign_.robot.wheelbase_m);
-  const double drift = 1.0 + p[kParamDrift] * r.campaign_index;
+  RunFactors wheels;
+  RunWheels(run, p, wheels.left, wheels.right);
   const std::size_t n = r.t.size();
   poses.resize(n);
   poses[0] = Pose2{};
-  for (std::size_t i = 0; i + 1 < n; ++i) poses[i + 1] = AdvanceInterval(r, i, f, drift, poses[i], 1.0);
+  for (std::size_t i = 0; i + 1 < n; ++i) poses[i + 1] = AdvanceInterval(r, i, f, wheels, poses[i], 1.0);
 }
 
 Pose2 MeanModel::PoseAt(int run, const ParamVector& p, const std::vector<Pose2>& poses, double t) const {
@@ -194,12 +239,13 @@ Pose2 MeanModel::PoseAt(int run, const ParamVector& p, const std::vector<Pose2>&
   if (i + 1 >= n) return poses.back();
   const double u = (t - r.t[i]) / (r.t[i + 1] - r.t[i]);
   const TrueFactors f = Factors(p, campaign_.robot.wheelbase_m);
-  const double drift = 1.0 + p[kParamDrift] * r.campaign_index;
+  RunFactors wheels;
+  RunWheels(run, p, wheels.left, wheels.right);
   // Before the wheels move in the interval nothing has happened, not even
   // the castor kick.
   const bool junction = !r.junction_of.empty() && r.junction_of[i] >= 0;
   if (!junction && (u <= r.window_start[i] || r.window_end[i] <= r.window_start[i])) return poses[i];
-  return AdvanceInterval(r, i, f, drift, poses[i], u);
+  return AdvanceInterval(r, i, f, wheels, poses[i], u);
 }
 
 std::vector<Pose2> MeanModel::PredictRun(int run, const ParamVector& p) const {
@@ -250,13 +296,24 @@ void MeanModel::Residuals(const ParamVector& p, std::vector<double>& eps) const 
 
 Eigen::MatrixXd MeanModel::Jacobian(const ParamVector& p, const std::vector<int>& params,
                                     const std::vector<double>& eps0) const {
-  static const double kStep[kNumParams] = {1e-6, 1e-6, 1e-6, 1e-6, 1e-6, 1e-7, 1e-8,
-                                                 1e-6, 1e-6, 1e-5, 1e-7, 1e-5, 1e-5, 1e-5, 1e-5};
+  static const double kStep[kParamRunTime0] = {1e-6, 1e-6, 1e-6, 1e-6, 1e-6, 1e-7, 1e-8,
+                                               1e-6, 1e-6, 1e-5, 1e-7, 1e-5, 1e-5, 1e-5, 1e-5};
   Eigen::MatrixXd J(eps0.size(), params.size());
   std::vector<double> eps;
   for (std::size_t k = 0; k < params.size(); ++k) {
     ParamVector q = p;
-    const double h = kStep[params[k]];
+    // A run-time effect's parameter: 1e-4 of its typical size (1e-6
+    // without one).
+    double h = 1e-6;
+    if (params[k] < kParamRunTime0) {
+      h = kStep[params[k]];
+    } else {
+      for (const RunTimeSlots& rt : run_time_)
+        if (params[k] >= rt.first && params[k] < rt.first + rt.count) {
+          const double typical = rt.effect->Parameters()[static_cast<std::size_t>(params[k] - rt.first)].typical;
+          if (typical > 0.0) h = 1e-4 * typical;
+        }
+    }
     q[params[k]] += h;
     Residuals(q, eps);
     for (std::size_t i = 0; i < eps.size(); ++i) J(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(k)) = (eps[i] - eps0[i]) / h;

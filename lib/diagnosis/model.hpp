@@ -42,6 +42,7 @@
 #include <Eigen/Core>
 
 #include "diagnosis/pieces.hpp"
+#include "effects/effect.hpp"
 
 namespace umbmark::diag {
 
@@ -69,13 +70,34 @@ enum ParamIndex : int {
   /// onto a castor).
   kParamSlideArc,
   kParamSlideBack,
-  kNumParams
+  /// The values of the effects that predict through the interface
+  /// (effects::Effect::PredictsMean: an effect added at run time), in
+  /// catalogue order, each taking as many slots as it has parameters
+  /// (RunTimeParams); an effect that finds no slots left is not fitted.
+  kParamRunTime0,
+  kNumParams = kParamRunTime0 + 6
 };
 using ParamVector = std::array<double, kNumParams>;
 
 /// E_d = E_b = 1, every effect zero.
 ParamVector NominalParams();
+/// A mean parameter's name: the contract's parameter name of its effect
+/// (the baseline's E_d, E_b); "?" for an index out of range or a run-time
+/// slot no effect takes.
 const char* ParamName(int index);
+
+/// An effect that predicts through the interface and its slots
+/// [first, first + count) in ParamVector.
+struct RunTimeSlots {
+  const effects::Effect* effect = nullptr;
+  int first = 0, count = 0;
+};
+/// The effects that predict through the interface (Effect::PredictsMean)
+/// and their slots, in catalogue order (those that fit in the slots).
+std::vector<RunTimeSlots> RunTimeEffects();
+/// The mean-model slots of `effect` (empty when it does not predict
+/// through the interface or finds no slots left).
+std::vector<int> RunTimeParams(const effects::Effect& effect);
 
 /// Residuals of every piece, flattened: eps[3 j + c] (c: x, y, theta).
 class MeanModel {
@@ -104,8 +126,12 @@ class MeanModel {
  private:
   void ReplayRun(int run, const ParamVector& p, std::vector<Pose2>& poses) const;
   Pose2 PoseAt(int run, const ParamVector& p, const std::vector<Pose2>& poses, double t) const;
+  /// The left and right wheel factors of run `run` at `p`: parameter_drift
+  /// on the right wheel, times each run-time effect's PredictWheels.
+  void RunWheels(int run, const ParamVector& p, double& left, double& right) const;
 
   const CampaignData& campaign_;
+  std::vector<RunTimeSlots> run_time_;
   std::vector<Pose2> observed_;
   std::vector<std::vector<int>> pieces_of_run_;
 };

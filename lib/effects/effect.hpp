@@ -12,6 +12,7 @@
 #pragma once
 
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -72,8 +73,9 @@ struct AdviceContext {
 /// Everything an effect is that needs no code.
 struct Descriptor {
   std::string_view name;      ///< contract name (JSON key, --effect NAME)
-  /// The built-in kind (transitional, values.hpp); none for an effect added
-  /// at run time.
+  /// The built-in kind (transitional, values.hpp); leave it empty for an
+  /// effect added at run time: Register gives it an id of its own
+  /// (EffectKind::kFirstRunTime and up).
   std::optional<EffectKind> kind;
   /// Position in the contract's table (the catalogue order: contract
   /// effects 0-13, outside effects 100+, parameter errors 200+).
@@ -155,6 +157,20 @@ class Effect {
   /// (e.g. a drift that shrinks a wheel to nothing), or empty.
   virtual std::string CheckCampaign(const Effects& /*e*/, int /*runs*/) const { return {}; }
 
+  /// Model prediction (the diagnosis' mean model, diagnosis/model.hpp):
+  /// whether the diagnosis fits this effect through PredictWheels, with
+  /// Parameters() as its fitted values (in their order, starting at 0). An
+  /// effect that answers true is a mean candidate of `diagnose` with no
+  /// other file touched. Built-in effects whose prediction is still written
+  /// out in diagnosis/model.cpp answer false (transitional). Default: false.
+  virtual bool PredictsMean() const { return false; }
+  /// Model prediction: multiplies the true left and right wheel travel the
+  /// model predicts for run `run_index` (0-based, campaign order) by what
+  /// the effect makes of it with values `v` (v[k]: Parameters()[k]): the
+  /// fitted counterpart of TrueWheels. Called once per run and prediction,
+  /// never per sample. Default: none.
+  virtual void PredictWheels(const double* /*v*/, int /*run_index*/, double& /*left*/, double& /*right*/) const {}
+
   /// How a fitted parameter reads: {factor, unit} (value x factor, unit),
   /// e.g. {1e3, " mm"}; {0, ""} leaves it to the generic reading.
   virtual std::pair<double, const char*> ParamUnit(std::string_view /*param*/) const { return {0.0, ""}; }
@@ -176,6 +192,8 @@ class Effect {
   static std::string FittedAtZero(const Params& p, const std::vector<std::pair<const char*, double>>& zero);
 
  private:
+  // Register gives an effect added at run time its kind (an id).
+  friend void Register(std::unique_ptr<Effect> effect);
   Descriptor d_;
 };
 

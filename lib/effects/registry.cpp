@@ -59,6 +59,8 @@ void Register(std::unique_ptr<Effect> effect) {
   if (Find(effect->Name()) != nullptr)
     throw InvalidOptions(fmt::format("effects::Register: an effect named '{}' exists already", effect->Name()));
   Store& s = TheStore();
+  if (!effect->d_.kind)
+    effect->d_.kind = static_cast<EffectKind>(static_cast<int>(EffectKind::kFirstRunTime) + static_cast<int>(s.owned.size()));
   s.all.push_back(effect.get());
   s.owned.push_back(std::move(effect));
   Sort(s.all);

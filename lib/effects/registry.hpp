@@ -23,10 +23,11 @@ const Effect* Find(std::string_view name);
 
 /// The built-in effect of kind `kind` (transitional, see values.hpp).
 const Effect& Of(EffectKind kind);
-/// The kind of a built-in effect (nullopt for one added at run time).
+/// The kind of an effect (nullopt only for one not registered yet).
 std::optional<EffectKind> KindOf(const Effect& e);
 
-/// Adds an effect at run time (a test's dummy effect). Throws
+/// Adds an effect at run time (a test's dummy effect), giving it a kind of
+/// its own when it has none (EffectKind::kFirstRunTime, + 1, ...). Throws
 /// InvalidOptions when its name is taken or empty. Not thread-safe: call
 /// before any simulation or diagnosis runs.
 void Register(std::unique_ptr<Effect> effect);

@@ -34,6 +34,9 @@ enum class EffectKind {
   kWheelbaseError,
   kDiameterRatioError,
   kWheelNoiseError,
+  /// The first id Register gives an effect added at run time (the next one
+  /// gets kFirstRunTime + 1, ...): a kind is an id, not a closed list.
+  kFirstRunTime = 1000,
 };
 
 /// Magnitudes of every effect; zero means absent.

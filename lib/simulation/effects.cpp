@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <set>
 
 #include <fmt/format.h>
@@ -13,17 +14,25 @@
 
 namespace umbmark::sim {
 
-// The catalogue of the built-in effects, from the registry (in its order).
+// The catalogue of the registered effects, from the registry (in its
+// order), rebuilt when an effect is added at run time (effects::Register:
+// before any simulation or diagnosis runs, so no reference into it is held
+// across a rebuild).
 const std::vector<EffectDescriptor>& EffectCatalogue() {
-  static const std::vector<EffectDescriptor> catalogue = [] {
-    std::vector<EffectDescriptor> out;
-    for (const ::umbmark::effects::Effect* e : ::umbmark::effects::All()) {
+  static std::mutex mutex;
+  static std::vector<EffectDescriptor> catalogue;
+  static std::size_t registered = 0;
+  const std::lock_guard<std::mutex> lock(mutex);
+  const std::vector<const ::umbmark::effects::Effect*>& all = ::umbmark::effects::All();
+  if (registered != all.size()) {
+    catalogue.clear();
+    for (const ::umbmark::effects::Effect* e : all) {
       const ::umbmark::effects::Descriptor& d = e->Describe();
       if (!d.kind) continue;
-      out.push_back({*d.kind, d.name, d.parameters, d.in_contract, d.definition, !d.parameter_error});
+      catalogue.push_back({*d.kind, d.name, d.parameters, d.in_contract, d.definition, !d.parameter_error});
     }
-    return out;
-  }();
+    registered = all.size();
+  }
   return catalogue;
 }
 
