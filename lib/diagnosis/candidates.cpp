@@ -19,25 +19,21 @@
 namespace umbmark::diag {
 
 std::vector<int> EffectParams(sim::EffectKind k) {
-  switch (k) {
-    case sim::EffectKind::kScaleError: return {kParamScale};
-    case sim::EffectKind::kTurnScrub: return {kParamScrub};
-    case sim::EffectKind::kDirectionAsymmetry: return {kParamAsym};
-    case sim::EffectKind::kCastorKick: return {kParamKappa};
-    case sim::EffectKind::kParameterDrift: return {kParamDrift};
-    case sim::EffectKind::kGtOffset: return {kParamDx, kParamDy};
-    case sim::EffectKind::kTimeOffset: return {kParamTau};
-    case sim::EffectKind::kStopSlide: return {kParamSlideD, kParamSlideA, kParamSlideArc, kParamSlideBack};
-    case sim::EffectKind::kCastorSwivel: return {kParamSwivel};
-    case sim::EffectKind::kWheelbaseError: return {kParamEb};
-    case sim::EffectKind::kDiameterRatioError: return {kParamEd};
-    // Any other effect predicts through the interface or is a noise effect.
-    default: return RunTimeParams(effects::Of(k));
-  }
+  const effects::Effect& e = effects::Of(k);
+  if (!e.Describe().mean_terms.empty()) return e.Describe().mean_terms;
+  return RunTimeParams(e);  // one that predicts through the interface, or a noise effect
 }
 
+namespace {
+
+bool Has(const std::vector<int>& v, int k) { return std::find(v.begin(), v.end(), k) != v.end(); }
+
+}  // namespace
+
 std::vector<int> EffectParams(sim::EffectKind k, const CampaignData& c) {
-  if (k != sim::EffectKind::kStopSlide) return EffectParams(k);
+  std::vector<int> all = EffectParams(k);
+  // The coast terms show only at stops of their kind (effects::MeanTerm).
+  if (!Has(all, kParamSlideD)) return all;
   bool line_stop = false, turn_stop = false, arc_stop = false, forward_stop = false, backward_stop = false;
   for (const DiagRun& r : c.runs)
     for (const DiagRun::Stop& st : r.stops) {
@@ -48,11 +44,18 @@ std::vector<int> EffectParams(sim::EffectKind k, const CampaignData& c) {
       arc_stop = arc_stop || std::abs(st.rate_right - st.rate_left) > 0.02 * std::abs(st.rate_right + st.rate_left);
       (st.rate_left + st.rate_right < 0.0 ? backward_stop : forward_stop) = true;
     }
+  const auto shown = [&](int term) {
+    switch (term) {
+      case kParamSlideD: return line_stop || !turn_stop;
+      case kParamSlideA: return turn_stop;
+      case kParamSlideArc: return arc_stop;
+      case kParamSlideBack: return forward_stop && backward_stop;
+      default: return true;
+    }
+  };
   std::vector<int> out;
-  if (line_stop || !turn_stop) out.push_back(kParamSlideD);
-  if (turn_stop) out.push_back(kParamSlideA);
-  if (arc_stop) out.push_back(kParamSlideArc);
-  if (forward_stop && backward_stop) out.push_back(kParamSlideBack);
+  for (const int term : all)
+    if (shown(term)) out.push_back(term);
   return out;
 }
 
@@ -80,31 +83,47 @@ double TypicalMagnitude(int param) {
 bool IsNoiseEffect(sim::EffectKind k) { return effects::Of(k).Random(); }
 
 void EnableNoiseEffect(sim::EffectKind k, PieceNoiseFitOptions& o) {
-  if (k == sim::EffectKind::kCorrelatedNoise) o.correlated = true;
-  if (k == sim::EffectKind::kStandstillMotion) o.standstill = true;
-  if (k == sim::EffectKind::kMotionNoiseFloor) o.motion_floor = true;
-  if (k == sim::EffectKind::kRunTimeOffset) o.run_time = true;
-  if (k == sim::EffectKind::kWheelNoiseError) o.fit_wheel_noise = true;
-}
-
-std::map<std::string, double> NoiseEffectParams(sim::EffectKind k, const NoiseParams& n) {
-  switch (k) {
-    case sim::EffectKind::kCorrelatedNoise: return {{"rho", n.rho()}};
-    case sim::EffectKind::kBumpOutliers: return {{"rate", n.bump_rate}, {"sigma", std::sqrt(n.bump_s2)}};
-    case sim::EffectKind::kStandstillMotion:
-      return {{"sigma_xy", std::sqrt(n.stand_xy2)}, {"sigma_theta", std::sqrt(n.stand_th2)}};
-    case sim::EffectKind::kMotionNoiseFloor: return {{"sigma", std::sqrt(n.floor_s2)}};
-    case sim::EffectKind::kRunTimeOffset: return {{"tau_sd", std::sqrt(n.run_tau2)}};
-    case sim::EffectKind::kWheelNoiseError: return {{"k_L", std::sqrt(n.kL2)}, {"k_R", std::sqrt(n.kR2)}};
-    default: return {};
+  switch (effects::Of(k).Describe().noise_term) {
+    case effects::NoiseTerm::kCorrelated: o.correlated = true; break;
+    case effects::NoiseTerm::kStandstill: o.standstill = true; break;
+    case effects::NoiseTerm::kMotionFloor: o.motion_floor = true; break;
+    case effects::NoiseTerm::kRunTime: o.run_time = true; break;
+    case effects::NoiseTerm::kWheelNoise: o.fit_wheel_noise = true; break;
+    case effects::NoiseTerm::kBumps:  // its own mixture fit (FitBumps)
+    case effects::NoiseTerm::kNone: break;
   }
 }
 
+effects::NoiseValues NoiseValuesOf(const NoiseParams& n) {
+  effects::NoiseValues v;
+  v.rho = n.rho();
+  // (NoiseParams' bump fields share bump_outliers' parameter name: the
+  // noise model's, not the effect's.)
+  v.bumps_per_m = n.bump_rate;
+  v.bump_var = n.bump_s2;
+  v.stand_xy2 = n.stand_xy2;
+  v.stand_th2 = n.stand_th2;
+  v.floor_s2 = n.floor_s2;
+  v.run_tau2 = n.run_tau2;
+  v.kL2 = n.kL2;
+  v.kR2 = n.kR2;
+  return v;
+}
+
+std::map<std::string, double> NoiseEffectParams(sim::EffectKind k, const NoiseParams& n) {
+  return effects::Of(k).FromNoise(NoiseValuesOf(n));
+}
+
+effects::NoiseTerm NoiseTermOf(sim::EffectKind k) { return effects::Of(k).Describe().noise_term; }
+
+std::string NoiseEffectName(effects::NoiseTerm term) {
+  for (const effects::Effect* e : effects::All())
+    if (e->Describe().noise_term == term) return std::string(e->Name());
+  return "?";
+}
+
 int EffectParameterCount(sim::EffectKind k) {
-  if (k == sim::EffectKind::kBumpOutliers || k == sim::EffectKind::kStandstillMotion ||
-      k == sim::EffectKind::kWheelNoiseError)
-    return 2;
-  if (IsNoiseEffect(k)) return 1;
+  if (IsNoiseEffect(k)) return std::max(1, static_cast<int>(effects::Of(k).FromNoise({}).size()));
   return static_cast<int>(EffectParams(k).size());
 }
 
@@ -314,7 +333,7 @@ std::string SlideSpeedNote(const CampaignData& c) {
                      med, v.size(), d, 1e3 * d * med * med);
 }
 
-MeanFit FitMeanEffect(const Shared& x, sim::EffectKind kind, const std::vector<int>& eparams, Candidate& cd) {
+MeanFit FitMeanEffect(const Shared& x, const std::vector<int>& eparams, Candidate& cd) {
   const CampaignData& c = x.c;
   std::vector<int> joint = x.b.free;
   joint.insert(joint.end(), eparams.begin(), eparams.end());
@@ -322,8 +341,9 @@ MeanFit FitMeanEffect(const Shared& x, sim::EffectKind kind, const std::vector<i
   // turn_scrub also changes the noise's heading in spot turns relative
   // to straight motion: its covariance bases follow the fit.
   std::vector<PieceBases> scrub_bases;
-  if (kind == sim::EffectKind::kTurnScrub) scrub_bases = ComputeBases(c, x.model, mf.p);
-  const std::vector<PieceBases>& bases = kind == sim::EffectKind::kTurnScrub ? scrub_bases : x.b.bases;
+  const bool bases_follow = Has(eparams, kParamScrub);
+  if (bases_follow) scrub_bases = ComputeBases(c, x.model, mf.p);
+  const std::vector<PieceBases>& bases = bases_follow ? scrub_bases : x.b.bases;
   // castor_swivel's random kicks after reversals: kappa^2 of heading
   // variance there, from the fitted kappa.
   NoiseParams start = x.b.noise;
@@ -365,7 +385,7 @@ MeanFit FitMeanEffect(const Shared& x, sim::EffectKind kind, const std::vector<i
   cd.heldout_loglik_gain = cv.loglik - x.cv_ll_base;
   const double gcv = ComputeGap(c, cv.scores, x.options.gap).score;
   cd.heldout_shrink = Shrink(Gap(gcv, x.null_median), x.gap_cv_before);
-  if (kind == sim::EffectKind::kTimeOffset) CheckTimeOffset(x, We, mf, cd);
+  if (Has(eparams, kParamTau)) CheckTimeOffset(x, We, mf, cd);
   return mf;
 }
 
@@ -379,7 +399,7 @@ MeanFit FitMeanEffect(const Shared& x, sim::EffectKind kind, const std::vector<i
 /// and its shape none.
 bool FitMeanCandidate(const Shared& x, sim::EffectKind kind, Candidate& cd, Eigen::MatrixXd& projected, MeanFit& mf) {
   std::vector<int> eparams = EffectParams(kind, x.c);
-  const bool slide = kind == sim::EffectKind::kStopSlide;
+  const bool slide = Has(EffectParams(kind), kParamSlideD);
   ParamVector slide_at = x.b.p;
   slide_at[kParamSlideD] = TypicalMagnitude(kParamSlideD);
   slide_at[kParamSlideA] = TypicalMagnitude(kParamSlideA);
@@ -406,7 +426,7 @@ bool FitMeanCandidate(const Shared& x, sim::EffectKind kind, Candidate& cd, Eige
     if (slide) cd.note += SlideSpeedNote(x.c);
     return false;
   }
-  mf = FitMeanEffect(x, kind, eparams, cd);
+  mf = FitMeanEffect(x, eparams, cd);
   // A turn part that comes out negative beyond 2 SE (a slide against the
   // turn) is E_b's constant extra turn read through a coast the samples
   // barely catch (10 Hz, a 16 ms coast): refitted without it.
@@ -417,7 +437,7 @@ bool FitMeanCandidate(const Shared& x, sim::EffectKind kind, Candidate& cd, Eige
     cd.param_se.clear();
     cd.parameters = static_cast<int>(eparams.size());
     turn_part_dropped = true;
-    mf = FitMeanEffect(x, kind, eparams, cd);
+    mf = FitMeanEffect(x, eparams, cd);
   }
   if (turn_part_dropped)
     cd.note = std::string(cd.note.empty() ? "" : cd.note + "; ") +
@@ -431,7 +451,7 @@ void FitNoiseEffect(const Shared& x, sim::EffectKind kind, Candidate& cd) {
   const CampaignData& c = x.c;
   // Gaussian noise effects (a variance component each); bump_outliers is
   // a mixture with its own fit.
-  const bool corr = kind != sim::EffectKind::kBumpOutliers;
+  const bool corr = NoiseTermOf(kind) != effects::NoiseTerm::kBumps;
   cd.parameters = EffectParameterCount(kind);
   cd.E_d = x.b.p[kParamEd];
   cd.E_b = x.b.p[kParamEb];
@@ -444,7 +464,7 @@ void FitNoiseEffect(const Shared& x, sim::EffectKind kind, Candidate& cd) {
                                    cf.fit_wheel_noise);
   // run_time_offset: its levers at the fitted tau_sd (run_block.hpp).
   std::vector<PieceBases> rescaled;
-  if (kind == sim::EffectKind::kRunTimeOffset)
+  if (NoiseTermOf(kind) == effects::NoiseTerm::kRunTime)
     rescaled = RescaleTimeLevers(x.model, x.b.p, x.b.bases, ne, [&](const std::vector<PieceBases>& bs, const NoiseParams& s) {
       return FitPieceNoise(x.b.eps, bs, c.pieces, {}, s, cf);
     });
@@ -465,7 +485,7 @@ void FitNoiseEffect(const Shared& x, sim::EffectKind kind, Candidate& cd) {
   cd.heldout_loglik_gain = cv.loglik - x.cv_ll_base;
   const double gcv = ComputeGap(c, cv.scores, x.options.gap).score;
   cd.heldout_shrink = Shrink(Gap(gcv, x.null_median), x.gap_cv_before);
-  if (kind == sim::EffectKind::kRunTimeOffset) CheckRunTimeOffset(x, bases, ne, cf, cd);
+  if (NoiseTermOf(kind) == effects::NoiseTerm::kRunTime) CheckRunTimeOffset(x, bases, ne, cf, cd);
   else cd.footprint = CheckNoiseFootprint(c, x.b.eps, bases, ne);
   // Fitted at zero, a noise effect is the baseline: what its refit changes
   // (the other noise parameters beside it, the folds' fits) is not its own,
@@ -485,12 +505,14 @@ void FitNoiseEffect(const Shared& x, sim::EffectKind kind, Candidate& cd) {
   // rate x sigma_b^2 of variance per metre, i.e. wheel noise growing with
   // distance, more than the given k. That is a wheel_noise_error (which
   // names the wheel and the k to set), not bumps.
-  if (kind == sim::EffectKind::kBumpOutliers && !cf.fit_wheel_noise && ne.bump_rate >= 0.95 * kMaxBumpRatePerMetre) {
+  const effects::NoiseValues fitted = NoiseValuesOf(ne);
+  if (!corr && !cf.fit_wheel_noise && fitted.bumps_per_m >= 0.95 * kMaxBumpRatePerMetre) {
     cd.identifiable = false;
-    cd.note = fmt::format("not identifiable here: indistinguishable from wheel_noise_error: fitted at its rate bound "
+    cd.note = fmt::format("not identifiable here: indistinguishable from {}: fitted at its rate bound "
                           "({:.2g} per metre of {:.2g} mm), bumps are their Gaussian limit, wheel noise growing "
                           "with distance, more than the given k",
-                          ne.bump_rate, 1e3 * std::sqrt(ne.bump_s2));
+                          NoiseEffectName(effects::NoiseTerm::kWheelNoise), fitted.bumps_per_m,
+                          1e3 * std::sqrt(fitted.bump_var));
   }
 }
 

@@ -25,7 +25,7 @@
 namespace umbmark::diag {
 
 struct Candidate {
-  sim::EffectKind effect = sim::EffectKind::kScaleError;
+  sim::EffectKind effect{};
   std::map<std::string, double> params;
   std::map<std::string, double> param_se;  ///< standard errors (mean effects)
   double E_d = 1.0, E_b = 1.0;             ///< refitted with the effect
@@ -106,6 +106,12 @@ bool IsNoiseEffect(sim::EffectKind k);
 /// Switches on the variance component(s) of a Gaussian noise effect (not
 /// bump_outliers, which has its own mixture fit).
 void EnableNoiseEffect(sim::EffectKind k, PieceNoiseFitOptions& o);
+/// The fitted noise as the effects read it (effects::NoiseValues).
+effects::NoiseValues NoiseValuesOf(const NoiseParams& n);
+/// The noise component an effect switches on (kNone: not a noise effect).
+effects::NoiseTerm NoiseTermOf(sim::EffectKind k);
+/// The name of the effect that switches on noise component `term`.
+std::string NoiseEffectName(effects::NoiseTerm term);
 /// Contract parameters of a noise effect from fitted noise parameters.
 std::map<std::string, double> NoiseEffectParams(sim::EffectKind k, const NoiseParams& n);
 /// Parameters an effect adds.

@@ -24,6 +24,13 @@ bool Contains(const std::vector<sim::EffectKind>& set, sim::EffectKind k) {
   return std::find(set.begin(), set.end(), k) != set.end();
 }
 
+/// Whether an effect of `set` switches on noise component `term`.
+bool HasNoise(const std::vector<sim::EffectKind>& set, effects::NoiseTerm term) {
+  for (sim::EffectKind e : set)
+    if (NoiseTermOf(e) == term) return true;
+  return false;
+}
+
 /// A set of effects fitted jointly, in sample and held out.
 struct SetFit {
   ParamVector p{};
@@ -76,7 +83,7 @@ MeanPart FitMeanPart(const CampaignData& c, const MeanModel& model, const Baseli
 SetFit FitSet(const CampaignData& c, const MeanModel& model, const BaselineFit& b, const Folds& folds,
               const std::vector<sim::EffectKind>& set, const MeanPart& mean, const GapOptions& gap,
               const NoiseParams* warm = nullptr) {
-  const bool bumps = Contains(set, sim::EffectKind::kBumpOutliers);
+  const bool bumps = HasNoise(set, effects::NoiseTerm::kBumps);
   const MeanFit& mf = mean.mf;
   const std::vector<PieceBases>& mean_bases = mean.scrub ? mean.scrub_bases : b.bases;
   PieceNoiseFitOptions nf = b.noise_fit;
@@ -94,7 +101,7 @@ SetFit FitSet(const CampaignData& c, const MeanModel& model, const BaselineFit& 
                          nf.fit_wheel_noise);
   else
     out.noise = FitPieceNoise(mf.eps, mean_bases, c.pieces, {}, start, nf);
-  if (!bumps && Contains(set, sim::EffectKind::kRunTimeOffset))
+  if (!bumps && HasNoise(set, effects::NoiseTerm::kRunTime))
     out.rescaled = RescaleTimeLevers(model, mf.p, mean_bases, out.noise,
                                      [&](const std::vector<PieceBases>& bs, const NoiseParams& s) {
                                        return FitPieceNoise(mf.eps, bs, c.pieces, {}, s, nf);
@@ -219,7 +226,8 @@ bool SizeWheelNoiseLike(const BaselineFit& base, const std::vector<PieceBases>& 
   // relative change of its sd, with the change of one piece's scatter in
   // mm / mrad beside it. A bump process of rate r and variance s_b^2 adds
   // r s_b^2 per metre of a wheel's travel, as k^2 does (eq. 4).
-  if (e == sim::EffectKind::kCorrelatedNoise) {
+  const effects::NoiseTerm term = NoiseTermOf(e);
+  if (term == effects::NoiseTerm::kCorrelated) {
     const double ratio = kbar2 > 0.0 ? f.noise.c_LR / kbar2 : 0.0;
     s.relative_size = std::abs(std::sqrt(std::max(0.0, 1.0 + ratio)) - 1.0);
     NoiseParams without = f.noise;
@@ -229,8 +237,9 @@ bool SizeWheelNoiseLike(const BaselineFit& base, const std::vector<PieceBases>& 
         [&](std::size_t j) -> Eigen::Matrix3d { return PieceCovariance(bases[j], without); }, s);
     return true;
   }
-  if (e == sim::EffectKind::kBumpOutliers) {
-    const double b2 = f.noise.bump_rate * f.noise.bump_s2;
+  if (term == effects::NoiseTerm::kBumps) {
+    const effects::NoiseValues v = NoiseValuesOf(f.noise);
+    const double b2 = v.bumps_per_m * v.bump_var;
     s.relative_size = kbar2 > 0.0 ? std::sqrt(1.0 + b2 / kbar2) - 1.0 : 1.0;
     MedianSdChange(
         bases.size(),
@@ -238,7 +247,7 @@ bool SizeWheelNoiseLike(const BaselineFit& base, const std::vector<PieceBases>& 
         [&](std::size_t j) -> Eigen::Matrix3d { return PieceCovariance(bases[j], f.noise); }, s);
     return true;
   }
-  if (e == sim::EffectKind::kWheelNoiseError) {
+  if (term == effects::NoiseTerm::kWheelNoise) {
     // A given model's wheel noise (baseline_given.hpp): how far the fitted
     // k_L, k_R are from the given ones (relative change of the standard
     // deviation, the wheel further off; x2 and x0.5 both count), like the
@@ -269,8 +278,8 @@ void SizeVarianceComponent(const CampaignData& c, const std::vector<PieceBases>&
   // type where that median is largest counts (types with fewer than
   // kMinPiecesPerType such pieces only when no type has that many).
   NoiseParams without = f.noise;
-  if (e == sim::EffectKind::kStandstillMotion) without.stand_xy2 = without.stand_th2 = 0.0;
-  if (e == sim::EffectKind::kMotionNoiseFloor) without.floor_s2 = 0.0;
+  if (NoiseTermOf(e) == effects::NoiseTerm::kStandstill) without.stand_xy2 = without.stand_th2 = 0.0;
+  if (NoiseTermOf(e) == effects::NoiseTerm::kMotionFloor) without.floor_s2 = 0.0;
   struct Spread {
     std::vector<double> rel, pos, head;
   };
@@ -319,7 +328,7 @@ void SizeMeanEffect(const CampaignData& c, const MeanModel& model, const Baselin
   // June circles an 82 ms tau_sd closing 31 % of the gap held out widened
   // the arc pieces by only 11 %.)
   ParamVector with = f.p, without = f.p;
-  if (e == sim::EffectKind::kRunTimeOffset)
+  if (NoiseTermOf(e) == effects::NoiseTerm::kRunTime)
     with[kParamTau] += std::sqrt(std::max(f.noise.run_tau2, 0.0));
   else
     for (int k : EffectParams(e)) without[k] = base.p[k];
@@ -360,7 +369,7 @@ void Size(const CampaignData& c, const MeanModel& model, const BaselineFit& base
           const std::vector<PieceBases>& bases, const PieceScatter& noise, const SetFit& f, sim::EffectKind e,
           ExplanationStep& s) {
   if (SizeWheelNoiseLike(base, bases, f, e, s)) return;
-  if (IsNoiseEffect(e) && e != sim::EffectKind::kRunTimeOffset) {
+  if (IsNoiseEffect(e) && NoiseTermOf(e) != effects::NoiseTerm::kRunTime) {
     SizeVarianceComponent(c, bases, f, e, s);
     return;
   }
@@ -545,7 +554,7 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
     std::vector<std::vector<sim::EffectKind>> sets(remaining.size(), chosen);
     for (std::size_t i = 0; i < remaining.size(); ++i) sets[i].push_back(remaining[i]);
     means.Prepare(sets);
-    const NoiseParams* warm = Contains(chosen, sim::EffectKind::kBumpOutliers) ? &current.noise : nullptr;
+    const NoiseParams* warm = HasNoise(chosen, effects::NoiseTerm::kBumps) ? &current.noise : nullptr;
     std::vector<SetFit> trial(remaining.size());
     ParallelFor(options.threads, static_cast<int>(remaining.size()), [&](int i) {
       const auto& set = sets[static_cast<std::size_t>(i)];

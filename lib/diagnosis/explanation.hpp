@@ -72,7 +72,7 @@ struct ExplanationOptions {
 };
 
 struct ExplanationStep {
-  sim::EffectKind effect = sim::EffectKind::kScaleError;
+  sim::EffectKind effect{};
   /// Parameters of this effect as fitted jointly at this step: the one
   /// value the report, the JSON, the HTML page, the advice and the
   /// suggested `simulate` command give.

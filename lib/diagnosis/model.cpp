@@ -11,6 +11,7 @@
 
 namespace umbmark::diag {
 
+
 ParamVector NominalParams() {
   ParamVector p{};
   p[kParamEd] = 1.0;

@@ -46,21 +46,22 @@
 
 namespace umbmark::diag {
 
-/// Mean-model parameters: the baseline's and every mean effect's.
+/// Mean-model parameters: the baseline's and every mean effect's (the
+/// values of effects::MeanTerm, in which the effects name theirs).
 enum ParamIndex : int {
-  kParamEd = 0,   ///< E_d
-  kParamEb,       ///< E_b
-  kParamScale,    ///< scale_error.s
-  kParamScrub,    ///< turn_scrub.k
-  kParamAsym,     ///< direction_asymmetry.a
-  kParamKappa,    ///< castor_kick.kappa [rad]
-  kParamDrift,    ///< parameter_drift.r [1/run]
-  kParamDx,       ///< gt_offset.dx [m]
-  kParamDy,       ///< gt_offset.dy [m]
-  kParamTau,      ///< time_offset.tau [s]
-  kParamSwivel,   ///< castor_swivel.kappa [rad]
-  kParamSlideD,   ///< stop_slide.d [s^2/m]
-  kParamSlideA,   ///< stop_slide.a [s^2/rad]
+  kParamEd = effects::kTermEd,   ///< E_d
+  kParamEb = effects::kTermEb,       ///< E_b
+  kParamScale = effects::kTermScale,    ///< scale_error.s
+  kParamScrub = effects::kTermScrub,    ///< turn_scrub.k
+  kParamAsym = effects::kTermAsym,     ///< direction_asymmetry.a
+  kParamKappa = effects::kTermKappa,    ///< castor_kick.kappa [rad]
+  kParamDrift = effects::kTermDrift,    ///< parameter_drift.r [1/run]
+  kParamDx = effects::kTermDx,       ///< gt_offset.dx [m]
+  kParamDy = effects::kTermDy,       ///< gt_offset.dy [m]
+  kParamTau = effects::kTermTau,      ///< time_offset.tau [s]
+  kParamSwivel = effects::kTermSwivel,   ///< castor_swivel.kappa [rad]
+  kParamSlideD = effects::kTermSlideD,   ///< stop_slide.d [s^2/m]
+  kParamSlideA = effects::kTermSlideA,   ///< stop_slide.a [s^2/rad]
   /// stop_slide's shape beyond the contract's d, a (what a physics engine
   /// shows; 0 is the contract's slide): how far the heading turns on after
   /// an arc (arc w/v times the distance coasted; 1: along the arc, 2: at
@@ -68,13 +69,13 @@ enum ParamIndex : int {
   /// do), and a backward coast's extra length (d
   /// (1 + back) v^2 backwards: braking shifts load off the driven wheels
   /// onto a castor).
-  kParamSlideArc,
-  kParamSlideBack,
+  kParamSlideArc = effects::kTermSlideArc,
+  kParamSlideBack = effects::kTermSlideBack,
   /// The values of the effects that predict through the interface
   /// (effects::Effect::PredictsMean: an effect added at run time), in
   /// catalogue order, each taking as many slots as it has parameters
   /// (RunTimeParams); an effect that finds no slots left is not fitted.
-  kParamRunTime0,
+  kParamRunTime0 = effects::kNumMeanTerms,
   kNumParams = kParamRunTime0 + 6
 };
 using ParamVector = std::array<double, kNumParams>;

@@ -2,6 +2,8 @@
 // of travel, each adding N(0, sigma^2) m of travel.
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "effects/effect.hpp"
 
 namespace umbmark::effects {
@@ -17,7 +19,9 @@ class BumpOutliers final : public Effect {
                 .random = true,
                 .definition =
                     "per wheel, Poisson bumps with `rate` per metre of travel, each adding N(0, sigma^2) m of travel",
-                .parameters = {{"rate", &Effects::bump_rate, "1/m"}, {"sigma", &Effects::bump_sigma, "m"}}}) {}
+                .parameters = {{"rate", &Effects::bump_rate, "1/m"}, {"sigma", &Effects::bump_sigma, "m"}},
+                .noise_term = NoiseTerm::kBumps}) {}
+  Params FromNoise(const NoiseValues& n) const override { return {{"rate", n.bumps_per_m}, {"sigma", std::sqrt(n.bump_var)}}; }
 
   // Bumps need both a rate and a size.
   bool Active(const Effects& e) const override { return e.bump_rate > 0.0 && e.bump_sigma > 0.0; }

@@ -19,7 +19,8 @@ class CastorKick final : public Effect {
                 .at_motion_starts = true,
                 .definition = "at every start from standstill the true heading jumps by kappa (forward) or -kappa "
                               "(backward); spot turns excluded",
-                .parameters = {{"kappa", &Effects::castor_kappa, "rad", 0.005}}}) {}
+                .parameters = {{"kappa", &Effects::castor_kappa, "rad", 0.005}},
+                .mean_terms = {kTermKappa}}) {}
 
   // A heading kick is a pose size already: below the heading floor.
   std::string PracticalFloor(const Params& p, const CampaignScale& c) const override {

@@ -26,7 +26,8 @@ class CastorSwivel final : public Effect {
                               "times the turn's sign (ccw +1, cw -1); after a reversal of the drive direction by "
                               "+kappa or -kappa with equal probability",
                 // As castor_kick.
-                .parameters = {{"kappa", &Effects::swivel_kappa, "rad", 0.005}}}) {}
+                .parameters = {{"kappa", &Effects::swivel_kappa, "rad", 0.005}},
+                .mean_terms = {kTermSwivel}}) {}
 
   // The range first: it catches NaN with the allowed range.
   std::string Check(const Effects& e) const override {

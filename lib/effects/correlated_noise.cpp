@@ -18,7 +18,9 @@ class CorrelatedNoise final : public Effect {
                 .effect_class = EffectClass::kNoise,
                 .random = true,
                 .definition = "left and right random wheel errors have correlation rho",
-                .parameters = {{"rho", &Effects::noise_rho, ""}}}) {}
+                .parameters = {{"rho", &Effects::noise_rho, ""}},
+                .noise_term = NoiseTerm::kCorrelated}) {}
+  Params FromNoise(const NoiseValues& n) const override { return {{"rho", n.rho}}; }
 
   std::string Unphysical(const Params& p, int /*runs*/, const Params& /*se*/) const override {
     if (std::abs(Get(p, "rho")) > 0.95)

@@ -17,7 +17,8 @@ class DiameterRatioError final : public Effect {
                 .effect_class = EffectClass::kMechanism,
                 .parameter_error = true,
                 .definition = "(diagnose --baseline) the given model's wheel-diameter ratio differs from the robot's",
-                .parameters = {}}) {}
+                .parameters = {},
+                .mean_terms = {kTermEd}}) {}
 };
 
 }  // namespace

@@ -17,7 +17,8 @@ class DirectionAsymmetry final : public Effect {
                 .order = 2,
                 .effect_class = EffectClass::kMechanism,
                 .definition = "a wheel turning backwards has (1 + a) times its forward effective diameter",
-                .parameters = {{"a", &Effects::asymmetry_a, "", 0.01}}}) {}
+                .parameters = {{"a", &Effects::asymmetry_a, "", 0.01}},
+                .mean_terms = {kTermAsym}}) {}
 
   std::string Unphysical(const Params& p, int /*runs*/, const Params& /*se*/) const override {
     if (std::abs(Get(p, "a")) > 0.1)

@@ -24,6 +24,52 @@
 
 namespace umbmark::effects {
 
+/// The diagnosis' mean-model parameters (diagnosis/model.hpp ParamIndex has
+/// the same values): the vocabulary in which an effect names those that
+/// are its own (Descriptor::mean_terms).
+enum MeanTerm : int {
+  kTermEd = 0,     ///< E_d (the baseline's)
+  kTermEb,         ///< E_b (the baseline's)
+  kTermScale,      ///< a common factor of both wheels' travel
+  kTermScrub,      ///< the heading lost in spot turns (also enters the covariance bases)
+  kTermAsym,       ///< a factor of backward travel
+  kTermKappa,      ///< a heading kick where a non-turn motion starts from standstill
+  kTermDrift,      ///< the right wheel's factor per run
+  kTermDx,         ///< the reported point, forward of the axle
+  kTermDy,         ///< the reported point, left of the axle
+  kTermTau,        ///< the ground truth's clock (checked on the moving samples alone)
+  kTermSwivel,     ///< a heading kick after a spot turn
+  kTermSlideD,     ///< a coast after a straight or arc motion (the campaign shows it only with such a stop)
+  kTermSlideA,     ///< a coast after a spot turn (only with a stop after a turn)
+  kTermSlideArc,   ///< a coast's turn after an arc (only with a stop on an arc)
+  kTermSlideBack,  ///< a backward coast's extra length (only with forward and backward stops)
+  kNumMeanTerms
+};
+
+/// The components of the diagnosis' piece noise model (diagnosis/
+/// piece_noise.hpp) a noise effect switches on (Descriptor::noise_term).
+enum class NoiseTerm {
+  kNone,
+  kCorrelated,   ///< correlation of the two wheels' noise
+  kBumps,        ///< a mixture of rare bumps (its own fit)
+  kStandstill,   ///< settling where a motion ends at a standstill
+  kMotionFloor,  ///< slip where motions start and stop
+  kRunTime,      ///< a clock offset of each run (run blocks)
+  kWheelNoise,   ///< the wheel noise k_L, k_R of a given model
+};
+
+/// The fitted noise, as the diagnosis' piece noise model has it (variances
+/// and the bump rate; Effect::FromNoise).
+struct NoiseValues {
+  double rho = 0.0;        ///< correlation of the wheels' noise
+  double bumps_per_m = 0.0;  ///< bumps per metre of a wheel's travel
+  double bump_var = 0.0;     ///< a bump's variance [m^2]
+  double stand_xy2 = 0.0, stand_th2 = 0.0;  ///< settling [m^2, rad^2]
+  double floor_s2 = 0.0;   ///< start / stop slip [m^2]
+  double run_tau2 = 0.0;   ///< per-run clock [s^2]
+  double kL2 = 0.0, kR2 = 0.0;  ///< wheel noise [m]
+};
+
 /// What an effect is: a property of the robot's motion (mechanism), of the
 /// recording (measurement), or a random scatter (noise).
 enum class EffectClass { kMechanism, kMeasurement, kNoise };
@@ -97,6 +143,12 @@ struct Descriptor {
   bool at_motion_stops = false;
   std::string_view definition;
   std::vector<Parameter> parameters;
+  /// Its parameters in the diagnosis' mean model, in the order of
+  /// `parameters` (empty: a noise effect, or one that predicts through
+  /// PredictWheels).
+  std::vector<int> mean_terms{};
+  /// The noise component it switches on (a random effect; kNone else).
+  NoiseTerm noise_term = NoiseTerm::kNone;
 };
 
 class Effect {
@@ -170,6 +222,10 @@ class Effect {
   /// fitted counterpart of TrueWheels. Called once per run and prediction,
   /// never per sample. Default: none.
   virtual void PredictWheels(const double* /*v*/, int /*run_index*/, double& /*left*/, double& /*right*/) const {}
+
+  /// A noise effect's contract parameters from the fitted noise (empty for
+  /// the others).
+  virtual Params FromNoise(const NoiseValues& /*n*/) const { return {}; }
 
   /// How a fitted parameter reads: {factor, unit} (value x factor, unit),
   /// e.g. {1e3, " mm"}; {0, ""} leaves it to the generic reading.

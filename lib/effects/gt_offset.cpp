@@ -17,7 +17,8 @@ class GtOffset final : public Effect {
                 .order = 7,
                 .effect_class = EffectClass::kMeasurement,
                 .definition = "ground truth reports the point (dx, dy) of the robot frame instead of the axle midpoint",
-                .parameters = {{"dx", &Effects::gt_dx, "m", 0.01}, {"dy", &Effects::gt_dy, "m", 0.01}}}) {}
+                .parameters = {{"dx", &Effects::gt_dx, "m", 0.01}, {"dy", &Effects::gt_dy, "m", 0.01}},
+                .mean_terms = {kTermDx, kTermDy}}) {}
 
   // The marker's distance is a position already: below the position floor.
   std::string PracticalFloor(const Params& p, const CampaignScale& c) const override {

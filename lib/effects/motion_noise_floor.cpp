@@ -3,6 +3,8 @@
 // simulator: half the variance as the motion starts, half as it stops).
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "effects/effect.hpp"
 
 namespace umbmark::effects {
@@ -18,7 +20,9 @@ class MotionNoiseFloor final : public Effect {
                 .random = true,
                 .definition = "every motion between two standstills adds N(0, sigma^2) m to each wheel's true travel, "
                               "independently of its length",
-                .parameters = {{"sigma", &Effects::floor_sigma, "m"}}}) {}
+                .parameters = {{"sigma", &Effects::floor_sigma, "m"}},
+                .noise_term = NoiseTerm::kMotionFloor}) {}
+  Params FromNoise(const NoiseValues& n) const override { return {{"sigma", std::sqrt(n.floor_s2)}}; }
 
   std::string Unphysical(const Params& p, int /*runs*/, const Params& /*se*/) const override {
     return NoisePerEventTooLarge(p, "sigma");

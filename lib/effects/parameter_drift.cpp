@@ -18,7 +18,8 @@ class ParameterDrift final : public Effect {
                 .order = 6,
                 .effect_class = EffectClass::kMechanism,
                 .definition = "in run i of the campaign the true right wheel diameter is (1 + r i) times run 0's",
-                .parameters = {{"r", &Effects::drift_r, "1/run", 1e-4}}}) {}
+                .parameters = {{"r", &Effects::drift_r, "1/run", 1e-4}},
+                .mean_terms = {kTermDrift}}) {}
 
   std::string Unphysical(const Params& p, int runs, const Params& /*se*/) const override {
     const double r = Get(p, "r");

@@ -17,7 +17,8 @@ class ScaleError final : public Effect {
                 .order = 0,
                 .effect_class = EffectClass::kMechanism,
                 .definition = "both true wheel diameters are (1 + s) times the model's",
-                .parameters = {{"s", &Effects::scale_s, "", 0.01}}}) {}
+                .parameters = {{"s", &Effects::scale_s, "", 0.01}},
+                .mean_terms = {kTermScale}}) {}
 
   // Negligible when the travel error over one of the campaign's legs is
   // under the position floor (0.3 mm at the default negligible).

@@ -4,6 +4,8 @@
 // applies it as the standstill begins).
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "effects/effect.hpp"
 
 namespace umbmark::effects {
@@ -21,7 +23,9 @@ class StandstillMotion final : public Effect {
                               "sigma_xy^2) m along each robot axis and N(0, sigma_theta^2) rad in heading, "
                               "independently per standstill",
                 .parameters = {{"sigma_xy", &Effects::stand_sigma_xy, "m"},
-                               {"sigma_theta", &Effects::stand_sigma_theta, "rad"}}}) {}
+                               {"sigma_theta", &Effects::stand_sigma_theta, "rad"}},
+                .noise_term = NoiseTerm::kStandstill}) {}
+  Params FromNoise(const NoiseValues& n) const override { return {{"sigma_xy", std::sqrt(n.stand_xy2)}, {"sigma_theta", std::sqrt(n.stand_th2)}}; }
 
   std::string Unphysical(const Params& p, int /*runs*/, const Params& /*se*/) const override {
     return NoisePerEventTooLarge(p, "sigma_xy");

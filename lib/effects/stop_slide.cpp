@@ -36,7 +36,8 @@ class StopSlide final : public Effect {
                 .parameters = {{"d", &Effects::slide_d, "s^2/m", 0.065},
                                {"a", &Effects::slide_a, "s^2/rad", 0.01},
                                {"arc", &Effects::slide_arc, "", 1.0},
-                               {"back", &Effects::slide_back, "", 0.3}}}) {}
+                               {"back", &Effects::slide_back, "", 0.3}},
+                .mean_terms = {kTermSlideD, kTermSlideA, kTermSlideArc, kTermSlideBack}}) {}
 
   // The ranges first: they catch NaN with the allowed range.
   std::string Check(const Effects& e) const override {

@@ -17,7 +17,8 @@ class TimeOffset final : public Effect {
                 .order = 8,
                 .effect_class = EffectClass::kMeasurement,
                 .definition = "a ground-truth sample stamped t shows the true pose at t - tau",
-                .parameters = {{"tau", &Effects::time_tau, "s", 0.02}}}) {}
+                .parameters = {{"tau", &Effects::time_tau, "s", 0.02}},
+                .mean_terms = {kTermTau}}) {}
 
   // A clock offset moves the pose by tau v and the heading by tau w: below
   // both floors at the campaign's typical speed and turn rate.

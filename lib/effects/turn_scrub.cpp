@@ -18,7 +18,8 @@ class TurnScrub final : public Effect {
                 .effect_class = EffectClass::kMechanism,
                 .definition =
                     "in on-the-spot turns the true heading change is (1 - k) times what the true wheel travel implies",
-                .parameters = {{"k", &Effects::scrub_k, "", 0.03}}}) {}
+                .parameters = {{"k", &Effects::scrub_k, "", 0.03}},
+                .mean_terms = {kTermScrub}}) {}
 
   // Negative below -0.01, or below 0 by more than 2 standard errors.
   std::string Unphysical(const Params& p, int /*runs*/, const Params& se) const override {

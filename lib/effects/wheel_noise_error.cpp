@@ -3,6 +3,8 @@
 // of the diagnosis only, never simulated (simulate the robot with other
 // parameters instead); its fit and correction live in the diagnosis's
 // given-model code (baseline_given.hpp).
+#include <cmath>
+
 #include "effects/effect.hpp"
 
 namespace umbmark::effects {
@@ -18,7 +20,9 @@ class WheelNoiseError final : public Effect {
                 .random = true,
                 .parameter_error = true,
                 .definition = "(diagnose --baseline) the given wheel noise k_L, k_R differs from the robot's",
-                .parameters = {}}) {}
+                .parameters = {},
+                .noise_term = NoiseTerm::kWheelNoise}) {}
+  Params FromNoise(const NoiseValues& n) const override { return {{"k_L", std::sqrt(n.kL2)}, {"k_R", std::sqrt(n.kR2)}}; }
 };
 
 }  // namespace

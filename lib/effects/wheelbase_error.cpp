@@ -17,7 +17,8 @@ class WheelbaseError final : public Effect {
                 .effect_class = EffectClass::kMechanism,
                 .parameter_error = true,
                 .definition = "(diagnose --baseline) the given model's wheelbase differs from the robot's",
-                .parameters = {}}) {}
+                .parameters = {},
+                .mean_terms = {kTermEb}}) {}
 };
 
 }  // namespace
