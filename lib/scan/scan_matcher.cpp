@@ -168,12 +168,21 @@ struct MatchKernel {
       while (rel < -kPi) rel += 2.0 * kPi;
     }
     long centre = std::lround(rel / model.angle_increment_);
-    if (model.full_circle_) centre = (centre % nb + nb) % nb;
+    if (model.full_circle_) {
+      if (centre < 0) centre += nb;
+      else if (centre >= nb) centre -= nb;
+      if (centre < 0 || centre >= nb) centre = (centre % nb + nb) % nb;
+    }
     double best = max_d * max_d;
     long found = -1;
+    // The neighbours of a full circle wrap around; centre is in [0, nb), so
+    // one add or subtract of nb does it while the search is under a circle
+    // (an integer division per candidate was a third of the matching time).
+    const bool wrap = model.full_circle_ && 2L * search < nb;
     for (long k = centre - search; k <= centre + search; ++k) {
       long j = k;
-      if (model.full_circle_) j = (k % nb + nb) % nb;
+      if (wrap) j = j < 0 ? j + nb : (j >= nb ? j - nb : j);
+      else if (model.full_circle_) j = (k % nb + nb) % nb;
       if (j < 0 || j >= nb) continue;
       const Point2& p = model.points_[static_cast<std::size_t>(j)];
       if (std::isnan(model.normals_[static_cast<std::size_t>(j)].x)) continue;
