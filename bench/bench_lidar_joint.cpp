@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
       calibration::LidarCalibrationOptions options;
       options.pairs.symmetric = !one_way;
       options.pairs.deskew = !no_deskew;
-      options.gyro_time_offset = !no_gyro_offset;
+      options.gyro.time_offset = !no_gyro_offset;
       const auto r = calibration::CalibrateLidar(in, options);
       fit_s += CpuSeconds() - t0;
       const std::size_t n = r.covariance_order.size();
@@ -134,6 +134,8 @@ int main(int argc, char** argv) {
         std::printf("seed %3llu: %zu scans, %zu meas (%zu out), s %.2f k %.2e up %d |", static_cast<unsigned long long>(c.seed),
                     r.scans, r.measurements, r.fit.outliers, r.fit.registration_scale, r.fit.wheel_noise_k, r.upside_down ? 1 : 0);
         for (int i = 0; i < 9; ++i) std::printf(" %s %+.3f(%.3f)", st[i].name, err[i] * st[i].scale, half[i] * st[i].scale);
+        std::printf(" | z");
+        for (int i = 0; i < 9; ++i) std::printf(" %+.2f", half[i] > 0 ? 1.96 * err[i] / half[i] : 0.0);
         std::printf("\n");
       }
     } catch (const std::exception& e) {

@@ -50,7 +50,8 @@ int main(int argc, char** argv) {
   }
   // [real, simulated] x [c_L, c_R, b]: normalised errors
   std::vector<double> zn[2][3];
-  std::vector<double> slopes, pred_var;
+  std::vector<double> slopes, pred_var, rots, rot_pred, hscales, hscale_pred, turn_t_pred;
+  std::vector<Eigen::Vector2d> turn_t;
   double chi2_sum = 0.0, n_sum = 0.0, lat_sum = 0.0, th_sum = 0.0;
   for (int b = 0; b < bags; ++b) {
     testing::LidarSimConfig c;
@@ -68,6 +69,10 @@ int main(int argc, char** argv) {
     };
     // Per drive: err_along = slope * dist (least squares through 0).
     double sxy = 0.0, sxx = 0.0, chi2 = 0.0, lat = 0.0, th = 0.0, pred = 0.0;  // pred: sum d^2 var(along)
+    double lxy = 0.0, lpred = 0.0;  // lateral error * d, sum d^2 var(lateral)
+    double hxy = 0.0, hxx = 0.0, hpred = 0.0;  // heading error * heading change, sum change^2, sum change^2 var(heading)
+    Eigen::Vector2d vxy = Eigen::Vector2d::Zero();  // translation error * heading change
+    Eigen::Matrix2d vpred = Eigen::Matrix2d::Zero();  // sum change^2 cov(translation)
     int n = 0;
     for (const auto& p : pr.pairs) {
       if (!p.undetermined.empty()) continue;
@@ -83,8 +88,17 @@ int main(int argc, char** argv) {
         const auto& cv = p.covariance;
         pred += d * d * (ux * ux * cv[0] + 2 * ux * uy * cv[1] + uy * uy * cv[4]);
         lat += (-e.x() * truth.y + e.y() * truth.x) / d;
+        lxy += (-e.x() * truth.y + e.y() * truth.x);
+        lpred += d * d * (uy * uy * cv[0] - 2 * ux * uy * cv[1] + ux * ux * cv[4]);
       }
       th += e.z();
+      hxy += e.z() * truth.theta;
+      hxx += truth.theta * truth.theta;
+      hpred += truth.theta * truth.theta * p.covariance[8];
+      vxy += truth.theta * e.head<2>();
+      Eigen::Matrix2d ct;
+      ct << p.covariance[0], p.covariance[1], p.covariance[3], p.covariance[4];
+      vpred += truth.theta * truth.theta * ct;
       Eigen::Matrix3d cov;
       for (int r = 0; r < 3; ++r)
         for (int k = 0; k < 3; ++k) cov(r, k) = p.covariance[static_cast<std::size_t>(3 * r + k)];
@@ -127,6 +141,19 @@ int main(int argc, char** argv) {
     }
     const double slope = sxx > 0 ? sxy / sxx : 0.0;
     slopes.push_back(slope);
+    // The rotation of the translations (lateral error per metre, rad).
+    const double rot = sxx > 0 ? lxy / sxx : 0.0;
+    rots.push_back(rot);
+    rot_pred.push_back(sxx > 0 ? chi2 / (3.0 * n) * lpred / (sxx * sxx) : 0.0);
+    // The scale of the heading changes (heading error per radian turned).
+    const double hscale = hxx > 0 ? hxy / hxx : 0.0;
+    hscales.push_back(hscale);
+    hscale_pred.push_back(hxx > 0 ? chi2 / (3.0 * n) * hpred / (hxx * hxx) : 0.0);
+    // A translation error per radian turned (lidar frame): what the mount's
+    // position takes as its own.
+    const Eigen::Vector2d per_rad = hxx > 0 ? Eigen::Vector2d(vxy / hxx) : Eigen::Vector2d::Zero();
+    turn_t.push_back(per_rad);
+    turn_t_pred.push_back(hxx > 0 ? 0.5 * (chi2 / (3.0 * n) * vpred / (hxx * hxx)).trace() : 0.0);
     // The slope's variance the reported covariances predict (times the
     // drive's s^2 = mean chi2 / 3), independent measurements.
     pred_var.push_back(sxx > 0 ? chi2 / (3.0 * n) * pred / (sxx * sxx) : 0.0);
@@ -134,8 +161,8 @@ int main(int argc, char** argv) {
     n_sum += n;
     lat_sum += lat;
     th_sum += th;
-    std::printf("seed %3llu: %4d measurements, scale bias %+.2e m/m, mean chi2 %.2f (3 if the covariance is right)\n",
-                static_cast<unsigned long long>(c.seed), n, slope, chi2 / n);
+    std::printf("seed %3llu: %4d measurements, scale bias %+.2e m/m, rotation %+.2e rad, heading scale %+.2e, translation per rad %+.2e %+.2e m, mean chi2 %.2f (3 if the covariance is right)\n",
+                static_cast<unsigned long long>(c.seed), n, slope, rot, hscale, per_rad.x(), per_rad.y(), chi2 / n);
   }
   double m = 0.0, v = 0.0;
   for (double s : slopes) m += s;
@@ -152,6 +179,39 @@ int main(int argc, char** argv) {
   std::printf("scale error per drive: RMS %.2e m/m, the reported covariances predict %.2e; the excess (a scale error the "
               "covariances do not carry) %.2e m/m\n",
               std::sqrt(msq), std::sqrt(mp), std::sqrt(std::max(0.0, msq - mp)));
+  double rsq = 0.0, rp = 0.0, rm = 0.0;
+  for (std::size_t i = 0; i < rots.size(); ++i) {
+    rsq += rots[i] * rots[i];
+    rp += rot_pred[i];
+    rm += rots[i];
+  }
+  rsq /= static_cast<double>(rots.size());
+  rp /= static_cast<double>(rots.size());
+  rm /= static_cast<double>(rots.size());
+  std::printf("rotation of the translations per drive (lateral error per metre): mean %+.2e rad, RMS %.2e rad, the reported "
+              "covariances predict %.2e; the excess %.2e rad\n",
+              rm, std::sqrt(rsq), std::sqrt(rp), std::sqrt(std::max(0.0, rsq - rp)));
+  double hsq = 0.0, hp = 0.0, hm = 0.0;
+  for (std::size_t i = 0; i < hscales.size(); ++i) {
+    hsq += hscales[i] * hscales[i];
+    hp += hscale_pred[i];
+    hm += hscales[i];
+  }
+  const double nh = static_cast<double>(hscales.size());
+  std::printf("scale of the heading changes per drive (heading error per radian turned): mean %+.2e, RMS %.2e, the reported "
+              "covariances predict %.2e; the excess %.2e\n",
+              hm / nh, std::sqrt(hsq / nh), std::sqrt(hp / nh), std::sqrt(std::max(0.0, hsq / nh - hp / nh)));
+  double tsq = 0.0, tp = 0.0;
+  Eigen::Vector2d tm = Eigen::Vector2d::Zero();
+  for (std::size_t i = 0; i < turn_t.size(); ++i) {
+    tsq += 0.5 * turn_t[i].squaredNorm();
+    tp += turn_t_pred[i];
+    tm += turn_t[i];
+  }
+  const double nt = static_cast<double>(turn_t.size());
+  std::printf("translation error per radian turned, per drive and axis: mean %+.2e %+.2e m, RMS %.2e m, the reported "
+              "covariances predict %.2e; the excess %.2e m\n",
+              tm.x() / nt, tm.y() / nt, std::sqrt(tsq / nt), std::sqrt(tp / nt), std::sqrt(std::max(0.0, tsq / nt - tp / nt)));
   std::printf("\n%d drives (%s): scale bias %+.2e m/m (t = %.1f; drive-to-drive sd %.2e), mean chi2 per measurement %.2f, "
               "mean lateral error %+.2e m, mean heading error %+.2e rad\n",
               bags, one_way ? "one way" : "both ways", m, m / se, std::sqrt(v / (static_cast<double>(slopes.size()) - 1)),

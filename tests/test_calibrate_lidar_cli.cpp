@@ -205,3 +205,33 @@ TEST_CASE("calibrate-lidar: bad input exits 1 or 2 naming the problem, writing n
   CHECK(r.status == 2);
   CHECK_FALSE(std::filesystem::exists(dir / "out.json"));
 }
+
+TEST_CASE("calibrate-lidar: a drive that determines nothing exits 3, says what to drive, writes no --ros2") {
+  // drive_still.mcap: the robot stands still for 40 s (long enough not to be
+  // refused as short), so no parameter is excited.
+  const auto dir = TempDir("calibrate-lidar-still");
+  const std::string args = "calibrate-lidar " + Q(kLidar / "drive_still.mcap") + " --scan /scan --wheels /joint_states --imu /imu" +
+                           " --robot " + Q(kLidar / "robot.toml") + " --ros2 " + Q(dir / "diff_drive.yaml");
+  const auto r = RunCli(args);
+  INFO(r.out << r.err);
+  CHECK(r.status == 3);
+  CHECK_THAT(r.err, Contains("the drive determines none of the wheel parameters") && Contains("nothing is written to --ros2"));
+  // What to drive, for the wheelbase, the diameters and the mount.
+  CHECK_THAT(r.err, Contains("add spot turns and loops, two full turns each way") &&
+                        Contains("straight runs of at least 2 m") && Contains("the drive does not determine the wheelbase") &&
+                        Contains("the drive does not determine the left wheel's diameter") &&
+                        Contains("the drive does not determine the lidar's mount"));
+  CHECK_FALSE(std::filesystem::exists(dir / "diff_drive.yaml"));
+  CHECK(std::filesystem::is_empty(dir));
+  // --json holds the refusal and the same advice (the contract: the JSON is
+  // the report of the refusal; the parameters file is what is withheld).
+  const auto j = RunCli(args + " --json -");
+  CHECK(j.status == 3);
+  const auto out = nlohmann::json::parse(j.out);
+  CHECK(out.at("refused").get<std::string>() == "the drive determines none of the wheel parameters");
+  for (const char* key : {"wheelbase_m", "wheel_diameter_left_m", "wheel_diameter_right_m", "lidar_mount"}) {
+    INFO(key);
+    CHECK(out.at("excitation").at(key).get<std::string>() == "not_excited");
+  }
+  CHECK_FALSE(std::filesystem::exists(dir / "diff_drive.yaml"));
+}

@@ -149,78 +149,20 @@ double GyroRateAt(const std::vector<scan::GyroSample>& g, std::int64_t t) {
   return a.rate_rad_s + u * (b.rate_rad_s - a.rate_rad_s);
 }
 
-// Gyro scale, bias and time offset: the integral of the reading over each
-// measurement's interval [t_a, t_b] (the scan stamps less the fitted clock
-// offset) is
-//
-//     scale * heading change + bias * (t_b - t_a) - tau * (w(t_b) - w(t_a)),
-//
-// tau being the gyro's stamp minus the time of the motion it measures (a
-// filter's group delay, a sample that averages the next interval) and w the
-// reading at the interval's ends: to first order a shifted window gains the
-// rate at one end and loses it at the other. Least squares, with the lag-1
-// sandwich covariance (consecutive intervals share a scan). Without the
-// third term a delay of half a millisecond biases the scale by about one
-// standard deviation of a 5-minute drive: spot turns start inside one
-// keyframe interval at full rate and end inside another with less, so the
-// end terms do not cancel. The term also absorbs an error of the fitted
-// scan clock, which shifts every window alike. Drives whose rate never
-// changes fit scale and bias alone.
-void FitGyro(const LidarCalibrationInput& in, const std::vector<ScanPair>& pairs, bool fit_delay, LidarCalibration& out) {
+void FitGyro(const LidarCalibrationInput& in, const std::vector<ScanPair>& pairs, const LidarCalibrationOptions& o,
+             LidarCalibration& out) {
   if (in.gyro.empty()) return;
-  const std::int64_t offset = std::llround(out.time_offset_s * 1e9);
-  using Vec3 = Eigen::Vector3d;
-  std::vector<Vec3> rows;
-  std::vector<double> ys;
-  for (const ScanPair& p : pairs) {
-    const std::int64_t ta = p.t_a_ns - offset, tb = p.t_b_ns - offset;
-    if (ta < in.gyro.front().t_ns || tb > in.gyro.back().t_ns) continue;
-    rows.emplace_back(p.lidar_a_T_lidar_b.theta, Seconds(tb - ta), GyroRateAt(in.gyro, tb) - GyroRateAt(in.gyro, ta));
-    ys.push_back(scan::IntegrateRate(in.gyro, 0.0, ta, tb));
-  }
-  if (rows.size() < 10) {
-    out.warnings.push_back("the gyro covers fewer than 10 scan measurements: no gyro scale or bias");
+  const std::optional<GyroFit> g = FitGyroToScans(in.gyro, pairs, out.time_offset_s, o.gyro);
+  if (!g) {
+    out.warnings.push_back("the gyro covers fewer than 10 scan measurements, or they do not turn: no gyro scale or bias");
     return;
   }
-  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-  Vec3 g = Vec3::Zero();
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    h += rows[i] * rows[i].transpose();
-    g += rows[i] * ys[i];
-  }
-  if (std::abs(h.topLeftCorner<2, 2>().determinant()) < 1e-12 * h.topLeftCorner<2, 2>().squaredNorm()) return;
-  // The delay only where the rate changes enough to tell it: its sd under
-  // 10 ms for a 0.01 rad residual, i.e. its information (the Schur
-  // complement of the rate-difference column) over 1 (rad/s)^2; else scale
-  // and bias alone.
-  const Eigen::Vector2d cross = h.block<2, 1>(0, 2);
-  const double info = h(2, 2) - cross.dot(h.topLeftCorner<2, 2>().ldlt().solve(cross));
-  const bool delay = fit_delay && info > 1.0;
-  if (!delay) {
-    h.row(2).setZero();
-    h.col(2).setZero();
-    h(2, 2) = 1.0;
-    g(2) = 0.0;
-    for (Vec3& r : rows) r(2) = 0.0;
-  }
-  const Vec3 x = h.ldlt().solve(g);
-  Eigen::Matrix3d meat = Eigen::Matrix3d::Zero();
-  std::vector<Vec3> score;
-  for (std::size_t i = 0; i < rows.size(); ++i) score.push_back(rows[i] * (ys[i] - rows[i].dot(x)));
-  for (std::size_t i = 0; i < score.size(); ++i) {
-    meat += score[i] * score[i].transpose();
-    if (i + 1 < score.size()) meat += score[i] * score[i + 1].transpose() + score[i + 1] * score[i].transpose();
-  }
-  const Eigen::Matrix3d hi = h.inverse();
-  const Eigen::Matrix3d cov = hi * meat * hi;
-  out.gyro_scale = x(0);
-  out.gyro_bias_rad_s = x(1);
-  out.gyro_scale_sd = std::sqrt(std::max(0.0, cov(0, 0)));
-  out.gyro_bias_sd = std::sqrt(std::max(0.0, cov(1, 1)));
-  if (delay && x(0) != 0.0) {
-    out.gyro_time_offset_s = -x(2) / x(0);
-    out.gyro_time_offset_sd = std::sqrt(std::max(0.0, cov(2, 2))) / std::abs(x(0));
-  }
+  out.gyro_scale = g->scale;
+  out.gyro_bias_rad_s = g->bias_rad_s;
+  out.gyro_scale_sd = g->scale_sd;
+  out.gyro_bias_sd = g->bias_sd;
+  out.gyro_time_offset_s = g->time_offset_s;
+  out.gyro_time_offset_sd = g->time_offset_sd;
 }
 
 // Heading turned left and right by the nominal wheels, and travel.
@@ -423,6 +365,90 @@ double DistanceScale(const LidarCalibrationInput& in, const PairResult& pr, cons
 
 }  // namespace
 
+// Gyro scale, bias and time offset: the integral of the reading over each
+// measurement's interval [t_a, t_b] (the scan stamps less the fitted clock
+// offset) is
+//
+//     scale * heading change + bias * (t_b - t_a) - tau * (w(t_b) - w(t_a)),
+//
+// tau being the gyro's stamp minus the time of the motion it measures (a
+// filter's group delay, a sample that averages the next interval) and w the
+// reading at the interval's ends: to first order a shifted window gains the
+// rate at one end and loses it at the other. Least squares, with the lag-1
+// sandwich covariance (consecutive intervals share a scan). Without the
+// third term a delay of half a millisecond biases the scale by about one
+// standard deviation of a 5-minute drive: spot turns start inside one
+// keyframe interval at full rate and end inside another with less, so the
+// end terms do not cancel. The term also absorbs an error of the fitted
+// scan clock, which shifts every window alike. Drives whose rate never
+// changes fit scale and bias alone.
+std::optional<GyroFit> FitGyroToScans(const std::vector<scan::GyroSample>& gyro, const std::vector<ScanPair>& pairs,
+                                      double scan_time_offset_s, const GyroFitOptions& o) {
+  if (const std::string err = o.Validate(); !err.empty()) throw InvalidOptions(err);
+  const bool fit_delay = o.time_offset;
+  const std::int64_t offset = std::llround(scan_time_offset_s * 1e9);
+  using Vec3 = Eigen::Vector3d;
+  std::vector<Vec3> rows;
+  std::vector<double> ys;
+  for (const ScanPair& p : pairs) {
+    const std::int64_t ta = p.t_a_ns - offset, tb = p.t_b_ns - offset;
+    if (ta < gyro.front().t_ns || tb > gyro.back().t_ns) continue;
+    rows.emplace_back(p.lidar_a_T_lidar_b.theta, Seconds(tb - ta), GyroRateAt(gyro, tb) - GyroRateAt(gyro, ta));
+    ys.push_back(scan::IntegrateRate(gyro, 0.0, ta, tb));
+  }
+  if (rows.size() < 10) return std::nullopt;
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  Vec3 g = Vec3::Zero();
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    h += rows[i] * rows[i].transpose();
+    g += rows[i] * ys[i];
+  }
+  if (std::abs(h.topLeftCorner<2, 2>().determinant()) < 1e-12 * h.topLeftCorner<2, 2>().squaredNorm()) return std::nullopt;
+  // The delay only where the rate changes enough to tell it: its sd under
+  // 10 ms for a 0.01 rad residual, i.e. its information (the Schur
+  // complement of the rate-difference column) over 1 (rad/s)^2; else scale
+  // and bias alone.
+  const Eigen::Vector2d cross = h.block<2, 1>(0, 2);
+  const double info = h(2, 2) - cross.dot(h.topLeftCorner<2, 2>().ldlt().solve(cross));
+  const bool delay = fit_delay && info > 1.0;
+  if (!delay) {
+    h.row(2).setZero();
+    h.col(2).setZero();
+    h(2, 2) = 1.0;
+    g(2) = 0.0;
+    for (Vec3& r : rows) r(2) = 0.0;
+  }
+  const Vec3 x = h.ldlt().solve(g);
+  Eigen::Matrix3d meat = Eigen::Matrix3d::Zero();
+  std::vector<Vec3> score;
+  for (std::size_t i = 0; i < rows.size(); ++i) score.push_back(rows[i] * (ys[i] - rows[i].dot(x)));
+  for (std::size_t i = 0; i < score.size(); ++i) {
+    meat += score[i] * score[i].transpose();
+    if (i + 1 < score.size()) meat += score[i] * score[i + 1].transpose() + score[i + 1] * score[i].transpose();
+  }
+  const Eigen::Matrix3d hi = h.inverse();
+  const Eigen::Matrix3d cov = hi * meat * hi;
+  GyroFit out;
+  out.measurements = rows.size();
+  out.scale = x(0);
+  out.bias_rad_s = x(1);
+  // Model error: a scale error g common to the drive's heading changes moves
+  // the scale by -g times itself.
+  out.scale_sd = std::sqrt(std::max(0.0, cov(0, 0)) + std::pow(o.heading_scale_sd * x(0), 2));
+  out.bias_sd = std::sqrt(std::max(0.0, cov(1, 1)));
+  if (delay && x(0) != 0.0) {
+    out.time_offset_s = -x(2) / x(0);
+    out.time_offset_sd = std::sqrt(std::max(0.0, cov(2, 2))) / std::abs(x(0));
+  }
+  return out;
+}
+
+std::string GyroFitOptions::Validate() const {
+  if (!(heading_scale_sd >= 0.0 && heading_scale_sd < 0.1))
+    return fmt::format("heading_scale_sd = {}: must be in [0, 0.1)", heading_scale_sd);
+  return {};
+}
+
 const char* ExcitationToString(Excitation e) {
   switch (e) {
     case Excitation::kDetermined: return "determined";
@@ -435,6 +461,7 @@ const char* ExcitationToString(Excitation e) {
 std::string LidarCalibrationOptions::Validate() const {
   if (const std::string e = pairs.Validate(); !e.empty()) return "pairs." + e;
   if (const std::string e = fit.Validate(); !e.empty()) return "fit." + e;
+  if (const std::string e = gyro.Validate(); !e.empty()) return "gyro." + e;
   for (const auto& [name, v] :
        {std::pair{"max_open_fraction", max_open_fraction}, std::pair{"min_drive_s", min_drive_s},
         std::pair{"target_wheelbase_rel", target_wheelbase_rel}, std::pair{"target_diameter_rel", target_diameter_rel},
@@ -497,7 +524,7 @@ LidarCalibration CalibrateLidar(const LidarCalibrationInput& in, const LidarCali
   out.wheel_separation_multiplier = out.parameters.wheelbase_m / in.nominal.wheelbase_m;
   out.left_wheel_radius_multiplier = scale * f.c_left;
   out.right_wheel_radius_multiplier = scale * f.c_right;
-  FitGyro(in, pairs, o.gyro_time_offset, out);
+  FitGyro(in, pairs, o, out);
   PhysicalCovariance(out.fit, in.nominal, scale, out);
   const std::size_t n = out.covariance_order.size();
   auto sd = [&](std::size_t i) { return std::sqrt(std::max(0.0, out.covariance[i * n + i])); };

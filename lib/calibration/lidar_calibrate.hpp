@@ -57,6 +57,40 @@ struct ParameterExcitation {
   std::string what_to_drive;  ///< empty when determined
 };
 
+/// Settings of the gyro's fit against the scans (FitGyroToScans).
+struct GyroFitOptions {
+  /// Fit the gyro's time offset with its scale and bias (where the drive's
+  /// rate changes enough to tell it); false fits scale and bias alone.
+  bool time_offset = true;
+  /// Relative sd of a scale error common to a drive's registered heading
+  /// changes (every heading change reads 1 + g times the truth), which the
+  /// gyro's scale takes as its own and no residual shows: added to the
+  /// scale's variance as a model-error term. 0 leaves it out.
+  double heading_scale_sd = 0.0;
+  /// Empty when valid, else a message naming the bad field.
+  std::string Validate() const;
+};
+
+/// The gyro against the scans' heading changes.
+struct GyroFit {
+  double scale = 1.0, bias_rad_s = 0.0;
+  double scale_sd = 0.0, bias_sd = 0.0;
+  std::optional<double> time_offset_s;  ///< the gyro's stamp minus the time of the motion it measures
+  double time_offset_sd = 0.0;
+  std::size_t measurements = 0;         ///< scan measurements inside the gyro's data
+};
+
+/// Fits the gyro's scale, bias and (options.time_offset) time offset to the
+/// heading changes of the scan measurements: the integral of the reading over
+/// each measurement's interval (the scan stamps less `scan_time_offset_s`) is
+/// scale * heading change + bias * duration - scale * tau * (rate at the end -
+/// rate at the start). Least squares with the lag-1 sandwich covariance
+/// (consecutive measurements share a scan), plus the model-error term.
+/// `gyro` in time order. nullopt when fewer than 10 measurements fall inside
+/// the gyro's data or they do not tell the scale from the bias.
+std::optional<GyroFit> FitGyroToScans(const std::vector<scan::GyroSample>& gyro, const std::vector<ScanPair>& pairs,
+                                      double scan_time_offset_s, const GyroFitOptions& options = {});
+
 /// Settings. Defaults: the targets of a 5-minute drive (wheelbase 0.3 %,
 /// diameters 0.2 %, mount 5 mm and 0.1 deg, clock 5 ms, gyro scale 0.3 %)
 /// count as determined; up to 20 times them as weak.
@@ -68,9 +102,7 @@ struct LidarCalibrationOptions {
   double target_wheelbase_rel = 0.003, target_diameter_rel = 0.002, target_position_m = 0.005;
   double target_yaw_rad = Deg2Rad(0.1), target_offset_s = 0.005, target_gyro_scale_rel = 0.003;
   double weak_factor = 20.0;       ///< a half-width up to this times the target is weak
-  /// Fit the gyro's time offset with its scale and bias (lidar_calibrate.cpp,
-  /// FitGyro); false fits scale and bias alone (for comparison).
-  bool gyro_time_offset = true;
+  GyroFitOptions gyro;
   /// Empty when valid, else a message naming the bad field.
   std::string Validate() const;
 };

@@ -8,10 +8,12 @@
 // range noise, 1/1024 m resolution, 1 % NaN dropouts, +inf beyond range).
 // Written with the independent writers: MCAP by @mcap/core, CDR by
 // @foxglove/rosmsg2-serialization, zstd chunks by @foxglove/wasm-zstd.
-//   node drive_gen.mjs [OUTDIR]     (default ../lidar; CI never runs this)
+//   node drive_gen.mjs [OUTDIR [FILE...]]   (default ../lidar, every file;
+//   FILE... writes only those, keeping the others' truth; CI never runs this)
 // The truth of each recording is in OUTDIR/README-truth.json. drive_odom.mcap
 // adds the controller's /odom (nav_msgs/Odometry) and a lidar whose ranges
-// read 1 % long, for --odometry and --distance-m.
+// read 1 % long, for --odometry and --distance-m. drive_still.mcap stands
+// still for 40 s: a drive that determines nothing (calibrate-lidar exits 3).
 import fs from "node:fs";
 import path from "node:path";
 import { McapWriter } from "@mcap/core";
@@ -186,10 +188,10 @@ function progressRates(m, dt) {
 
 // 1 ms states {phiL, phiR, x, y, th, w} of a drive of `seconds` (3 s still
 // first, 2 s still last).
-function simulate(robot, seconds, seed) {
+function simulate(robot, seconds, seed, still = false) {
   const R = rng(seed), dt = 0.001, n = Math.round(seconds / dt);
   const v = new Float64Array(n), w = new Float64Array(n);
-  let plan = [0, 0, 0], k = 3000;
+  let plan = [0, 0, 0], k = still ? n : 3000;
   while (k < n - 2000) {
     const m = pick(R, plan);
     for (const r of progressRates(m, dt)) {
@@ -250,7 +252,7 @@ function tfStatic(ns, child, [x, y, yaw], roll) {
 }
 
 function recording(cfg) {
-  const states = simulate(cfg.robot, cfg.seconds, cfg.seed);
+  const states = simulate(cfg.robot, cfg.seconds, cfg.seed, cfg.still);
   const R = rng(cfg.seed + 1);
   const msgs = [];
   const at = (ms) => BASE_NS + BigInt(ms) * 1000000n;
@@ -335,6 +337,10 @@ const VARIANTS = [
   // first seed from 2903 whose drive ends at least 1.5 m from its start.
   { file: "drive_odom.mcap", seed: 2903, seconds: 100, mount: [0.08, -0.03, 0.2], tfMount: [0.08, -0.03, 0.2],
     upsideDown: false, clockOffsetS: 0.01, tfTopic: "/tf_static", odom: true, rangeScale: 1.01, minEndDistance: 1.5 },
+  // Standing still for 40 s (long enough not to be refused as short): the
+  // drive determines none of the parameters.
+  { file: "drive_still.mcap", seed: 2904, seconds: 40, mount: [0.08, -0.03, 0.2], tfMount: [0.08, -0.03, 0.2],
+    upsideDown: false, clockOffsetS: 0.0, tfTopic: "/tf_static", still: true },
 ];
 
 await zstd.isLoaded;
@@ -342,8 +348,11 @@ const outDir = process.argv[2] ?? path.resolve(path.dirname(new URL(import.meta.
 fs.mkdirSync(outDir, { recursive: true });
 fs.writeFileSync(path.join(outDir, "robot.toml"),
   "# the parameters the odometry uses (nominal) for drive_*.mcap\nwheelbase_m = 0.28\nwheel_diameter_left_m = 0.066\nwheel_diameter_right_m = 0.066\n");
-const truth = {};
+const only = process.argv.slice(3);
+const truthFile = path.join(outDir, "README-truth.json");
+const truth = only.length > 0 && fs.existsSync(truthFile) ? JSON.parse(fs.readFileSync(truthFile, "utf8")) : {};
 for (const v of VARIANTS) {
+  if (only.length > 0 && !only.includes(v.file)) continue;
   while (v.minEndDistance) {  // the first seed whose drive ends far enough from its start
     const end = simulate(ROBOT, v.seconds, v.seed).at(-1);
     if (Math.hypot(end.x, end.y) >= v.minEndDistance) break;
@@ -363,4 +372,4 @@ for (const v of VARIANTS) {
   }
   process.stdout.write(`wrote ${v.file}: ${msgs.filter((m) => m.topic === "/scan").length} scans\n`);
 }
-fs.writeFileSync(path.join(outDir, "README-truth.json"), JSON.stringify(truth, null, 2) + "\n");
+fs.writeFileSync(truthFile, JSON.stringify(truth, null, 2) + "\n");
