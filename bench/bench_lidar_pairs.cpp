@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--fit") == 0) fit = true;
   }
   // [real, simulated] x [c_L, c_R, b]: normalised errors
-  std::vector<double> zn[2][3];
+  std::vector<double> zn[2][7];
   std::vector<double> slopes, pred_var, rots, rot_pred, hscales, hscale_pred, turn_t_pred;
   std::vector<Eigen::Vector2d> turn_t;
   double chi2_sum = 0.0, n_sum = 0.0, lat_sum = 0.0, th_sum = 0.0;
@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
       for (const auto& p : pr.pairs)
         if (p.undetermined.empty()) used.push_back(p);
       const auto start = calibration::LinearCalibration(wheels, used, c.nominal_wheelbase_m).params;
-      const double truth[3] = {c.c_left, c.c_right, c.wheelbase_m};
+      const double truth[7] = {c.c_left, c.c_right, c.wheelbase_m, c.mount.x, c.mount.y, c.mount.theta, c.time_offset_s};
       std::mt19937_64 rng(c.seed * 7919 + 1);
       std::normal_distribution<double> n01(0.0, 1.0);
       double s2 = 1.0;
@@ -130,8 +130,9 @@ int main(int argc, char** argv) {
         fo.registration_scale_sd = 0.0;  // the fit's own covariance, without the model-error term
         const auto f = calibration::FitLidarJoint(wheels, zs, start, fo);
         if (mode == 0) s2 = f.registration_scale * f.registration_scale;
-        const double est[3] = {f.params.c_left, f.params.c_right, f.params.wheelbase_m};
-        for (int q = 0; q < 3; ++q) zn[mode][q].push_back((est[q] - truth[q]) / f.Sd(q));
+        const double est[7] = {f.params.c_left, f.params.c_right, f.params.wheelbase_m, f.params.mount.x, f.params.mount.y,
+                               f.params.mount.theta, f.params.time_offset_s};
+        for (int q = 0; q < 7; ++q) zn[mode][q].push_back((est[q] - truth[q]) / f.Sd(q));
         if (mode == 0)
           std::printf("seed %3llu fit: c_left %+.4f %% (sd %.4f), c_right %+.4f %% (sd %.4f), wheelbase %+.4f %% (sd %.4f)\n",
                       static_cast<unsigned long long>(c.seed), 100 * (est[0] / truth[0] - 1), 100 * f.Sd(0) / truth[0],
@@ -217,9 +218,9 @@ int main(int argc, char** argv) {
               bags, one_way ? "one way" : "both ways", m, m / se, std::sqrt(v / (static_cast<double>(slopes.size()) - 1)),
               chi2_sum / n_sum, lat_sum / n_sum, th_sum / n_sum);
   if (fit) {
-    const char* names[3] = {"c_left", "c_right", "wheelbase"};
+    const char* names[7] = {"c_left", "c_right", "wheelbase", "mount x", "mount y", "mount yaw", "clock"};
     for (int mode = 0; mode < 2; ++mode)
-      for (int q = 0; q < 3; ++q) {
+      for (int q = 0; q < 7; ++q) {
         double mean = 0.0, ms = 0.0;
         int in = 0;
         for (double x : zn[mode][q]) {
