@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
       calibration::LidarCalibrationOptions options;
       options.pairs.symmetric = !one_way;
       options.pairs.deskew = !no_deskew;
-      options.gyro.time_offset = !no_gyro_offset;
+      options.gyro.fit_delay = !no_gyro_offset;
       const auto r = calibration::CalibrateLidar(in, options);
       fit_s += CpuSeconds() - t0;
       const std::size_t n = r.covariance_order.size();

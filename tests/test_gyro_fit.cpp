@@ -101,13 +101,17 @@ TEST_CASE("gyro Monte Carlo: scale, bias and time offset recovered, their 95 % i
   // normalised errors (chi-square, 120 degrees of freedom: sd of the RMS
   // 0.065) must lie in [0.75, 1.25] (about 4 sd either way), no single one
   // beyond 4.5, and the mean scale error within 4 sd of the mean (a bias).
+  // The simulation has no heading error common to a drive: the fit without
+  // the model-error term for it.
   const GyroTruth g;
+  GyroFitOptions no_term;
+  no_term.heading_scale_sd = 0.0;
   int inside = 0, total = 0;
   double z2 = 0.0, worst = 0.0, scale_err = 0.0, scale_var = 0.0;
   const int drives = 40;
   for (int k = 1; k <= drives; ++k) {
     const GyroDrive d = Simulate(static_cast<std::uint64_t>(k), 120.0, g);
-    const std::optional<GyroFit> f = FitGyroToScans(d.gyro, d.pairs, g.scan_offset_s);
+    const std::optional<GyroFit> f = FitGyroToScans(d.gyro, d.pairs, g.scan_offset_s, no_term);
     REQUIRE(f);
     REQUIRE(f->time_offset_s);
     const double z[3] = {(f->scale - g.scale) / f->scale_sd, (f->bias_rad_s - g.bias) / f->bias_sd,
@@ -138,7 +142,9 @@ TEST_CASE("gyro Monte Carlo: scale, bias and time offset recovered, their 95 % i
 TEST_CASE("gyro fit: the heading-scale model-error term widens the scale's interval only") {
   const GyroTruth g;
   const GyroDrive d = Simulate(7, 120.0, g);
-  const auto a = FitGyroToScans(d.gyro, d.pairs, g.scan_offset_s);
+  GyroFitOptions none;
+  none.heading_scale_sd = 0.0;
+  const auto a = FitGyroToScans(d.gyro, d.pairs, g.scan_offset_s, none);
   GyroFitOptions o;
   o.heading_scale_sd = 1e-4;
   const auto b = FitGyroToScans(d.gyro, d.pairs, g.scan_offset_s, o);

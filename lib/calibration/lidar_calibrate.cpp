@@ -385,7 +385,7 @@ double DistanceScale(const LidarCalibrationInput& in, const PairResult& pr, cons
 std::optional<GyroFit> FitGyroToScans(const std::vector<scan::GyroSample>& gyro, const std::vector<ScanPair>& pairs,
                                       double scan_time_offset_s, const GyroFitOptions& o) {
   if (const std::string err = o.Validate(); !err.empty()) throw InvalidOptions(err);
-  const bool fit_delay = o.time_offset;
+  const bool fit_delay = o.fit_delay;
   const std::int64_t offset = std::llround(scan_time_offset_s * 1e9);
   using Vec3 = Eigen::Vector3d;
   std::vector<Vec3> rows;

@@ -291,6 +291,8 @@ std::string LidarJointOptions::Validate() const {
     if (!(v > 0.0) || !std::isfinite(v)) return fmt::format("{} = {}: must be a finite number > 0", name, v);
   if (!(registration_scale_sd >= 0.0 && registration_scale_sd < 0.1))
     return fmt::format("registration_scale_sd = {}: must be in [0, 0.1)", registration_scale_sd);
+  if (!(registration_rotation_sd >= 0.0 && registration_rotation_sd < 0.1))
+    return fmt::format("registration_rotation_sd = {}: must be in [0, 0.1)", registration_rotation_sd);
   if (rounds < 1) return fmt::format("rounds = {}: must be >= 1", rounds);
   if (max_iterations < 1) return fmt::format("max_iterations = {}: must be >= 1", max_iterations);
   return {};
@@ -491,6 +493,8 @@ LidarJointFit FitLidarJoint(const std::vector<WheelTravelSample>& wheels, const 
   Vec7 lengths = Vec7::Zero();
   for (const int i : {kCLeft, kCRight, kWheelbase, kMountX, kMountY}) lengths(i) = p(i);
   cov += o.registration_scale_sd * o.registration_scale_sd * lengths * lengths.transpose();
+  // A common rotation r of the registrations' translations moves the yaw by -r alone.
+  cov(kMountYaw, kMountYaw) += o.registration_rotation_sd * o.registration_rotation_sd;
   for (int r = 0; r < kLidarParams; ++r)
     for (int c = 0; c < kLidarParams; ++c) fit.covariance[static_cast<std::size_t>(r * kLidarParams + c)] = cov(r, c);
   fit.measurements = costs.size();
