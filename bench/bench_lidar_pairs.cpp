@@ -6,16 +6,22 @@
 //     regressed on the distance travelled (m/m; a registration that reads
 //     translations long has a positive slope), with its t-value over the
 //     drives' spread;
+//   - likewise the rotation of the translations (lateral error per metre,
+//     which the fit's lidar yaw takes as its own), the scale of the heading
+//     changes (heading error per radian turned, the gyro scale's) and the
+//     translation error per radian turned (the mount position's), each with
+//     what the reported covariances predict for independent measurements
+//     (an overestimate: consecutive measurements share a scan);
 //   - the mean normalised squared error under the reported covariance (3 for
 //     a covariance that is right up to the fit's one scale factor s^2, which
 //     the joint fit estimates; its spread across measurements is what s^2
 //     cannot absorb).
-// For development seeds (1-40 and others below 20000): the fresh seeds from
-// 20001 are held out for bench_lidar_joint.
+// For development seeds (1-200, 50001 on): 20001-20200, 30001-30200 and
+// 40001-40200 were each run once as fresh sets by bench_lidar_joint.
 // --fit also fits each drive twice (lidar_joint.hpp, from Censi's linear
 // start): with the registrations as they are, and with each replaced by the
 // truth plus Gaussian noise of its own reported covariance (times the s^2
-// the first fit found); per wheel quantity the share of drives whose 95 %
+// the first fit found); per wheel, mount and clock quantity the share of drives whose 95 %
 // interval holds the truth and the mean and RMS normalised error: what the
 // registrations' errors beyond their covariance do to the wheels.
 //   bench_lidar_pairs BAGS MINUTES [FIRST_SEED] [--one-way] [--keep-shadow-edges] [--fit]
