@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "diagnosis/candidates.hpp"
 #include "diagnosis/mean_fit.hpp"
 
 namespace umbmark::diag {
@@ -58,15 +59,18 @@ BaselineFit FitGivenBaseline(const CampaignData& c, const MeanModel& model, cons
       given.source, given.params.wheelbase_m, given.params.wheel_diameter_left_m,
       given.params.wheel_diameter_right_m, b.p[kParamEd], b.p[kParamEb], 100.0 * b.p[kParamScale],
       given.noise_given ? fmt::format("given (k_L = {:.3g}, k_R = {:.3g} m^1/2)", given.k_L, given.k_R)
-                        : fmt::format("not given: fitted (k_L = {:.3g}, k_R = {:.3g} m^1/2; wheel_noise_error is not a "
-                                      "candidate)",
-                                      std::sqrt(b.noise.kL2), std::sqrt(b.noise.kR2))));
+                        : fmt::format("not given: fitted (k_L = {:.3g}, k_R = {:.3g} m^1/2; {} is not a candidate)",
+                                      std::sqrt(b.noise.kL2), std::sqrt(b.noise.kR2),
+                                      NoiseEffectName(effects::NoiseTerm::kWheelNoise))));
   return b;
 }
 
 std::vector<sim::EffectKind> GivenModelCandidates(const GivenModel& given) {
-  std::vector<sim::EffectKind> out = {sim::EffectKind::kWheelbaseError, sim::EffectKind::kDiameterRatioError};
-  if (given.noise_given) out.push_back(sim::EffectKind::kWheelNoiseError);
+  // The parameter errors in catalogue order; the wheel noise's only when it
+  // is given.
+  std::vector<sim::EffectKind> out;
+  for (sim::EffectKind k : sim::ParameterErrorEffects())
+    if (given.noise_given || NoiseTermOf(k) != effects::NoiseTerm::kWheelNoise) out.push_back(k);
   return out;
 }
 

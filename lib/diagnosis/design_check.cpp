@@ -21,19 +21,14 @@ std::string CampaignDesignProblem(const Manifest& manifest) {
       straight);
 }
 
-std::string TurnScrubDesignNote(const CampaignData& campaign, bool scrub_separable, double E_b) {
-  int turns = 0, arcs = 0;
+effects::DesignFacts DesignFactsOf(const CampaignData& campaign, double E_b) {
+  effects::DesignFacts f;
   for (const Piece& p : campaign.pieces) {
-    turns += p.type == PieceType::kTurn || p.type == PieceType::kReturn;
-    arcs += p.type == PieceType::kArc;
+    f.spot_turns += p.type == PieceType::kTurn || p.type == PieceType::kReturn;
+    f.arcs += p.type == PieceType::kArc;
   }
-  if (turns == 0 || arcs > 0 || scrub_separable) return {};
-  return fmt::format(
-      "turn_scrub is indistinguishable from the fitted wheelbase on this design: every rotation is a spot turn, where "
-      "a scrub k (heading x (1 - k)) is exactly a wheelbase of b E_b / (1 - k); the baseline's E_b = {:.5f} holds any "
-      "scrub, so spot turns are predicted right but arcs would not be. To tell a scrub from a wheelbase error, add a "
-      "free experiment that turns while driving (e.g. 4 figure-eight runs of about 1 m radius)",
-      E_b);
+  f.E_b = E_b;
+  return f;
 }
 
 }  // namespace umbmark::diag

@@ -19,6 +19,7 @@
 
 #include "core/runs.hpp"
 #include "diagnosis/pieces.hpp"
+#include "effects/effect.hpp"
 
 namespace umbmark::diag {
 
@@ -26,13 +27,10 @@ namespace umbmark::diag {
 /// what to add, for an error message.
 std::string CampaignDesignProblem(const Manifest& manifest);
 
-/// A note for the report when the campaign rotates only on the spot (turn
-/// pieces, no arc pieces) and turn_scrub is therefore not separately
-/// identifiable (`scrub_separable` false: the candidate is not, or only
-/// weakly, identifiable): that a turn scrub, if any, is inside the fitted
-/// wheelbase E_b (`E_b`) and which run to add. Empty otherwise. (Diagnose
-/// leaves it out when a weakly identifiable scrub is named on its own
-/// held-out evidence: the spot turns' small forward motion, E_d far from 1.)
-std::string TurnScrubDesignNote(const CampaignData& campaign, bool scrub_separable, double E_b);
+/// What the campaign's design shows for the effects' design notes
+/// (effects::Effect::DesignNote): its spot-turn and arc pieces and the
+/// baseline's E_b (`separable` is left true: the caller sets it per
+/// candidate).
+effects::DesignFacts DesignFactsOf(const CampaignData& campaign, double E_b);
 
 }  // namespace umbmark::diag

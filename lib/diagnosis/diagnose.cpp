@@ -26,6 +26,7 @@
 #include "diagnosis/stop_model.hpp"
 #include "diagnosis/verdict.hpp"
 #include "diagnosis/where.hpp"
+#include "effects/registry.hpp"
 #include "planning/advice.hpp"
 
 namespace umbmark::diag {
@@ -53,8 +54,8 @@ std::string DiagnoseOptions::Check() const {
     if (!given)
       return fmt::format("effect {} is a parameter error of a given model: a candidate only with --baseline CAL.json",
                          sim::EffectToString(k));
-    if (k == sim::EffectKind::kWheelNoiseError && !given->noise_given)
-      return "effect wheel_noise_error needs the given model's wheel noise (--kl, --kr)";
+    if (NoiseTermOf(k) == effects::NoiseTerm::kWheelNoise && !given->noise_given)
+      return fmt::format("effect {} needs the given model's wheel noise (--kl, --kr)", sim::EffectToString(k));
   }
   if (auto e = pieces.Check(); !e.empty()) return "pieces: " + e;
   if (auto e = run_faults.Check(); !e.empty()) return "run_faults: " + e;
@@ -306,12 +307,15 @@ void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit
     explained = std::move(ex);
     timer.Lap("stepwise explanation");
   }
-  const bool scrub_named = std::find(out.verdict_effects.begin(), out.verdict_effects.end(), "turn_scrub") !=
-                           out.verdict_effects.end();
-  for (const Candidate& cd : out.candidates)
-    if (cd.effect == sim::EffectKind::kTurnScrub && !scrub_named)
-      if (std::string n = TurnScrubDesignNote(c, cd.identifiable && !cd.weak, base.p[kParamEb]); !n.empty())
-        out.notes.push_back(std::move(n));
+  // What the design cannot tell apart, for each effect not named
+  // (Effect::DesignNote).
+  effects::DesignFacts design = DesignFactsOf(c, base.p[kParamEb]);
+  for (const Candidate& cd : out.candidates) {
+    const std::string name = sim::EffectToString(cd.effect);
+    if (std::find(out.verdict_effects.begin(), out.verdict_effects.end(), name) != out.verdict_effects.end()) continue;
+    design.separable = cd.identifiable && !cd.weak;
+    if (std::string n = effects::Of(cd.effect).DesignNote(design); !n.empty()) out.notes.push_back(std::move(n));
+  }
 }
 
 /// The ground-truth noise against the standstill scatter

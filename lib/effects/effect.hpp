@@ -116,6 +116,17 @@ struct AdviceContext {
   int runs = 0;            ///< runs in the campaign
 };
 
+/// What the campaign's design shows, for an effect's design note
+/// (Effect::DesignNote).
+struct DesignFacts {
+  int spot_turns = 0;  ///< pieces that rotate on the spot (spot turns, a square's return)
+  int arcs = 0;        ///< pieces that turn while driving
+  /// The effect's candidate fit is told from E_d, E_b (identifiable and not
+  /// weakly so).
+  bool separable = true;
+  double E_b = 1.0;  ///< the baseline's wheelbase factor
+};
+
 /// Everything an effect is that needs no code.
 struct Descriptor {
   std::string_view name;      ///< contract name (JSON key, --effect NAME)
@@ -223,6 +234,10 @@ class Effect {
   /// never per sample. Default: none.
   virtual void PredictWheels(const double* /*v*/, int /*run_index*/, double& /*left*/, double& /*right*/) const {}
 
+  /// A note for the report when the campaign's design cannot show the
+  /// effect apart from the baseline and it is not named: why, and which
+  /// experiment to add; empty otherwise. Default: none.
+  virtual std::string DesignNote(const DesignFacts& /*f*/) const { return {}; }
   /// A noise effect's contract parameters from the fitted noise (empty for
   /// the others).
   virtual Params FromNoise(const NoiseValues& /*n*/) const { return {}; }

@@ -21,6 +21,19 @@ class TurnScrub final : public Effect {
                 .parameters = {{"k", &Effects::scrub_k, "", 0.03}},
                 .mean_terms = {kTermScrub}}) {}
 
+  // Every rotation on the spot: a scrub is a wheelbase there. (Not when a
+  // weakly identifiable scrub is told apart on its own held-out evidence:
+  // the spot turns' small forward motion, E_d far from 1.)
+  std::string DesignNote(const DesignFacts& f) const override {
+    if (f.spot_turns == 0 || f.arcs > 0 || f.separable) return {};
+    return fmt::format(
+        "turn_scrub is indistinguishable from the fitted wheelbase on this design: every rotation is a spot turn, "
+        "where a scrub k (heading x (1 - k)) is exactly a wheelbase of b E_b / (1 - k); the baseline's E_b = {:.5f} "
+        "holds any scrub, so spot turns are predicted right but arcs would not be. To tell a scrub from a wheelbase "
+        "error, add a free experiment that turns while driving (e.g. 4 figure-eight runs of about 1 m radius)",
+        f.E_b);
+  }
+
   // Negative below -0.01, or below 0 by more than 2 standard errors.
   std::string Unphysical(const Params& p, int /*runs*/, const Params& se) const override {
     const double k = Get(p, "k");
