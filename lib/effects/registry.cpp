@@ -46,6 +46,13 @@ const Effect* Find(std::string_view name) {
   return nullptr;
 }
 
+const Effect* WithMeanTerm(int term) {
+  for (const Effect* e : All())
+    for (const int t : e->Describe().mean_terms)
+      if (t == term) return e;
+  return nullptr;
+}
+
 const Effect& Of(EffectKind kind) {
   for (const Effect* e : All())
     if (e->Describe().kind == kind) return *e;

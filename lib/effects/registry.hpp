@@ -21,6 +21,10 @@ const std::vector<const Effect*>& All();
 /// The effect named `name`, or nullptr.
 const Effect* Find(std::string_view name);
 
+/// The first effect (catalogue order) whose Descriptor::mean_terms holds
+/// `term` (effects::MeanTerm), or nullptr.
+const Effect* WithMeanTerm(int term);
+
 /// The built-in effect of kind `kind` (transitional, see values.hpp).
 const Effect& Of(EffectKind kind);
 /// The kind of an effect (nullopt only for one not registered yet).

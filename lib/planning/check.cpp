@@ -11,6 +11,7 @@
 
 #include "core/angles.hpp"
 #include "core/errors.hpp"
+#include "effects/registry.hpp"
 #include "error_models/path_covariance.hpp"
 #include "error_models/wheel_noise_fit.hpp"
 #include "error_models/wheel_noise_fit_data.hpp"
@@ -44,8 +45,13 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// Columns of the ground truth's footprint per run: the calibration
 /// parameters and the diagnosis effects (see check.hpp).
 enum Column { kEb, kEd, kEs, kDirectionAsymmetry, kCastorKick, kGtOffsetX, kGtOffsetY, kTimeOffset, kColumns };
-constexpr const char* kColumnName[kColumns] = {"E_b",         "E_d",       "scale",     "direction_asymmetry",
-                                               "castor_kick", "gt_offset", "gt_offset", "time_offset"};
+/// The calibration parameters' names (columns kEb, kEd, kEs).
+constexpr const char* kColumnName[3] = {"E_b", "E_d", "scale"};
+/// Each column's mean-model term (effects::MeanTerm): the effect that takes
+/// it names an effect column (ColumnName).
+constexpr int kColumnTerm[kColumns] = {effects::kTermEb,   effects::kTermEd,    effects::kTermScale,
+                                       effects::kTermAsym, effects::kTermKappa, effects::kTermDx,
+                                       effects::kTermDy,   effects::kTermTau};
 using Info = Eigen::Matrix<double, kColumns, kColumns>;
 
 /// One run as the check sees it.
@@ -388,7 +394,12 @@ void NoiseFor(const Gathered& g, const CheckOptions& o, CheckResult* r) {
       r->noise.k_L, r->noise.k_R, r->calibration_noise.k_L, r->calibration_noise.k_R));
 }
 
-std::string ColumnName(int c) { return c == kEs ? "scale_error" : kColumnName[c]; }
+/// A column's name: E_b, E_d, or the effect whose mean-model term it is.
+std::string ColumnName(int c) {
+  if (c == kEb || c == kEd) return kColumnName[c];
+  const effects::Effect* e = effects::WithMeanTerm(kColumnTerm[c]);
+  return e ? std::string(e->Name()) : std::string("?");
+}
 
 /// Effects (diagnosis) the footprint information cannot tell from the
 /// baseline parameters or from each other (see check.hpp).
