@@ -59,9 +59,14 @@ const char* GroundTruthNoiseSourceToString(GroundTruthNoiseSource g) {
   return g == GroundTruthNoiseSource::kStandstills ? "standstills" : "fitted";
 }
 
+const char* WheelNoiseSourceToString(WheelNoiseSource w) {
+  return w == WheelNoiseSource::kRepeats ? "repeats" : "fitted";
+}
+
 std::string BaselineFitOptions::Check() const {
   if (rounds < 1) return fmt::format("rounds = {} must be >= 1", rounds);
   if (std::string e = standstill.Check(); !e.empty()) return "standstill." + e;
+  if (std::string e = repeat.Check(); !e.empty()) return "repeat." + e;
   return {};
 }
 
@@ -98,6 +103,34 @@ void FitPiecesGroundTruth(const CampaignData& c, BaselineFit& b) {
   b.pieces_sigma_theta_rad = std::sqrt(n.sth2);
 }
 
+void FitPiecesWheelNoise(const CampaignData& c, BaselineFit& b) {
+  if (b.wheel_noise_source != "repeats") return;
+  PieceNoiseFitOptions o = b.noise_fit;
+  o.fit_wheel_noise = true;
+  const NoiseParams n = FitPieceNoise(b.eps, b.bases, c.pieces, {}, b.noise, o);
+  b.pieces_k_L = std::sqrt(n.kL2);
+  b.pieces_k_R = std::sqrt(n.kR2);
+}
+
+namespace {
+
+/// The wheel noise from the repeated runs' scatter at the start's residuals
+/// (the contrasts hold no mean: where E_d, E_b start does not matter), held
+/// fixed from here on when options.wheel is kRepeats and the design
+/// supports it.
+void StartWheelNoise(const CampaignData& c, const std::vector<double>& eps, const BaselineFitOptions& options,
+                     BaselineFit& b, NoiseParams& noise) {
+  b.repeat = MeasureRepeatNoise(c, eps, b.bases, noise, b.noise_fit, options.repeat);
+  b.wheel_noise_source = "fitted";
+  if (options.wheel != WheelNoiseSource::kRepeats || !b.repeat.measured) return;
+  b.wheel_noise_source = "repeats";
+  noise.kL2 = std::max(b.repeat.k_L * b.repeat.k_L, b.noise_fit.min_k2);
+  noise.kR2 = std::max(b.repeat.k_R * b.repeat.k_R, b.noise_fit.min_k2);
+  b.noise_fit.fit_wheel_noise = false;
+}
+
+}  // namespace
+
 BaselineFit FitBaseline(const CampaignData& c, const MeanModel& model, const BaselineStart& start,
                         const BaselineFitOptions& options) {
   BaselineFit b;
@@ -107,6 +140,7 @@ BaselineFit FitBaseline(const CampaignData& c, const MeanModel& model, const Bas
   std::vector<double> eps;
   model.Residuals(p, eps);
   b.bases = ComputeBases(c, model, p);
+  StartWheelNoise(c, eps, options, b, noise);
   noise = FitPieceNoise(eps, b.bases, c.pieces, {}, noise, b.noise_fit);
   MeanFit base;
   for (int round = 0; round < options.rounds; ++round) {
@@ -136,6 +170,7 @@ BaselineFit FitBaseline(const CampaignData& c, const MeanModel& model, const Bas
   // Jacobian at the final point for the null refits and cross-validation.
   b.D = model.Jacobian(p, BaselineParams(), b.eps);
   FitPiecesGroundTruth(c, b);
+  FitPiecesWheelNoise(c, b);
   return b;
 }
 

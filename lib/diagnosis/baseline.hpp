@@ -8,6 +8,11 @@
 // noise they take in part of any effect the baseline leaves out (a 30 mm
 // marker offset: 13.8 mm), and the gap test then finds less. Too few
 // standstill samples: fitted (BaselineFitOptions::GroundTruthNoiseSource).
+// The wheel noise k_L, k_R likewise, where the design supports it: from the
+// scatter of repeated runs about their own mean (repeat_noise.hpp), held
+// fixed; fitted jointly with the mean it takes in part of a mean effect the
+// baseline leaves out (a 42 mm marker offset on June circles: k_L 0.008 ->
+// 0.22). Otherwise fitted (BaselineFitOptions::WheelNoiseSource).
 #pragma once
 
 #include <string>
@@ -19,6 +24,7 @@
 #include "diagnosis/model.hpp"
 #include "diagnosis/piece_noise.hpp"
 #include "diagnosis/pieces.hpp"
+#include "diagnosis/repeat_noise.hpp"
 #include "diagnosis/standstill_noise.hpp"
 
 namespace umbmark::diag {
@@ -50,6 +56,18 @@ enum class GroundTruthNoiseSource {
 };
 const char* GroundTruthNoiseSourceToString(GroundTruthNoiseSource g);
 
+/// Where the wheel noise k_L, k_R comes from (a given model's, `--kl --kr`,
+/// is its own: baseline_given.hpp).
+enum class WheelNoiseSource {
+  /// The scatter of repeated runs about their own mean (repeat_noise.hpp),
+  /// held fixed; fitted as kFitted when the design does not support it.
+  kRepeats,
+  /// Fitted jointly with E_d, E_b on the pieces (before issue 28; for
+  /// comparison: an unmodelled mean effect can widen it).
+  kFitted,
+};
+const char* WheelNoiseSourceToString(WheelNoiseSource w);
+
 struct BaselineFitOptions {
   /// Alternations of mean fit and noise fit (>= 1). Default 2.
   int rounds = 2;
@@ -57,6 +75,9 @@ struct BaselineFitOptions {
   /// Default kStandstills.
   GroundTruthNoiseSource ground_truth = GroundTruthNoiseSource::kStandstills;
   StandstillNoiseOptions standstill;
+  /// Default kRepeats.
+  WheelNoiseSource wheel = WheelNoiseSource::kRepeats;
+  RepeatNoiseOptions repeat;
 
   std::string Check() const;
 };
@@ -83,6 +104,15 @@ struct BaselineFit {
   /// the baseline's mean [m], [rad] (0 when the source is "fitted" or the
   /// manifest: then noise.sxy2, sth2 are that fit or the stated values).
   double pieces_sigma_xy_m = 0.0, pieces_sigma_theta_rad = 0.0;
+  /// "repeats" or "fitted" (a given model: "given" or "fitted"): where
+  /// noise.kL2, kR2 come from.
+  std::string wheel_noise_source = "fitted";
+  /// The wheel noise from the scatter of repeated runs (measured for every
+  /// fitted baseline whose design supports it, whatever the source).
+  RepeatNoise repeat;
+  /// Source "repeats": k_L, k_R the pieces would fit jointly with the mean
+  /// [m^1/2] (0 otherwise).
+  double pieces_k_L = 0.0, pieces_k_R = 0.0;
   std::vector<PieceBases> bases;
   std::vector<double> eps;            ///< piece residuals at p
   std::vector<Eigen::Matrix3d> W;     ///< whiteners at `noise`
@@ -106,5 +136,9 @@ void StartGroundTruthNoise(const CampaignData& c, const BaselineFitOptions& opti
 /// With the source "standstills": the sigmas the pieces would fit with the
 /// wheel noise (b.pieces_sigma_*), for the warning when they disagree.
 void FitPiecesGroundTruth(const CampaignData& c, BaselineFit& b);
+
+/// With the wheel-noise source "repeats": the k_L, k_R the pieces would fit
+/// jointly with the mean (b.pieces_k_*), for the warning when they disagree.
+void FitPiecesWheelNoise(const CampaignData& c, BaselineFit& b);
 
 }  // namespace umbmark::diag

@@ -40,6 +40,7 @@ BaselineFit FitGivenBaseline(const CampaignData& c, const MeanModel& model, cons
   NoiseParams noise;
   StartGroundTruthNoise(c, options, b, noise);
   b.noise_fit.fit_wheel_noise = !given.noise_given;
+  b.wheel_noise_source = given.noise_given ? "given" : "fitted";
   if (given.noise_given) {
     // A wheel given as noise-free keeps a tiny variance: the covariances
     // must stay invertible.

@@ -100,6 +100,10 @@ BaselineSummary Summarise(const CampaignData& c, const BaselineStart& start, con
   bs.standstill = b.standstill;
   bs.pieces_sigma_xy_m = b.pieces_sigma_xy_m;
   bs.pieces_sigma_theta_rad = b.pieces_sigma_theta_rad;
+  bs.wheel_noise_source = b.wheel_noise_source;
+  bs.repeat = b.repeat;
+  bs.pieces_k_L = b.pieces_k_L;
+  bs.pieces_k_R = b.pieces_k_R;
   bs.start = start.description;
   bs.pieces = static_cast<int>(c.pieces.size());
   bs.runs = static_cast<int>(c.runs.size());
@@ -349,6 +353,27 @@ std::string StandstillDisagreement(const BaselineSummary& b) {
       s.differences, StandstillNoiseOptions{}.settle_s, advice);
 }
 
+/// The wheel noise fitted jointly with the mean on the pieces against the
+/// repeated runs' scatter (repeat_noise.hpp): a warning when a k differs by
+/// more than 1.5 x (either way) and by more than two of the repeated runs'
+/// standard errors.
+std::string RepeatDisagreement(const BaselineSummary& b) {
+  if (b.wheel_noise_source != "repeats") return {};
+  const RepeatNoise& r = b.repeat;
+  auto off = [](double a, double ref, double sd) {
+    return std::abs(a - ref) > 2.0 * sd && (a > 1.5 * ref || a < ref / 1.5);
+  };
+  if (!off(b.pieces_k_L, r.k_L, r.sd_k_L) && !off(b.pieces_k_R, r.k_R, r.sd_k_R)) return {};
+  return fmt::format(
+      "fitted jointly with E_d, E_b on the pieces, the wheel noise would be k_L = {:.3g}, k_R = {:.3g} m^1/2: {:.2g} x "
+      "/ {:.2g} x the scatter of repeated runs about their own mean (k_L = {:.3g} +- {:.2g}, k_R = {:.3g} +- {:.2g}): "
+      "the pieces hold something the same in every run that the baseline leaves out (a mean effect the joint fit "
+      "would take as wheel noise) or noise that differs between experiments; the baseline keeps the repeated runs' "
+      "k, so the gap test sees it",
+      b.pieces_k_L, b.pieces_k_R, b.pieces_k_L / std::max(r.k_L, 1e-12), b.pieces_k_R / std::max(r.k_R, 1e-12), r.k_L,
+      r.sd_k_L, r.k_R, r.sd_k_R);
+}
+
 /// What the standstill scatter's estimate rests on, when it is more than a
 /// plain sample-to-sample sd: correlation over samples, a drift, a floor.
 std::string StandstillNote(const BaselineSummary& b) {
@@ -522,6 +547,7 @@ DiagnoseSummary DiagnoseCampaign(const CampaignData& recorded, const DiagnoseOpt
   out.baseline.given = options.given;
   if (std::string w = StandstillDisagreement(out.baseline); !w.empty()) out.warnings.push_back(std::move(w));
   if (std::string n = StandstillNote(out.baseline); !n.empty()) out.notes.push_back(std::move(n));
+  if (std::string w = RepeatDisagreement(out.baseline); !w.empty()) out.warnings.push_back(std::move(w));
   timer.Lap("baseline predictions");
 
   // 2. Where, and the gap's null distribution.

@@ -150,6 +150,15 @@ struct BaselineSummary {
   /// Source "standstills": the sigmas the pieces would fit with the wheel
   /// noise (a warning when far from the scatter) [m], [rad]; else 0.
   double pieces_sigma_xy_m = 0.0, pieces_sigma_theta_rad = 0.0;
+  /// Where k_L, k_R come from: "repeats" (the scatter of repeated runs
+  /// below), "fitted" (jointly with E_d, E_b on the pieces) or "given".
+  std::string wheel_noise_source;
+  /// The wheel noise from the scatter of repeated runs about their own mean
+  /// (repeat_noise.hpp), or why the design does not support it.
+  RepeatNoise repeat;
+  /// Source "repeats": k_L, k_R the pieces would fit jointly with the mean
+  /// (a warning when far from the repeated runs') [m^1/2]; else 0.
+  double pieces_k_L = 0.0, pieces_k_R = 0.0;
   std::string start;  ///< where E_d, E_b started (refine or nominal)
   std::vector<ReturnPrediction> returns;
   std::vector<GrowthRow> growth;

@@ -484,7 +484,7 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
   // There the mean parts are weighted with the wheel noise refitted to the
   // baseline's residuals, and the candidates' mean fits (weighted the
   // given way) are not reused.
-  const bool given_noise = !b.noise_fit.fit_wheel_noise;
+  const bool given_noise = b.given && !b.noise_fit.fit_wheel_noise;  // not the repeated runs' k (measured)
   const BaselineFit weighted = given_noise ? RefittedWeights(c, b) : BaselineFit{};
   const std::map<std::vector<int>, MeanFit> not_known;
   MeanPartCache means(c, model, given_noise ? weighted : b, options.threads, given_noise ? not_known : known, candidates);

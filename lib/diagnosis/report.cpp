@@ -205,6 +205,21 @@ nlohmann::json BaselineJson(const BaselineSummary& b) {
                ? nlohmann::json{{"sigma_xy_m", Num(b.pieces_sigma_xy_m)},
                                 {"sigma_theta_rad", Num(b.pieces_sigma_theta_rad)}}
                : nlohmann::json(nullptr)},
+          {"wheel_noise_source", b.wheel_noise_source},
+          {"repeat_scatter",
+           b.repeat.measured ? nlohmann::json{{"k_L", Num(b.repeat.k_L)},
+                                              {"k_R", Num(b.repeat.k_R)},
+                                              {"sd_k_L", Num(b.repeat.sd_k_L)},
+                                              {"sd_k_R", Num(b.repeat.sd_k_R)},
+                                              {"correlation", Num(b.repeat.correlation)},
+                                              {"contrasts", b.repeat.contrasts},
+                                              {"positions", b.repeat.positions},
+                                              {"runs", b.repeat.runs},
+                                              {"groups", b.repeat.groups}}
+                             : nlohmann::json{{"not_measured", b.repeat.reason}}},
+          {"wheel_noise_fitted_to_pieces",
+           b.wheel_noise_source == "repeats" ? nlohmann::json{{"k_L", Num(b.pieces_k_L)}, {"k_R", Num(b.pieces_k_R)}}
+                                             : nlohmann::json(nullptr)},
           {"start", b.start},
           {"return_error_noise_fit",
            b.return_fit ? nlohmann::json{{"k_L", Num(b.return_k_L)},
@@ -257,6 +272,13 @@ void BaselineSection(TextReport& o, const DiagnoseSummary& s) {
     o.line(fmt::format("  fitted to the pieces with the wheel noise instead: sigma_xy = {:.3g} mm, sigma_theta = {:.3g} "
                        "mrad (not used)",
                        1e3 * b.pieces_sigma_xy_m, 1e3 * b.pieces_sigma_theta_rad));
+  if (!b.wheel_noise_source.empty() && b.wheel_noise_source != "given")
+    o.line("  wheel noise: " + std::string(b.wheel_noise_source == "repeats" ? "held at " : "fitted with E_d, E_b; ") +
+           RepeatNoiseSummary(b.repeat) +
+           (b.wheel_noise_source == "repeats"
+                ? fmt::format("; fitted jointly with E_d, E_b instead: k_L = {:.3g}, k_R = {:.3g} m^1/2 (not used)",
+                              b.pieces_k_L, b.pieces_k_R)
+                : std::string()));
   for (const auto& w : s.warnings) o.line("  WARNING: " + w);
   o.line(fmt::format("  {} runs, {} pieces", b.runs, b.pieces));
   if (b.return_fit)

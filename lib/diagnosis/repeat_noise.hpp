@@ -1,0 +1,115 @@
+// The wheel noise k_L, k_R measured where a mean effect cannot reach it:
+// the scatter of repeated runs about their own mean.
+//
+// Runs of one experiment and direction repeat the same commanded path, so
+// they break into the same sequence of pieces (pieces.hpp): piece m of each
+// run is the same stretch of the path. A deterministic effect the baseline
+// leaves out (a marker offset, a scale error, a clock offset, a scrub, a
+// wrong E_d or E_b) moves piece m's residual by the same amount mu_m in each
+// run: eps_{i,m} = mu_m + e_{i,m}, with e_{i,m} ~ N(0, C_{i,m}) independent
+// from run to run (Chong & Kleeman's covariance propagation, C of
+// piece_noise.hpp: k_L^2 A_L + k_R^2 A_R + the ground truth's noise + the
+// encoders' quantisation). For n such runs, a contrast z = sum_i h_i
+// eps_{i,m} with sum_i h_i = 0 has no mu_m at all, whatever its size:
+//   E z = 0,   Cov z = sum_i h_i^2 C_{i,m}.
+// The n - 1 Helmert contrasts (h_k = (1, ..., 1, -k, 0, ...) / sqrt(k (k+1)),
+// k ones) are orthonormal; with equal C_{i,m} they are independent N(0, C),
+// so the within-group scatter carries n - 1 of the n runs' information on
+// k_L, k_R. The same Fisher scoring as on the pieces (piece_noise.hpp)
+// fits k_L^2, k_R^2 to the contrasts, the ground truth's noise held at the
+// baseline's (the standstill scatter or the manifest's). With unequal
+// C_{i,m} the contrasts are slightly correlated; ignoring that keeps the
+// score unbiased (a composite likelihood) and costs a little efficiency.
+// The standard errors come from the Fisher information of the contrasts.
+//
+// Option `detrend`: contrasts orthogonal also to the run's place in the
+// campaign (a linear parameter_drift, the same in every group, is then
+// gone too), at one more contrast per piece.
+//
+// What the within-group scatter does NOT hold out: effects that differ
+// from run to run (run_time_offset's per-run clocks, bump_outliers,
+// correlated_noise, standstill_motion, motion_noise_floor): they are noise,
+// and widen the repeat scatter as they widen the pieces' fit.
+//
+// The design supports it when the campaign has at least min_contrasts
+// contrast pieces and the contrasts separate k_L from k_R (the correlation
+// of the two estimates within max_correlation); otherwise `measured` is
+// false and `reason` says why (the baseline then fits k_L, k_R jointly
+// with the mean on the pieces, baseline.hpp).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "diagnosis/model.hpp"
+#include "diagnosis/piece_noise.hpp"
+#include "diagnosis/pieces.hpp"
+
+namespace umbmark::diag {
+
+struct RepeatNoiseOptions {
+  /// Fewest runs of one experiment and direction for its pieces to count
+  /// (>= 2). Default 3.
+  int min_runs = 3;
+  /// Fewest contrast pieces (over all groups) for a measurement (>= 1).
+  /// Default 20.
+  int min_contrasts = 20;
+  /// Piece m of the runs of a group is one stretch of the path when every
+  /// run's piece m has the same type and sign and its travel lies within
+  /// this fraction (or within travel_slack_m) of the group's median; a
+  /// position where one run differs leaves that position out (> 0).
+  /// Default 0.15.
+  double travel_tolerance = 0.15;
+  /// Absolute slack of the travel match [m] (>= 0). Default 0.05.
+  double travel_slack_m = 0.05;
+  /// Contrasts orthogonal to the run's place in the campaign too (a linear
+  /// parameter_drift drops out); needs one run more per group. Default false.
+  bool detrend = false;
+  /// Largest |correlation| of the k_L^2 and k_R^2 estimates for the design
+  /// to separate the wheels (in (0, 1)). Default 0.95.
+  double max_correlation = 0.95;
+
+  std::string Check() const;
+};
+
+struct RepeatNoise {
+  bool measured = false;
+  std::string reason;       ///< why not measured (empty when measured)
+  double k_L = 0.0, k_R = 0.0;        ///< [m^1/2]
+  /// Standard errors from the contrasts' Fisher information: of k^2 [m], and
+  /// of k by the delta method sd(k^2) / (2 k) [m^1/2] (large when k ~ 0).
+  double sd_kL2 = 0.0, sd_kR2 = 0.0, sd_k_L = 0.0, sd_k_R = 0.0;
+  double correlation = 0.0;  ///< of the k_L^2 and k_R^2 estimates
+  int groups = 0;            ///< experiment-direction groups used
+  int runs = 0;              ///< runs in those groups
+  int positions = 0;         ///< piece positions matched across a group's runs
+  int contrasts = 0;         ///< contrast pieces fitted
+};
+
+/// The contrasts themselves, for a fit or a test: eps (3 per contrast),
+/// their covariance bases sum_i h_i^2 B_i, pseudo-pieces (components).
+struct RepeatContrasts {
+  std::vector<double> eps;
+  std::vector<PieceBases> bases;
+  std::vector<Piece> pieces;
+  int groups = 0, runs = 0, positions = 0;
+};
+
+/// Groups the runs by experiment and direction, matches their pieces by
+/// position and forms the contrasts of residuals `eps` (3 per piece of c).
+RepeatContrasts FormRepeatContrasts(const CampaignData& c, const std::vector<double>& eps,
+                                    const std::vector<PieceBases>& bases, const RepeatNoiseOptions& options);
+
+/// k_L, k_R from the contrasts of `eps` at bases `bases`; `start` carries the
+/// ground truth's noise (held fixed unless fit.fit_ground_truth) and the
+/// start of k; `fit` the noise fit's floors (wheel noise always fitted,
+/// correlated, motion floor, standstill and run-time terms never).
+RepeatNoise MeasureRepeatNoise(const CampaignData& c, const std::vector<double>& eps,
+                               const std::vector<PieceBases>& bases, const NoiseParams& start,
+                               const PieceNoiseFitOptions& fit, const RepeatNoiseOptions& options = {});
+
+/// One line: "k_L = ... +- ..., k_R = ... +- ... m^1/2 from N contrasts of
+/// R runs in G groups" or why it was not measured.
+std::string RepeatNoiseSummary(const RepeatNoise& r);
+
+}  // namespace umbmark::diag
