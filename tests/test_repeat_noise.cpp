@@ -99,6 +99,31 @@ TEST_CASE("repeat noise: a mean the same in every run drops out of the contrasts
   o.detrend = true;
   const RepeatContrasts rd = FormRepeatContrasts(c, eps, bases, o);
   CHECK(rd.pieces.size() + static_cast<std::size_t>(rd.positions) == rc.pieces.size());
+
+  // A real run has a creep the others lack: a piece inserted into run 0
+  // (a 1 mm forward creep, a residual of 5 cm) is skipped by the alignment,
+  // every other stretch still matched in all runs, and the contrasts stay
+  // free of the mean.
+  CampaignData c2 = c;
+  std::vector<PieceBases> bases2 = bases;
+  std::vector<double> eps2 = eps;
+  std::size_t at = 0;
+  while (c2.pieces[at].run != 0) ++at;
+  at += 3;
+  Piece creep = c2.pieces[at];
+  creep.type = PieceType::kStraight;
+  creep.sign = 1;
+  creep.travel_m = 0.001;
+  c2.pieces.insert(c2.pieces.begin() + static_cast<std::ptrdiff_t>(at), creep);
+  bases2.insert(bases2.begin() + static_cast<std::ptrdiff_t>(at), bases[at]);
+  eps2.insert(eps2.begin() + static_cast<std::ptrdiff_t>(3 * at), {0.05, 0.05, 0.05});
+  o.detrend = false;
+  const RepeatContrasts ra = FormRepeatContrasts(c2, eps2, bases2, o);
+  CHECK(ra.positions == rc.positions);
+  CHECK(ra.pieces.size() == rc.pieces.size());
+  largest = 0.0;
+  for (double e : ra.eps) largest = std::max(largest, std::abs(e));
+  CHECK(largest < 1e-15);
 }
 
 TEST_CASE("repeat noise: k_L, k_R come back on simulated campaigns, within the stated sd", "[repeat_noise]") {

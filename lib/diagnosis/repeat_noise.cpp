@@ -49,12 +49,6 @@ Eigen::MatrixXd Contrasts(const Eigen::MatrixXd& X) {
   return Q.rightCols(n - p).transpose();
 }
 
-/// Whether piece b is the same stretch of the path as reference a.
-bool SameStretch(const Piece& a, const Piece& b, double median_travel, const RepeatNoiseOptions& o) {
-  if (a.type != b.type || a.sign != b.sign) return false;
-  return std::abs(b.travel_m - median_travel) <= std::max(o.travel_tolerance * median_travel, o.travel_slack_m);
-}
-
 /// Runs of each experiment and direction (campaign order), each with its
 /// pieces in order.
 std::map<std::pair<int, std::string>, std::vector<std::vector<int>>> GroupRuns(const CampaignData& c) {
@@ -73,52 +67,73 @@ std::map<std::pair<int, std::string>, std::vector<std::vector<int>>> GroupRuns(c
   return groups;
 }
 
-/// The runs of a group with its most common piece count (a run with a
-/// piece more or less, a glitch or a stop of its own, is left out).
-std::vector<std::vector<int>> ModalRuns(std::vector<std::vector<int>> runs) {
-  std::map<std::size_t, int> count;
-  for (const auto& r : runs) ++count[r.size()];
-  std::size_t best = 0;
-  int most = 0;
-  for (const auto& [size, n] : count)
-    if (n > most) best = size, most = n;
-  std::erase_if(runs, [&](const std::vector<int>& r) { return r.size() != best; });
-  return runs;
+/// Piece b of another run matched to piece a of the reference run: the
+/// same type and sign, and travel within the tolerance.
+bool Matches(const Piece& a, const Piece& b, const RepeatNoiseOptions& o) {
+  if (a.type != b.type || a.sign != b.sign) return false;
+  return std::abs(b.travel_m - a.travel_m) <=
+         std::max(o.travel_tolerance * std::max(a.travel_m, b.travel_m), o.travel_slack_m);
 }
 
-/// The contrasts of one position m of a group's runs `runs` (indices of
-/// their pieces), appended to out; false when the runs' pieces differ.
-bool AddPosition(const CampaignData& c, const std::vector<double>& eps, const std::vector<PieceBases>& bases,
-                 const std::vector<std::vector<int>>& runs, std::size_t m, const Eigen::MatrixXd& H,
-                 const RepeatNoiseOptions& o, RepeatContrasts& out) {
-  std::vector<double> travel;
-  for (const auto& r : runs) travel.push_back(c.pieces[static_cast<std::size_t>(r[m])].travel_m);
-  std::nth_element(travel.begin(), travel.begin() + static_cast<std::ptrdiff_t>(travel.size() / 2), travel.end());
-  const double median = travel[travel.size() / 2];
-  const Piece& ref = c.pieces[static_cast<std::size_t>(runs.front()[m])];
-  int components = 3;
-  for (const auto& r : runs) {
-    const Piece& p = c.pieces[static_cast<std::size_t>(r[m])];
-    if (!SameStretch(ref, p, median, o)) return false;
-    components = std::min(components, p.components);
+/// For each piece of the reference run `ref`, the matched piece of `run`
+/// (-1: none), by the longest common subsequence under Matches: a real run
+/// has a creep or a split the others lack, so pieces are aligned, not
+/// counted.
+std::vector<int> Align(const CampaignData& c, const std::vector<int>& ref, const std::vector<int>& run,
+                       const RepeatNoiseOptions& o) {
+  const std::size_t n = ref.size(), m = run.size();
+  std::vector<int> L((n + 1) * (m + 1), 0);
+  auto at = [&](std::size_t i, std::size_t j) -> int& { return L[i * (m + 1) + j]; };
+  auto match = [&](std::size_t i, std::size_t j) {
+    return Matches(c.pieces[static_cast<std::size_t>(ref[i])], c.pieces[static_cast<std::size_t>(run[j])], o);
+  };
+  for (std::size_t i = n; i-- > 0;)
+    for (std::size_t j = m; j-- > 0;)
+      at(i, j) = match(i, j) ? at(i + 1, j + 1) + 1 : std::max(at(i + 1, j), at(i, j + 1));
+  std::vector<int> out(n, -1);
+  for (std::size_t i = 0, j = 0; i < n && j < m;) {
+    if (match(i, j) && at(i, j) == at(i + 1, j + 1) + 1) {
+      out[i] = run[j];
+      ++i, ++j;
+    } else if (at(i + 1, j) >= at(i, j + 1)) {
+      ++i;
+    } else {
+      ++j;
+    }
   }
+  return out;
+}
+
+/// The contrasts of one stretch of the path: `pieces` (one per run, in
+/// campaign order) with their runs' places in the campaign `place`.
+void AddPosition(const CampaignData& c, const std::vector<double>& eps, const std::vector<PieceBases>& bases,
+                 const std::vector<int>& pieces, const std::vector<double>& place, const RepeatNoiseOptions& o,
+                 RepeatContrasts& out) {
+  const Eigen::Index n = static_cast<Eigen::Index>(pieces.size());
+  Eigen::MatrixXd X(n, o.detrend ? 2 : 1);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    X(i, 0) = 1.0;
+    if (o.detrend) X(i, 1) = place[static_cast<std::size_t>(i)];
+  }
+  const Eigen::MatrixXd H = Contrasts(X);
+  int components = 3;
+  for (int j : pieces) components = std::min(components, c.pieces[static_cast<std::size_t>(j)].components);
   for (Eigen::Index k = 0; k < H.rows(); ++k) {
     Eigen::Vector3d z = Eigen::Vector3d::Zero();
     PieceBases B;
-    for (std::size_t i = 0; i < runs.size(); ++i) {
-      const std::size_t j = static_cast<std::size_t>(runs[i][m]);
-      const double h = H(k, static_cast<Eigen::Index>(i));
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const std::size_t j = static_cast<std::size_t>(pieces[static_cast<std::size_t>(i)]);
+      const double h = H(k, i);
       z += h * Eigen::Vector3d(eps[3 * j], eps[3 * j + 1], eps[3 * j + 2]);
       AddBases(B, bases[j], h * h);
     }
     if (components < 3) z[2] = 0.0;
     out.eps.insert(out.eps.end(), {z[0], z[1], z[2]});
     out.bases.push_back(B);
-    Piece p = ref;
+    Piece p = c.pieces[static_cast<std::size_t>(pieces.front())];
     p.components = components;
     out.pieces.push_back(p);
   }
-  return true;
 }
 
 /// Fisher information of (k_L^2, k_R^2) on the contrasts at n.
@@ -143,21 +158,32 @@ Eigen::Matrix2d WheelInformation(const RepeatContrasts& rc, const NoiseParams& n
 RepeatContrasts FormRepeatContrasts(const CampaignData& c, const std::vector<double>& eps,
                                     const std::vector<PieceBases>& bases, const RepeatNoiseOptions& options) {
   RepeatContrasts out;
-  for (auto& [key, all] : GroupRuns(c)) {
-    const std::vector<std::vector<int>> runs = ModalRuns(std::move(all));
-    const int n = static_cast<int>(runs.size());
-    if (n < options.min_runs || n < (options.detrend ? 3 : 2)) continue;
-    Eigen::MatrixXd X(n, options.detrend ? 2 : 1);
-    for (int i = 0; i < n; ++i) {
-      X(i, 0) = 1.0;
-      if (options.detrend) X(i, 1) = c.runs[static_cast<std::size_t>(c.pieces[static_cast<std::size_t>(runs[static_cast<std::size_t>(i)].front())].run)].campaign_index;
-    }
-    const Eigen::MatrixXd H = Contrasts(X);
+  const std::size_t fewest = options.detrend ? 3 : 2;  // runs at a position: more than the contrasts' constraints
+  for (const auto& [key, runs] : GroupRuns(c)) {
+    if (static_cast<int>(runs.size()) < options.min_runs) continue;
+    // Reference: the run with the median piece count (a typical run).
+    std::vector<std::size_t> by_count(runs.size());
+    for (std::size_t i = 0; i < runs.size(); ++i) by_count[i] = i;
+    std::sort(by_count.begin(), by_count.end(), [&](std::size_t a, std::size_t b) { return runs[a].size() < runs[b].size(); });
+    const std::vector<int>& ref = runs[by_count[runs.size() / 2]];
+    std::vector<std::vector<int>> aligned;
+    for (const auto& r : runs) aligned.push_back(&r == &ref ? r : Align(c, ref, r, options));
     int used = 0;
-    for (std::size_t m = 0; m < runs.front().size(); ++m) used += AddPosition(c, eps, bases, runs, m, H, options, out) ? 1 : 0;
+    for (std::size_t m = 0; m < ref.size(); ++m) {
+      std::vector<int> pieces;
+      std::vector<double> place;
+      for (const auto& a : aligned)
+        if (a[m] >= 0) {
+          pieces.push_back(a[m]);
+          place.push_back(c.runs[static_cast<std::size_t>(c.pieces[static_cast<std::size_t>(a[m])].run)].campaign_index);
+        }
+      if (pieces.size() < fewest) continue;
+      AddPosition(c, eps, bases, pieces, place, options, out);
+      ++used;
+    }
     if (used == 0) continue;
     ++out.groups;
-    out.runs += n;
+    out.runs += static_cast<int>(runs.size());
     out.positions += used;
   }
   return out;

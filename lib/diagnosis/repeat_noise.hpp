@@ -2,8 +2,10 @@
 // the scatter of repeated runs about their own mean.
 //
 // Runs of one experiment and direction repeat the same commanded path, so
-// they break into the same sequence of pieces (pieces.hpp): piece m of each
-// run is the same stretch of the path. A deterministic effect the baseline
+// they break into the same sequence of pieces (pieces.hpp), up to a creep
+// or a split a real run has and the others lack: aligned to the group's
+// typical run (longest common subsequence of pieces of the same type, sign
+// and travel), piece m of each run is the same stretch of the path. A deterministic effect the baseline
 // leaves out (a marker offset, a scale error, a clock offset, a scrub, a
 // wrong E_d or E_b) moves piece m's residual by the same amount mu_m in each
 // run: eps_{i,m} = mu_m + e_{i,m}, with e_{i,m} ~ N(0, C_{i,m}) independent
@@ -12,9 +14,11 @@
 // encoders' quantisation). For n such runs, a contrast z = sum_i h_i
 // eps_{i,m} with sum_i h_i = 0 has no mu_m at all, whatever its size:
 //   E z = 0,   Cov z = sum_i h_i^2 C_{i,m}.
-// The n - 1 Helmert contrasts (h_k = (1, ..., 1, -k, 0, ...) / sqrt(k (k+1)),
-// k ones) are orthonormal; with equal C_{i,m} they are independent N(0, C),
-// so the within-group scatter carries n - 1 of the n runs' information on
+// Any n - 1 orthonormal rows h orthogonal to (1, ..., 1) will do (the
+// Helmert contrasts, h_k = (1, ..., 1, -k, 0, ...) / sqrt(k (k+1)), are one
+// choice; the code takes the complement of a QR factorisation); with equal
+// C_{i,m} they are independent N(0, C), so the within-group scatter carries
+// n - 1 of the n runs' information on
 // k_L, k_R. The same Fisher scoring as on the pieces (piece_noise.hpp)
 // fits k_L^2, k_R^2 to the contrasts, the ground truth's noise held at the
 // baseline's (the standstill scatter or the manifest's). With unequal
@@ -54,11 +58,13 @@ struct RepeatNoiseOptions {
   /// Fewest contrast pieces (over all groups) for a measurement (>= 1).
   /// Default 20.
   int min_contrasts = 20;
-  /// Piece m of the runs of a group is one stretch of the path when every
-  /// run's piece m has the same type and sign and its travel lies within
-  /// this fraction (or within travel_slack_m) of the group's median; a
-  /// position where one run differs leaves that position out (> 0).
-  /// Default 0.15.
+  /// Pieces of the runs of a group are one stretch of the path when they
+  /// have the same type and sign and their travel agrees within this
+  /// fraction (or within travel_slack_m); each run is aligned to the
+  /// group's typical run (median piece count) by the longest common
+  /// subsequence of such matches, so a creep or a split one run has and the
+  /// others lack is skipped, and a stretch counts where at least two runs
+  /// (three with detrend) have it (> 0). Default 0.15.
   double travel_tolerance = 0.15;
   /// Absolute slack of the travel match [m] (>= 0). Default 0.05.
   double travel_slack_m = 0.05;
@@ -82,7 +88,7 @@ struct RepeatNoise {
   double correlation = 0.0;  ///< of the k_L^2 and k_R^2 estimates
   int groups = 0;            ///< experiment-direction groups used
   int runs = 0;              ///< runs in those groups
-  int positions = 0;         ///< piece positions matched across a group's runs
+  int positions = 0;         ///< stretches matched in at least two runs of a group
   int contrasts = 0;         ///< contrast pieces fitted
 };
 
