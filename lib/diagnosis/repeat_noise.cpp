@@ -16,6 +16,7 @@ std::string RepeatNoiseOptions::Check() const {
   if (min_contrasts < 1) return fmt::format("min_contrasts = {} must be >= 1", min_contrasts);
   if (!(travel_tolerance > 0.0)) return fmt::format("travel_tolerance = {} must be > 0", travel_tolerance);
   if (!(travel_slack_m >= 0.0)) return fmt::format("travel_slack_m = {} must be >= 0", travel_slack_m);
+  if (!(turn_tolerance_rad > 0.0)) return fmt::format("turn_tolerance_rad = {} must be > 0", turn_tolerance_rad);
   if (!(max_correlation > 0.0 && max_correlation < 1.0))
     return fmt::format("max_correlation = {} must be in (0, 1)", max_correlation);
   return {};
@@ -69,23 +70,32 @@ std::map<std::pair<int, std::string>, std::vector<std::vector<int>>> GroupRuns(c
 
 /// Piece b of another run matched to piece a of the reference run: the
 /// same type and sign, and travel within the tolerance.
-bool Matches(const Piece& a, const Piece& b, const RepeatNoiseOptions& o) {
+bool Matches(const Piece& a, const Piece& b, const PieceBases& A, const PieceBases& B, double wheelbase_m,
+             const RepeatNoiseOptions& o) {
   if (a.type != b.type || a.sign != b.sign) return false;
-  return std::abs(b.travel_m - a.travel_m) <=
-         std::max(o.travel_tolerance * std::max(a.travel_m, b.travel_m), o.travel_slack_m);
+  if (std::abs(b.travel_m - a.travel_m) > std::max(o.travel_tolerance * std::max(a.travel_m, b.travel_m), o.travel_slack_m))
+    return false;
+  // Heading change: the same turn or circle, not its mirror or another
+  // radius (a spot turn's from both wheels' travel and its sign).
+  auto turn = [&](const Piece& p, const PieceBases& q) {
+    return p.type == PieceType::kTurn ? p.sign * (q.travel_left_m + q.travel_right_m) / wheelbase_m
+                                      : (q.travel_right_m - q.travel_left_m) / wheelbase_m;
+  };
+  return std::abs(turn(a, A) - turn(b, B)) <= o.turn_tolerance_rad;
 }
 
 /// For each piece of the reference run `ref`, the matched piece of `run`
 /// (-1: none), by the longest common subsequence under Matches: a real run
 /// has a creep or a split the others lack, so pieces are aligned, not
 /// counted.
-std::vector<int> Align(const CampaignData& c, const std::vector<int>& ref, const std::vector<int>& run,
-                       const RepeatNoiseOptions& o) {
+std::vector<int> Align(const CampaignData& c, const std::vector<PieceBases>& bases, const std::vector<int>& ref,
+                       const std::vector<int>& run, const RepeatNoiseOptions& o) {
   const std::size_t n = ref.size(), m = run.size();
   std::vector<int> L((n + 1) * (m + 1), 0);
   auto at = [&](std::size_t i, std::size_t j) -> int& { return L[i * (m + 1) + j]; };
   auto match = [&](std::size_t i, std::size_t j) {
-    return Matches(c.pieces[static_cast<std::size_t>(ref[i])], c.pieces[static_cast<std::size_t>(run[j])], o);
+    const std::size_t a = static_cast<std::size_t>(ref[i]), b = static_cast<std::size_t>(run[j]);
+    return Matches(c.pieces[a], c.pieces[b], bases[a], bases[b], c.robot.wheelbase_m, o);
   };
   for (std::size_t i = n; i-- > 0;)
     for (std::size_t j = m; j-- > 0;)
@@ -159,32 +169,43 @@ RepeatContrasts FormRepeatContrasts(const CampaignData& c, const std::vector<dou
                                     const std::vector<PieceBases>& bases, const RepeatNoiseOptions& options) {
   RepeatContrasts out;
   const std::size_t fewest = options.detrend ? 3 : 2;  // runs at a position: more than the contrasts' constraints
-  for (const auto& [key, runs] : GroupRuns(c)) {
-    if (static_cast<int>(runs.size()) < options.min_runs) continue;
-    // Reference: the run with the median piece count (a typical run).
-    std::vector<std::size_t> by_count(runs.size());
-    for (std::size_t i = 0; i < runs.size(); ++i) by_count[i] = i;
-    std::sort(by_count.begin(), by_count.end(), [&](std::size_t a, std::size_t b) { return runs[a].size() < runs[b].size(); });
-    const std::vector<int>& ref = runs[by_count[runs.size() / 2]];
-    std::vector<std::vector<int>> aligned;
-    for (const auto& r : runs) aligned.push_back(&r == &ref ? r : Align(c, ref, r, options));
-    int used = 0;
-    for (std::size_t m = 0; m < ref.size(); ++m) {
-      std::vector<int> pieces;
-      std::vector<double> place;
-      for (const auto& a : aligned)
-        if (a[m] >= 0) {
-          pieces.push_back(a[m]);
-          place.push_back(c.runs[static_cast<std::size_t>(c.pieces[static_cast<std::size_t>(a[m])].run)].campaign_index);
-        }
-      if (pieces.size() < fewest) continue;
-      AddPosition(c, eps, bases, pieces, place, options, out);
-      ++used;
+  for (auto& [key, group] : GroupRuns(c)) {
+    // Runs of one label may drive different paths (the June circles: cw and
+    // ccw both "circular"): the runs that share at least half of a typical
+    // run's pieces form one set, the rest are tried again among themselves.
+    std::vector<std::vector<int>> left = std::move(group);
+    while (static_cast<int>(left.size()) >= options.min_runs) {
+      std::vector<std::size_t> by_count(left.size());
+      for (std::size_t i = 0; i < left.size(); ++i) by_count[i] = i;
+      std::sort(by_count.begin(), by_count.end(), [&](std::size_t a, std::size_t b) { return left[a].size() < left[b].size(); });
+      const std::vector<int> ref = left[by_count[left.size() / 2]];
+      std::vector<std::vector<int>> aligned, rest;
+      for (auto& r : left) {
+        std::vector<int> a = Align(c, bases, ref, r, options);
+        const std::size_t matched = static_cast<std::size_t>(std::count_if(a.begin(), a.end(), [](int j) { return j >= 0; }));
+        if (2 * matched >= ref.size()) aligned.push_back(std::move(a));
+        else rest.push_back(std::move(r));
+      }
+      left = std::move(rest);
+      if (static_cast<int>(aligned.size()) < options.min_runs) continue;
+      int used = 0;
+      for (std::size_t m = 0; m < ref.size(); ++m) {
+        std::vector<int> pieces;
+        std::vector<double> place;
+        for (const auto& a : aligned)
+          if (a[m] >= 0) {
+            pieces.push_back(a[m]);
+            place.push_back(c.runs[static_cast<std::size_t>(c.pieces[static_cast<std::size_t>(a[m])].run)].campaign_index);
+          }
+        if (pieces.size() < fewest) continue;
+        AddPosition(c, eps, bases, pieces, place, options, out);
+        ++used;
+      }
+      if (used == 0) continue;
+      ++out.groups;
+      out.runs += static_cast<int>(aligned.size());
+      out.positions += used;
     }
-    if (used == 0) continue;
-    ++out.groups;
-    out.runs += static_cast<int>(runs.size());
-    out.positions += used;
   }
   return out;
 }

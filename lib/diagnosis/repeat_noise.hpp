@@ -4,8 +4,11 @@
 // Runs of one experiment and direction repeat the same commanded path, so
 // they break into the same sequence of pieces (pieces.hpp), up to a creep
 // or a split a real run has and the others lack: aligned to the group's
-// typical run (longest common subsequence of pieces of the same type, sign
-// and travel), piece m of each run is the same stretch of the path. A deterministic effect the baseline
+// typical run (longest common subsequence of pieces of the same type, sign,
+// travel and heading change), piece m of each run is the same stretch of
+// the path. Runs of one label that share less than half of the typical
+// run's pieces (the June circles label cw and ccw alike) form a set of
+// their own. A deterministic effect the baseline
 // leaves out (a marker offset, a scale error, a clock offset, a scrub, a
 // wrong E_d or E_b) moves piece m's residual by the same amount mu_m in each
 // run: eps_{i,m} = mu_m + e_{i,m}, with e_{i,m} ~ N(0, C_{i,m}) independent
@@ -68,6 +71,11 @@ struct RepeatNoiseOptions {
   double travel_tolerance = 0.15;
   /// Absolute slack of the travel match [m] (>= 0). Default 0.05.
   double travel_slack_m = 0.05;
+  /// Largest difference of a leg's or arc's heading change between matched
+  /// pieces [rad] (> 0): the same circle, not its mirror or another radius
+  /// (a marker offset d moves a piece by about d x the heading change, so
+  /// 0.02 rad leaves 0.8 mm of a 42 mm offset's effect). Default 0.02.
+  double turn_tolerance_rad = 0.02;
   /// Contrasts orthogonal to the run's place in the campaign too (a linear
   /// parameter_drift drops out); needs one run more per group. Default false.
   bool detrend = false;
