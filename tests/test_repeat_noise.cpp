@@ -202,3 +202,48 @@ TEST_CASE("repeat noise: a design without repeated runs says why it is not measu
   const RepeatNoise two = Measure(c, o);
   CHECK(two.contrasts > 0);
 }
+
+TEST_CASE("repeat noise: the baseline holds it with --hold-wheel-noise, reports it and warns by default",
+          "[repeat_noise][diagnose]") {
+  // A 36 mm marker offset (gt_offset 30, -20 mm) on the small campaign: held
+  // (kRepeats), the baseline's k are the repeated runs' (within 3 sd of the
+  // truth 1.5e-3, 2.5e-3: the marker's second-order shift is ~1 sd, above)
+  // and the joint fit beside them is reported; by default (kFitted) k is the
+  // joint fit, the repeated runs' k is still measured, and the warning
+  // says the two disagree when they do by more than 1.5 x and 2 sd.
+  testing::SmallCampaign s = Campaign(7);
+  s.sim.effects.gt_dx = 0.03;
+  s.sim.effects.gt_dy = -0.02;
+  const CampaignData c = testing::BuildSmallCampaign(s);
+  DiagnoseOptions o;
+  o.null_simulations = 50;
+  o.seed = 1;
+  o.threads = 2;
+  o.pieces.folds = 4;
+  o.effects = {sim::EffectKind::kGtOffset, sim::EffectKind::kScaleError};
+  o.baseline_fit.wheel = WheelNoiseSource::kRepeats;
+  const DiagnoseSummary held = Diagnose(c, o);
+  INFO(RepeatNoiseSummary(held.baseline.repeat));
+  REQUIRE(held.baseline.repeat.measured);
+  CHECK(held.baseline.wheel_noise_source == "repeats");
+  CHECK(held.baseline.k_L == Approx(held.baseline.repeat.k_L).epsilon(1e-9));
+  CHECK(held.baseline.k_R == Approx(held.baseline.repeat.k_R).epsilon(1e-9));
+  CHECK(std::abs(held.baseline.k_L - 1.5e-3) < 3.0 * held.baseline.repeat.sd_k_L);
+  CHECK(std::abs(held.baseline.k_R - 2.5e-3) < 3.0 * held.baseline.repeat.sd_k_R);
+  CHECK(held.baseline.pieces_k_L > 0.0);
+  CHECK(held.verdict == "gt_offset");
+
+  o.baseline_fit.wheel = WheelNoiseSource::kFitted;
+  const DiagnoseSummary fitted = Diagnose(c, o);
+  CHECK(fitted.baseline.wheel_noise_source == "fitted");
+  CHECK(fitted.baseline.repeat.measured);
+  CHECK(fitted.baseline.repeat.k_L == Approx(held.baseline.repeat.k_L).epsilon(1e-9));
+  const bool off = (fitted.baseline.k_L > 1.5 * fitted.baseline.repeat.k_L &&
+                    fitted.baseline.k_L - fitted.baseline.repeat.k_L > 2.0 * fitted.baseline.repeat.sd_k_L) ||
+                   (fitted.baseline.k_R > 1.5 * fitted.baseline.repeat.k_R &&
+                    fitted.baseline.k_R - fitted.baseline.repeat.k_R > 2.0 * fitted.baseline.repeat.sd_k_R);
+  bool warned = false;
+  for (const std::string& w : fitted.warnings) warned = warned || w.find("scatter of repeated runs") != std::string::npos;
+  INFO("fitted k_L " << fitted.baseline.k_L << ", k_R " << fitted.baseline.k_R);
+  CHECK(warned == off);
+}

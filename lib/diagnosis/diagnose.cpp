@@ -353,25 +353,30 @@ std::string StandstillDisagreement(const BaselineSummary& b) {
       s.differences, StandstillNoiseOptions{}.settle_s, advice);
 }
 
-/// The wheel noise fitted jointly with the mean on the pieces against the
+/// The wheel noise fitted jointly with the mean on the pieces (the
+/// baseline's, or with the source "repeats" the fit beside it) against the
 /// repeated runs' scatter (repeat_noise.hpp): a warning when a k differs by
 /// more than 1.5 x (either way) and by more than two of the repeated runs'
 /// standard errors.
 std::string RepeatDisagreement(const BaselineSummary& b) {
-  if (b.wheel_noise_source != "repeats") return {};
   const RepeatNoise& r = b.repeat;
+  if (!r.measured || (b.wheel_noise_source != "repeats" && b.wheel_noise_source != "fitted")) return {};
+  const bool held = b.wheel_noise_source == "repeats";
+  const double kl = held ? b.pieces_k_L : b.k_L, kr = held ? b.pieces_k_R : b.k_R;
   auto off = [](double a, double ref, double sd) {
     return std::abs(a - ref) > 2.0 * sd && (a > 1.5 * ref || a < ref / 1.5);
   };
-  if (!off(b.pieces_k_L, r.k_L, r.sd_k_L) && !off(b.pieces_k_R, r.k_R, r.sd_k_R)) return {};
+  if (!off(kl, r.k_L, r.sd_k_L) && !off(kr, r.k_R, r.sd_k_R)) return {};
   return fmt::format(
-      "fitted jointly with E_d, E_b on the pieces, the wheel noise would be k_L = {:.3g}, k_R = {:.3g} m^1/2: {:.2g} x "
-      "/ {:.2g} x the scatter of repeated runs about their own mean (k_L = {:.3g} +- {:.2g}, k_R = {:.3g} +- {:.2g}): "
-      "the pieces hold something the same in every run that the baseline leaves out (a mean effect the joint fit "
-      "would take as wheel noise) or noise that differs between experiments; the baseline keeps the repeated runs' "
-      "k, so the gap test sees it",
-      b.pieces_k_L, b.pieces_k_R, b.pieces_k_L / std::max(r.k_L, 1e-12), b.pieces_k_R / std::max(r.k_R, 1e-12), r.k_L,
-      r.sd_k_L, r.k_R, r.sd_k_R);
+      "fitted jointly with E_d, E_b on the pieces, the wheel noise {} k_L = {:.3g}, k_R = {:.3g} m^1/2: {:.2g} x / {:.2g} x "
+      "the scatter of repeated runs about their own mean (k_L = {:.3g} +- {:.2g}, k_R = {:.3g} +- {:.2g}): the pieces "
+      "hold something the same in every run that the baseline leaves out (a mean effect the joint fit takes as wheel "
+      "noise), or the runs differ in something of their own (a per-run clock, bumps, settling) that the repeated runs "
+      "see and the pieces fit otherwise; {}",
+      held ? "would be" : "is", kl, kr, kl / std::max(r.k_L, 1e-12),
+      kr / std::max(r.k_R, 1e-12), r.k_L, r.sd_k_L, r.k_R, r.sd_k_R,
+      held ? "the baseline keeps the repeated runs' k, so the gap test sees it"
+           : "diagnose with --hold-wheel-noise to hold k at the repeated runs' scatter, and compare the verdicts");
 }
 
 /// What the standstill scatter's estimate rests on, when it is more than a

@@ -228,9 +228,11 @@ RepeatNoise MeasureRepeatNoise(const CampaignData& c, const std::vector<double>&
   PieceNoiseFitOptions o = fit;
   o.fit_wheel_noise = true;
   o.correlated = o.motion_floor = o.standstill = o.run_time = false;
-  NoiseParams n = start;
-  n.c_LR = n.floor_s2 = n.stand_xy2 = n.stand_th2 = n.run_tau2 = n.swivel_rev2 = 0.0;
-  n.bump_rate = n.bump_s2 = 0.0;
+  NoiseParams n;  // the wheels and the ground truth only
+  n.kL2 = start.kL2;
+  n.kR2 = start.kR2;
+  n.sxy2 = start.sxy2;
+  n.sth2 = start.sth2;
   n = FitPieceNoise(rc.eps, rc.bases, rc.pieces, {}, n, o);
   r.k_L = std::sqrt(n.kL2);
   r.k_R = std::sqrt(n.kR2);
