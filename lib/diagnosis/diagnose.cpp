@@ -507,8 +507,8 @@ DiagnoseSummary WithoutFaultyRuns(const CampaignData& rest, const DiagnoseOption
   return out;
 }
 
-// The diagnosis as its numbered stages, each a call into its own file. About
-// 110 lines because each stage's options are filled from DiagnoseOptions here,
+// The diagnosis as its numbered stages, each a call into its own file. It is
+// 111 lines long because each stage's options are filled from DiagnoseOptions here,
 // in place, so that every route of a user's option is visible in one place.
 DiagnoseSummary DiagnoseCampaign(const CampaignData& recorded, const DiagnoseOptions& options, bool scan_faults) {
   DiagnoseSummary out;
