@@ -9,6 +9,8 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <system_error>
+#include <vector>
 
 namespace umbmark::testing {
 
@@ -24,13 +26,29 @@ inline std::string Slurp(const std::string& path) {
   return ss.str();
 }
 
+/// The temporary directories this test process made, removed when it ends
+/// (set UMBMARK_KEEP_TEST_DIRS=1 to keep them for a look after a failure).
+struct TempDirRegistry {
+  std::vector<std::filesystem::path> dirs;
+  TempDirRegistry() = default;
+  TempDirRegistry(const TempDirRegistry&) = delete;
+  TempDirRegistry& operator=(const TempDirRegistry&) = delete;
+  ~TempDirRegistry() {
+    if (std::getenv("UMBMARK_KEEP_TEST_DIRS") != nullptr) return;
+    std::error_code ec;
+    for (const auto& d : dirs) std::filesystem::remove_all(d, ec);
+  }
+};
+
 /// A fresh temporary directory under the system temp path, unique per call.
 inline std::filesystem::path TempDir(const std::string& tag) {
   static int counter = 0;
+  static TempDirRegistry registry;
   auto dir = std::filesystem::temp_directory_path() /
              ("umbmark-test-" + tag + "-" + std::to_string(::getpid()) + "-" + std::to_string(++counter));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
+  registry.dirs.push_back(dir);
   return dir;
 }
 
