@@ -139,6 +139,36 @@ TEST_CASE("unexplained: the report says what to look at and which experiment to 
   CHECK(j["candidates"][0].contains("unphysical"));
 }
 
+TEST_CASE("unexplained: the named effects' fixes come first when they close most of the gap", "[diagnose][report]") {
+  // Issue 28 item 6: on the real June session s1 with a 45 mm marker offset
+  // injected, the verdict was `unexplained` with the marker closing 86 % of
+  // the gap held out, and the first thing to do was "look at experiment 1";
+  // the marker's fix now comes first when the listed effects close at
+  // least half of the gap held out, and the largest discrepancy after it.
+  const CampaignData c = Simulated(71, 0.0, 0.012);  // unexplained, with a discrepancy to point at
+  DiagnoseSummary d = Diagnose(c, Fast());
+  REQUIRE(d.verdict == "unexplained");
+  REQUIRE_FALSE(d.where.empty());
+  ExplanationStep marker;
+  marker.effect = *sim::EffectFromString("gt_offset");
+  marker.params = {{"dx", 0.0385}, {"dy", -0.0233}};
+  d.explanation = {marker};
+  d.verdict_effects = {"gt_offset"};
+  d.unexplained_fraction = 0.14;
+  std::vector<std::string> steps = AdviseNextSteps(c, d);
+  REQUIRE(steps.size() >= 2);
+  CHECK(steps[0].find("(+38.5, -23.3) mm") != std::string::npos);
+  CHECK(steps[1].rfind("Then, for what those changes leave, look at experiment", 0) == 0);
+  d.next_steps = steps;
+  CHECK(PlainSummary(d).find("What to do first: Motion capture:") != std::string::npos);
+  // Closing less than half, the discrepancy comes first and the fix after.
+  d.unexplained_fraction = 0.6;
+  steps = AdviseNextSteps(c, d);
+  REQUIRE(steps.size() >= 2);
+  CHECK(steps[0].rfind("Look first at experiment", 0) == 0);
+  CHECK(steps[1].find("(+38.5, -23.3) mm") != std::string::npos);
+}
+
 TEST_CASE("unexplained: the back-and-forth advice says squares confuse only when there are squares alone",
           "[diagnose][report]") {
   // Issue 28: "Add back_and_forth ... which squares alone confuse" appeared

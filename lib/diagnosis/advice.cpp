@@ -180,17 +180,24 @@ std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSu
                     fmt::format("{}", fmt::join(symptoms, "; ")) + ".");
     return out;
   }
+  // The listed effects' fixes come first when together they close at least
+  // half of the gap on held-out runs (the share the verdict asks of named
+  // effects): fixing them is then the larger step, and what is left is
+  // looked at after; otherwise the largest discrepancy comes first.
+  const bool fixes_first = !changes.empty() && 1.0 - s.unexplained_fraction >= 0.5;
+  if (fixes_first) out.insert(out.end(), changes.begin(), changes.end());
   if (!s.where.empty()) {
     const WhereItem& w = s.where.front();
     const std::string exp = w.experiment >= 0 && w.experiment < static_cast<int>(s.experiment_labels.size())
                                 ? "experiment " + s.experiment_labels[w.experiment]
                                 : std::string("all experiments");
-    out.push_back(fmt::format("Look first at {}, {}: its {} of the {} component is {:.1f} standard errors off the "
+    out.push_back(fmt::format("{} {}, {}: its {} of the {} component is {:.1f} standard errors off the "
                               "model. Plot those runs' odometry against the ground truth (umbmark evaluate --report) "
                               "and check the ground truth there (marker swaps, dropped samples, timing).",
-                              exp, w.subset, StatKindToString(w.statistic), w.component, w.z));
+                              fixes_first ? "Then, for what those changes leave, look at" : "Look first at", exp,
+                              w.subset, StatKindToString(w.statistic), w.component, w.z));
   }
-  out.insert(out.end(), changes.begin(), changes.end());
+  if (!fixes_first) out.insert(out.end(), changes.begin(), changes.end());
   if (!symptoms.empty())
     out.push_back("These effects fitted impossible values, so the gap is something else that they try to imitate: " +
                   fmt::format("{}", fmt::join(symptoms, "; ")) + ".");
