@@ -14,6 +14,10 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const std::string path = "/tmp/umbmark-fuzz-mcap-" + std::to_string(::getpid()) + ".mcap";
+  // Removed when the fuzzer exits (it ends by exit() after -max_total_time).
+  static const struct Remove {
+    ~Remove() { std::remove(path.c_str()); }
+  } remove_at_exit;
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) return 0;
   std::fwrite(data, 1, size, f);
