@@ -353,26 +353,260 @@ double Median(std::vector<double> v) {
   return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
 }
 
+/// The classes to run: --classes, else every simulated effect with the
+/// clean, negligible, pair and baseline-mode classes.
+std::vector<std::string> Classes(const Args& args) {
+  std::vector<std::string> classes = args.classes;
+  if (!classes.empty()) return classes;
+  classes.push_back("none");
+  // Issue 21's effects come last, so that every other class keeps its
+  // campaigns (a case's seed follows its class index).
+  const auto late = [](sim::EffectKind k) {
+    return k == sim::EffectKind::kStopSlide || k == sim::EffectKind::kCastorSwivel;
+  };
+  for (const auto& d : sim::EffectCatalogue())
+    if (d.simulated && !late(d.kind)) classes.emplace_back(d.name);
+  for (const char* b : {"base_ok", "base_wheelbase", "base_ratio", "base_noise", "base_noise_left",
+                        "base_noise_right", "base_wheelbase_castor", "base_ratio_gt_offset"})
+    classes.emplace_back(b);
+  for (const auto& d : sim::EffectCatalogue())
+    if (late(d.kind)) classes.emplace_back(d.name);
+  return classes;
+}
+
+/// --write-dir: the campaign, its truth beside it, and what the verdict
+/// must be, so that the same case can be diagnosed through the CLI.
+void WriteCase(const std::string& dir, const Case& c, const sim::SimulatedCampaign& campaign) {
+  io::WriteCampaign(campaign.manifest, campaign.data, dir + "/campaign");
+  nlohmann::json truth = sim::CampaignTruthJson(campaign, c.sim);
+  truth["design"] = {{"figure_eights", c.arcs}};
+  if (!c.expected_verdict.empty()) truth["expected_verdict"] = c.expected_verdict;
+  io::WriteFileAtomically(dir + "/truth.json", truth.dump(2) + "\n");
+  // The right verdict when it is not the truth's name (outside effects,
+  // turn_scrub without arcs), and the note the diagnosis must give.
+  if (!c.given && !c.expected_verdict.empty() && c.expected_verdict != c.truth)
+    io::WriteFileAtomically(dir + "/expected_verdict.txt", c.expected_verdict + "\n");
+  if (c.expect_scrub_note) io::WriteFileAtomically(dir + "/expected_note.txt", std::string(kScrubNote) + "\n");
+  if (!c.given) return;
+  // The user's model as `diagnose --baseline` reads it (a calibrate JSON's
+  // `parameters`), and its k_L, k_R for --kl/--kr.
+  const RobotParams& p = c.given->params;
+  io::WriteFileAtomically(dir + "/given.json",
+                          nlohmann::json{{"parameters",
+                                          {{"wheelbase_m", p.wheelbase_m},
+                                           {"wheel_diameter_left_m", p.wheel_diameter_left_m},
+                                           {"wheel_diameter_right_m", p.wheel_diameter_right_m}}}}
+                                  .dump(2) + "\n");
+  io::WriteFileAtomically(dir + "/given_noise.txt", fmt::format("{:.17g} {:.17g}\n", c.given->k_L, c.given->k_R));
+  // What the verdict must name (every word; none: `none`).
+  io::WriteFileAtomically(dir + "/expected.txt",
+                          (c.expected.empty() ? std::string("none") : fmt::format("{}", fmt::join(c.expected, " "))) +
+                              "\n");
+}
+
+/// The scores over all cases.
+struct Tally {
+  std::map<std::string, std::map<std::string, int>> confusion;
+  nlohmann::json records = nlohmann::json::array();
+  std::vector<double> times, heldout_true, heldout_verdict;
+  std::map<std::string, std::vector<double>> stage_times;
+  int listed = 0, listed_right = 0, listed_no_scrub = 0, listed_no_scrub_right = 0;
+  int clean = 0, false_alarms = 0, outside = 0, outside_unexplained = 0;
+  int negligible = 0, negligible_none = 0, pairs = 0, pairs_both = 0;
+  struct Rate {
+    int n = 0, right = 0;
+  };
+  std::map<std::string, Rate> baseline;
+  int base_wrong = 0, base_wrong_named = 0;
+  // turn_scrub by design (false: spot turns only, expected `none` + note).
+  struct ScrubTally {
+    int n = 0, right = 0, noted = 0;
+  };
+  std::map<bool, ScrubTally> scrub;
+  int with_arcs = 0;
+};
+
+/// Baseline mode: every wrong parameter and effect of the class named
+/// (base_ok: `none`); one wheel's k wrong: the named wheel_noise_error must
+/// put the error on that wheel (its ratio k_fit / k_given further from 1)
+/// and find the other right (within 25 %, the size below which a noise
+/// error is negligible).
+void ScoreBaselineMode(const Case& c, const diag::DiagnoseSummary& s, Tally& t) {
+  auto named = [&](const std::string& e) {
+    return std::find(s.verdict_effects.begin(), s.verdict_effects.end(), e) != s.verdict_effects.end();
+  };
+  bool all = true;
+  for (const auto& e : c.expected) all = all && named(e);
+  if (c.wrong_wheel) {
+    bool wheel = false;
+    for (const auto& e : s.explanation) {
+      if (e.effect != sim::EffectKind::kWheelNoiseError) continue;
+      const double wrong = e.params.at(c.wrong_wheel == 'L' ? "ratio_L" : "ratio_R");
+      const double other = e.params.at(c.wrong_wheel == 'L' ? "ratio_R" : "ratio_L");
+      wheel = std::abs(std::log(wrong)) > std::abs(std::log(other)) && std::abs(other - 1.0) < 0.25;
+    }
+    all = all && wheel;
+  }
+  const bool ok = c.expected.empty() ? s.verdict == "none" : all;
+  Tally::Rate& r = t.baseline[c.truth];
+  ++r.n;
+  r.right += ok;
+  if (!c.expected.empty()) {
+    ++t.base_wrong;
+    t.base_wrong_named += c.wrong_wheel ? ok : named(c.expected.front());
+  }
+}
+
+/// Scores one diagnosis into the tally; returns whether the verdict is right.
+bool Score(const Case& c, const diag::DiagnoseSummary& s, Tally& t) {
+  t.confusion[c.truth][s.verdict] += 1;
+  const bool noted = std::any_of(s.notes.begin(), s.notes.end(),
+                                 [](const std::string& n) { return n.find(kScrubNote) != std::string::npos; });
+  // turn_scrub on spot turns only: `none` with the note, or the scrub
+  // itself when its small footprint there (the turns' forward motion,
+  // E_d far from 1) gave it held-out evidence.
+  const bool right = (s.verdict == c.expected_verdict && (!c.expect_scrub_note || noted)) ||
+                     (c.expect_scrub_note && s.verdict == c.truth);
+  if (c.truth == "turn_scrub") {
+    Tally::ScrubTally& sc = t.scrub[c.arcs];
+    ++sc.n;
+    sc.right += right;
+    sc.noted += noted;
+  }
+  auto named = [&](const char* e) {
+    return std::find(s.verdict_effects.begin(), s.verdict_effects.end(), e) != s.verdict_effects.end();
+  };
+  if (c.given) {
+    ScoreBaselineMode(c, s, t);
+  } else if (c.truth == "negligible") {
+    ++t.negligible;
+    t.negligible_none += s.verdict == "none";
+  } else if (c.truth.rfind("pair_", 0) == 0) {
+    ++t.pairs;
+    t.pairs_both += c.truth == "pair_castor_bumps" ? named("castor_kick") && named("bump_outliers")
+                                                   : named("time_offset") && named("gt_offset");
+  } else if (c.truth == "none") {
+    ++t.clean;
+    if (s.verdict != "none") ++t.false_alarms;
+  } else if (c.outside) {
+    ++t.outside;
+    if (right) ++t.outside_unexplained;
+  } else {
+    ++t.listed;
+    t.listed_right += right;
+    if (c.truth != "turn_scrub") {
+      ++t.listed_no_scrub;
+      t.listed_no_scrub_right += right;
+    }
+    for (const auto& cd : s.candidates) {
+      if (sim::EffectToString(cd.effect) == c.truth) t.heldout_true.push_back(cd.heldout_shrink);
+      if (sim::EffectToString(cd.effect) == s.verdict) t.heldout_verdict.push_back(cd.heldout_shrink);
+    }
+  }
+  return right;
+}
+
+/// One case's record for --json.
+nlohmann::json Record(std::size_t i, const Case& c, const sim::SimulatedCampaign& campaign,
+                      const diag::DiagnoseSummary& s, bool right, double seconds) {
+  nlohmann::json explanation = nlohmann::json::array();
+  for (const auto& e : s.explanation)
+    explanation.push_back({{"effect", sim::EffectToString(e.effect)}, {"params", e.params}, {"negligible", e.negligible}});
+  return {{"case", i},
+          {"truth", c.truth},
+          {"verdict", s.verdict},
+          {"verdict_effects", s.verdict_effects},
+          {"figure_eights", c.arcs},
+          {"expected_verdict", c.expected_verdict},
+          {"right", right},
+          {"expected", c.expected},
+          {"explanation", explanation},
+          {"p_value", s.p_value},
+          {"score_p_value", s.score_p_value},
+          {"tests_p_value", s.tests_p_value},
+          {"gap_score", s.gap_score},
+          {"seconds", seconds},
+          {"robot",
+           {{"wheelbase_m", c.manifest.robot.wheelbase_m},
+            {"diameter_m", c.manifest.robot.wheel_diameter_left_m},
+            {"ticks_per_rev", *c.manifest.robot.ticks_per_rev}}},
+          {"sim_truth", sim::CampaignTruthJson(campaign, c.sim)},
+          {"top", s.candidates.empty() ? nlohmann::json(nullptr)
+                                       : nlohmann::json{{"effect", sim::EffectToString(s.candidates[0].effect)},
+                                                        {"heldout_shrink", s.candidates[0].heldout_shrink},
+                                                        {"evidence", s.candidates[0].evidence}}}};
+}
+
+double Pct(int a, int b) { return b > 0 ? 100.0 * a / b : std::nan(""); }
+
+/// The confusion matrix and the rates.
+void PrintSummary(const Args& args, const std::vector<std::string>& classes, std::size_t n_cases, Tally& t) {
+  std::vector<std::string> verdict_names = {"none", "unexplained"};
+  for (auto k : sim::ContractEffects()) verdict_names.emplace_back(sim::EffectToString(k));
+  for (auto k : sim::ParameterErrorEffects()) verdict_names.emplace_back(sim::EffectToString(k));
+  fmt::print("\nConfusion matrix (rows: truth, columns: verdict)\n{:<20}", "");
+  for (const auto& v : verdict_names) fmt::print(" {:>6.6}", v);
+  fmt::print("\n");
+  for (const auto& c : classes) {
+    fmt::print("{:<20}", c);
+    for (const auto& v : verdict_names) fmt::print(" {:>6d}", t.confusion[c][v]);
+    fmt::print("\n");
+  }
+  fmt::print("\ncampaign: standard{}; {} of {} with 4 figure-eight runs\n",
+             args.extended ? " + 4 figure-eight runs (extended)" : "", t.with_arcs, n_cases);
+  fmt::print("top-1 accuracy on listed effects:          {:5.1f}% ({}/{})\n", Pct(t.listed_right, t.listed),
+             t.listed_right, t.listed);
+  fmt::print("  without turn_scrub:                       {:5.1f}% ({}/{})\n",
+             Pct(t.listed_no_scrub_right, t.listed_no_scrub), t.listed_no_scrub_right, t.listed_no_scrub);
+  fmt::print("  turn_scrub with figure-eights (named):    {:5.1f}% ({}/{})\n", Pct(t.scrub[true].right, t.scrub[true].n),
+             t.scrub[true].right, t.scrub[true].n);
+  fmt::print("  turn_scrub, spot turns only (none + note): {:5.1f}% ({}/{}; note given {}/{})\n",
+             Pct(t.scrub[false].right, t.scrub[false].n), t.scrub[false].right, t.scrub[false].n, t.scrub[false].noted,
+             t.scrub[false].n);
+  fmt::print("false alarms on clean campaigns:           {:5.1f}% ({}/{})\n", Pct(t.false_alarms, t.clean),
+             t.false_alarms, t.clean);
+  fmt::print("'unexplained' on outside effects:          {:5.1f}% ({}/{})\n", Pct(t.outside_unexplained, t.outside),
+             t.outside_unexplained, t.outside);
+  fmt::print("'none' on negligible-mismatch campaigns:   {:5.1f}% ({}/{})\n", Pct(t.negligible_none, t.negligible),
+             t.negligible_none, t.negligible);
+  fmt::print("both effects named on pair campaigns:      {:5.1f}% ({}/{})\n", Pct(t.pairs_both, t.pairs), t.pairs_both,
+             t.pairs);
+  fmt::print("baseline mode (--baseline CAL.json --kl --kr; all of the class's wrong parameters and effects named, "
+             "base_ok: none):\n");
+  for (const auto& [cls, r] : t.baseline) fmt::print("  {:<24} {:5.1f}% ({}/{})\n", cls, Pct(r.right, r.n), r.right, r.n);
+  fmt::print("baseline mode, wrong parameter named:      {:5.1f}% ({}/{})\n", Pct(t.base_wrong_named, t.base_wrong),
+             t.base_wrong_named, t.base_wrong);
+  fmt::print("median heldout_shrink (true effect):       {:.3f}\n", Median(t.heldout_true));
+  fmt::print("median heldout_shrink (verdict's effect):  {:.3f}\n", Median(t.heldout_verdict));
+  fmt::print("time per diagnosis: median {:.2f} s, max {:.2f} s\n", Median(t.times),
+             t.times.empty() ? 0.0 : *std::max_element(t.times.begin(), t.times.end()));
+  for (const auto& [stage, v] : t.stage_times) fmt::print("  {:<42} median {:.3f} s\n", stage, Median(v));
+}
+
+void WriteJson(const Args& args, const Tally& t) {
+  nlohmann::json summary = {{"extended", args.extended},
+                            {"arc_fraction", args.extended ? 1.0 : args.arc_fraction},
+                            {"seed", args.seed},
+                            {"top1_listed", Pct(t.listed_right, t.listed) / 100.0},
+                            {"top1_listed_without_turn_scrub", Pct(t.listed_no_scrub_right, t.listed_no_scrub) / 100.0},
+                            {"false_alarm_rate", Pct(t.false_alarms, t.clean) / 100.0},
+                            {"outside_unexplained_rate", Pct(t.outside_unexplained, t.outside) / 100.0},
+                            {"negligible_none_rate", Pct(t.negligible_none, t.negligible) / 100.0},
+                            {"pairs_both_named_rate", Pct(t.pairs_both, t.pairs) / 100.0},
+                            {"baseline_wrong_parameter_named_rate", Pct(t.base_wrong_named, t.base_wrong) / 100.0},
+                            {"median_heldout_shrink_true", Median(t.heldout_true)},
+                            {"median_heldout_shrink_verdict", Median(t.heldout_verdict)},
+                            {"median_seconds", Median(t.times)},
+                            {"confusion", t.confusion},
+                            {"cases", t.records}};
+  io::WriteFileAtomically(args.json, summary.dump(1) + "\n");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const Args args = Parse(argc, argv);
-  std::vector<std::string> classes = args.classes;
-  if (classes.empty()) {
-    classes.push_back("none");
-    // Issue 21's effects come last, so that every other class keeps its
-    // campaigns (a case's seed follows its class index).
-    const auto late = [](sim::EffectKind k) {
-      return k == sim::EffectKind::kStopSlide || k == sim::EffectKind::kCastorSwivel;
-    };
-    for (const auto& d : sim::EffectCatalogue())
-      if (d.simulated && !late(d.kind)) classes.emplace_back(d.name);
-    for (const char* b : {"base_ok", "base_wheelbase", "base_ratio", "base_noise", "base_noise_left",
-                          "base_noise_right", "base_wheelbase_castor", "base_ratio_gt_offset"})
-      classes.emplace_back(b);
-    for (const auto& d : sim::EffectCatalogue())
-      if (late(d.kind)) classes.emplace_back(d.name);
-  }
+  const std::vector<std::string> classes = Classes(args);
   std::vector<Case> cases;
   for (std::size_t ci = 0; ci < classes.size(); ++ci) {
     const int count =
@@ -381,66 +615,16 @@ int main(int argc, char** argv) {
       cases.push_back(MakeCase(classes[ci], args.seed * 1000003ull + ci * 10007ull + static_cast<std::uint64_t>(i),
                                args.extended ? 1.0 : args.arc_fraction, args.pause_s));
   }
-
   diag::DiagnoseOptions dopt;
   dopt.threads = args.threads;
   dopt.null_simulations = args.null_sims;
-  std::vector<std::string> verdict_names = {"none", "unexplained"};
-  for (auto k : sim::ContractEffects()) verdict_names.emplace_back(sim::EffectToString(k));
-  for (auto k : sim::ParameterErrorEffects()) verdict_names.emplace_back(sim::EffectToString(k));
-
-  std::map<std::string, std::map<std::string, int>> confusion;
-  nlohmann::json records = nlohmann::json::array();
-  std::vector<double> times, heldout_true, heldout_verdict;
-  std::map<std::string, std::vector<double>> stage_times;
-  int listed = 0, listed_right = 0, listed_no_scrub = 0, listed_no_scrub_right = 0;
-  int clean = 0, false_alarms = 0, outside = 0, outside_unexplained = 0;
-  int negligible = 0, negligible_none = 0, pairs = 0, pairs_both = 0;
-  struct BaselineTally {
-    int n = 0, right = 0;
-  };
-  std::map<std::string, BaselineTally> baseline;
-  int base_wrong = 0, base_wrong_named = 0;
-  // turn_scrub by design (false: spot turns only, expected `none` + note).
-  struct ScrubTally {
-    int n = 0, right = 0, noted = 0;
-  };
-  std::map<bool, ScrubTally> scrub;
-  int with_arcs = 0;
+  Tally t;
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const Case& c = cases[i];
     if (args.only_case >= 0 && static_cast<int>(i) != args.only_case) continue;
     const sim::SimulatedCampaign campaign = sim::SimulateCampaign(c.manifest, c.sim);
-    with_arcs += c.arcs;
-    if (!args.write_dir.empty()) {
-      const std::string dir = fmt::format("{}/{:03d}_{}", args.write_dir, i, c.truth);
-      io::WriteCampaign(campaign.manifest, campaign.data, dir + "/campaign");
-      nlohmann::json truth = sim::CampaignTruthJson(campaign, c.sim);
-      truth["design"] = {{"figure_eights", c.arcs}};
-      if (!c.expected_verdict.empty()) truth["expected_verdict"] = c.expected_verdict;
-      io::WriteFileAtomically(dir + "/truth.json", truth.dump(2) + "\n");
-      // The right verdict when it is not the truth's name (outside effects,
-      // turn_scrub without arcs), and the note the diagnosis must give.
-      if (!c.given && !c.expected_verdict.empty() && c.expected_verdict != c.truth)
-        io::WriteFileAtomically(dir + "/expected_verdict.txt", c.expected_verdict + "\n");
-      if (c.expect_scrub_note) io::WriteFileAtomically(dir + "/expected_note.txt", std::string(kScrubNote) + "\n");
-      if (c.given) {
-        // The user's model as `diagnose --baseline` reads it (a calibrate
-        // JSON's `parameters`), and its k_L, k_R for --kl/--kr.
-        const RobotParams& p = c.given->params;
-        io::WriteFileAtomically(dir + "/given.json",
-                                nlohmann::json{{"parameters",
-                                                {{"wheelbase_m", p.wheelbase_m},
-                                                 {"wheel_diameter_left_m", p.wheel_diameter_left_m},
-                                                 {"wheel_diameter_right_m", p.wheel_diameter_right_m}}}}
-                                        .dump(2) + "\n");
-        io::WriteFileAtomically(dir + "/given_noise.txt", fmt::format("{:.17g} {:.17g}\n", c.given->k_L, c.given->k_R));
-        // What the verdict must name (every word; none: `none`).
-        io::WriteFileAtomically(dir + "/expected.txt",
-                                (c.expected.empty() ? std::string("none") : fmt::format("{}", fmt::join(c.expected, " "))) +
-                                    "\n");
-      }
-    }
+    t.with_arcs += c.arcs;
+    if (!args.write_dir.empty()) WriteCase(fmt::format("{}/{:03d}_{}", args.write_dir, i, c.truth), c, campaign);
     // Blind: the diagnosis sees the manifest and the data only.
     const auto t0 = std::chrono::steady_clock::now();
     const diag::CampaignData data = diag::BuildCampaign(campaign.manifest, campaign.data, dopt.pieces);
@@ -449,160 +633,15 @@ int main(int argc, char** argv) {
     o.given = c.given;
     const diag::DiagnoseSummary s = diag::Diagnose(data, o);
     const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    times.push_back(dt);
-    for (const auto& [stage, v] : s.timings) stage_times[stage].push_back(v);
-    confusion[c.truth][s.verdict] += 1;
-    const bool noted = std::any_of(s.notes.begin(), s.notes.end(),
-                                   [](const std::string& n) { return n.find(kScrubNote) != std::string::npos; });
-    // turn_scrub on spot turns only: `none` with the note, or the scrub
-    // itself when its small footprint there (the turns' forward motion,
-    // E_d far from 1) gave it held-out evidence.
-    const bool right = (s.verdict == c.expected_verdict && (!c.expect_scrub_note || noted)) ||
-                       (c.expect_scrub_note && s.verdict == c.truth);
-    if (c.truth == "turn_scrub") {
-      ScrubTally& t = scrub[c.arcs];
-      ++t.n;
-      t.right += right;
-      t.noted += noted;
-    }
-    auto named = [&](const char* e) {
-      return std::find(s.verdict_effects.begin(), s.verdict_effects.end(), e) != s.verdict_effects.end();
-    };
-    if (c.given) {
-      bool all = true;
-      for (const auto& e : c.expected) all = all && named(e.c_str());
-      // One wheel's k wrong: the named wheel_noise_error must put the
-      // error on that wheel (its ratio k_fit / k_given further from 1) and
-      // find the other right (within 25 %, the size below which a noise
-      // error is negligible).
-      if (c.wrong_wheel) {
-        bool wheel = false;
-        for (const auto& e : s.explanation) {
-          if (e.effect != sim::EffectKind::kWheelNoiseError) continue;
-          const double wrong = e.params.at(c.wrong_wheel == 'L' ? "ratio_L" : "ratio_R");
-          const double other = e.params.at(c.wrong_wheel == 'L' ? "ratio_R" : "ratio_L");
-          wheel = std::abs(std::log(wrong)) > std::abs(std::log(other)) && std::abs(other - 1.0) < 0.25;
-        }
-        all = all && wheel;
-      }
-      const bool ok = c.expected.empty() ? s.verdict == "none" : all;
-      BaselineTally& t = baseline[c.truth];
-      ++t.n;
-      t.right += ok;
-      if (!c.expected.empty()) {
-        ++base_wrong;
-        base_wrong_named += c.wrong_wheel ? ok : named(c.expected.front().c_str());
-      }
-    } else if (c.truth == "negligible") {
-      ++negligible;
-      negligible_none += s.verdict == "none";
-    } else if (c.truth.rfind("pair_", 0) == 0) {
-      ++pairs;
-      pairs_both += c.truth == "pair_castor_bumps" ? named("castor_kick") && named("bump_outliers")
-                                                   : named("time_offset") && named("gt_offset");
-    } else if (c.truth == "none") {
-      ++clean;
-      if (s.verdict != "none") ++false_alarms;
-    } else if (c.outside) {
-      ++outside;
-      if (right) ++outside_unexplained;
-    } else {
-      ++listed;
-      listed_right += right;
-      if (c.truth != "turn_scrub") {
-        ++listed_no_scrub;
-        listed_no_scrub_right += right;
-      }
-      for (const auto& cd : s.candidates) {
-        if (sim::EffectToString(cd.effect) == c.truth) heldout_true.push_back(cd.heldout_shrink);
-        if (sim::EffectToString(cd.effect) == s.verdict) heldout_verdict.push_back(cd.heldout_shrink);
-      }
-    }
-    nlohmann::json truth = sim::CampaignTruthJson(campaign, c.sim);
-    nlohmann::json explanation = nlohmann::json::array();
-    for (const auto& e : s.explanation)
-      explanation.push_back({{"effect", sim::EffectToString(e.effect)}, {"params", e.params}, {"negligible", e.negligible}});
-    records.push_back({{"case", i},
-                       {"truth", c.truth},
-                       {"verdict", s.verdict},
-                       {"verdict_effects", s.verdict_effects},
-                       {"figure_eights", c.arcs},
-                       {"expected_verdict", c.expected_verdict},
-                       {"right", right},
-                       {"expected", c.expected},
-                       {"explanation", explanation},
-                       {"p_value", s.p_value},
-                       {"score_p_value", s.score_p_value},
-                       {"tests_p_value", s.tests_p_value},
-                       {"gap_score", s.gap_score},
-                       {"seconds", dt},
-                       {"robot",
-                        {{"wheelbase_m", c.manifest.robot.wheelbase_m},
-                         {"diameter_m", c.manifest.robot.wheel_diameter_left_m},
-                         {"ticks_per_rev", *c.manifest.robot.ticks_per_rev}}},
-                       {"sim_truth", truth},
-                       {"top",
-                        s.candidates.empty() ? nlohmann::json(nullptr)
-                                             : nlohmann::json{{"effect", sim::EffectToString(s.candidates[0].effect)},
-                                                              {"heldout_shrink", s.candidates[0].heldout_shrink},
-                                                              {"evidence", s.candidates[0].evidence}}}});
+    t.times.push_back(dt);
+    for (const auto& [stage, v] : s.timings) t.stage_times[stage].push_back(v);
+    const bool right = Score(c, s, t);
+    t.records.push_back(Record(i, c, campaign, s, right, dt));
     fmt::print("{:4d} {:<20} -> {:<20} p={:<7.4f} G={:<10.1f} {:.2f}s  effects: {}\n", i, c.truth, s.verdict,
                s.p_value, s.gap_score, dt, fmt::join(s.verdict_effects, " + "));
     std::fflush(stdout);
   }
-
-  fmt::print("\nConfusion matrix (rows: truth, columns: verdict)\n{:<20}", "");
-  for (const auto& v : verdict_names) fmt::print(" {:>6.6}", v);
-  fmt::print("\n");
-  for (const auto& t : classes) {
-    fmt::print("{:<20}", t);
-    for (const auto& v : verdict_names) fmt::print(" {:>6d}", confusion[t][v]);
-    fmt::print("\n");
-  }
-  auto pct = [](int a, int b) { return b > 0 ? 100.0 * a / b : std::nan(""); };
-  fmt::print("\ncampaign: standard{}; {} of {} with 4 figure-eight runs\n",
-             args.extended ? " + 4 figure-eight runs (extended)" : "", with_arcs, cases.size());
-  fmt::print("top-1 accuracy on listed effects:          {:5.1f}% ({}/{})\n", pct(listed_right, listed), listed_right, listed);
-  fmt::print("  without turn_scrub:                       {:5.1f}% ({}/{})\n", pct(listed_no_scrub_right, listed_no_scrub),
-             listed_no_scrub_right, listed_no_scrub);
-  fmt::print("  turn_scrub with figure-eights (named):    {:5.1f}% ({}/{})\n", pct(scrub[true].right, scrub[true].n),
-             scrub[true].right, scrub[true].n);
-  fmt::print("  turn_scrub, spot turns only (none + note): {:5.1f}% ({}/{}; note given {}/{})\n",
-             pct(scrub[false].right, scrub[false].n), scrub[false].right, scrub[false].n, scrub[false].noted,
-             scrub[false].n);
-  fmt::print("false alarms on clean campaigns:           {:5.1f}% ({}/{})\n", pct(false_alarms, clean), false_alarms, clean);
-  fmt::print("'unexplained' on outside effects:          {:5.1f}% ({}/{})\n", pct(outside_unexplained, outside),
-             outside_unexplained, outside);
-  fmt::print("'none' on negligible-mismatch campaigns:   {:5.1f}% ({}/{})\n", pct(negligible_none, negligible),
-             negligible_none, negligible);
-  fmt::print("both effects named on pair campaigns:      {:5.1f}% ({}/{})\n", pct(pairs_both, pairs), pairs_both, pairs);
-  fmt::print("baseline mode (--baseline CAL.json --kl --kr; all of the class's wrong parameters and effects named, "
-             "base_ok: none):\n");
-  for (const auto& [cls, t] : baseline) fmt::print("  {:<24} {:5.1f}% ({}/{})\n", cls, pct(t.right, t.n), t.right, t.n);
-  fmt::print("baseline mode, wrong parameter named:      {:5.1f}% ({}/{})\n", pct(base_wrong_named, base_wrong),
-             base_wrong_named, base_wrong);
-  fmt::print("median heldout_shrink (true effect):       {:.3f}\n", Median(heldout_true));
-  fmt::print("median heldout_shrink (verdict's effect):  {:.3f}\n", Median(heldout_verdict));
-  fmt::print("time per diagnosis: median {:.2f} s, max {:.2f} s\n", Median(times),
-             times.empty() ? 0.0 : *std::max_element(times.begin(), times.end()));
-  for (const auto& [stage, v] : stage_times) fmt::print("  {:<42} median {:.3f} s\n", stage, Median(v));
-  if (!args.json.empty()) {
-    nlohmann::json summary = {{"extended", args.extended},
-                              {"arc_fraction", args.extended ? 1.0 : args.arc_fraction},
-                              {"seed", args.seed},
-                              {"top1_listed", pct(listed_right, listed) / 100.0},
-                              {"top1_listed_without_turn_scrub", pct(listed_no_scrub_right, listed_no_scrub) / 100.0},
-                              {"false_alarm_rate", pct(false_alarms, clean) / 100.0},
-                              {"outside_unexplained_rate", pct(outside_unexplained, outside) / 100.0},
-                              {"negligible_none_rate", pct(negligible_none, negligible) / 100.0},
-                              {"pairs_both_named_rate", pct(pairs_both, pairs) / 100.0},
-                              {"baseline_wrong_parameter_named_rate", pct(base_wrong_named, base_wrong) / 100.0},
-                              {"median_heldout_shrink_true", Median(heldout_true)},
-                              {"median_heldout_shrink_verdict", Median(heldout_verdict)},
-                              {"median_seconds", Median(times)},
-                              {"confusion", confusion},
-                              {"cases", records}};
-    io::WriteFileAtomically(args.json, summary.dump(1) + "\n");
-  }
+  PrintSummary(args, classes, cases.size(), t);
+  if (!args.json.empty()) WriteJson(args, t);
   return 0;
 }

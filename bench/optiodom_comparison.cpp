@@ -302,19 +302,9 @@ void SelectionSchemes(const std::vector<io::OptiOdomDataset>& sets) {
   }
 }
 
-/// --sessions: every recording set of the folder (4 square, 6 circular, 4
-/// ivanjko sessions) calibrates in turn; each calibration is tested on
-/// every OTHER set's runs (mean final position error, odometry from the
-/// first ground-truth pose: the OptiOdom protocol). Columns split the
-/// pairs by what calibrated and what was tested.
-int Sessions(const fs::path& root) {
-  std::vector<io::OptiOdomDataset> sets;
-  for (const char* cat : {"square", "circular", "ivanjko"}) {
-    std::vector<fs::path> dirs;
-    for (const auto& e : fs::directory_iterator(root / cat)) dirs.push_back(e.path());
-    std::sort(dirs.begin(), dirs.end());
-    for (const auto& d : dirs) sets.push_back(io::ImportOptiOdom(d.string()));
-  }
+/// The calibrations --sessions compares, in the order of its table (plain
+/// least squares third: the reference column).
+std::vector<SessionCandidate> SessionCandidates() {
   auto refined = [](RefineOptions o) {
     return [o](const io::OptiOdomDataset& ds) -> std::optional<RobotParams> {
       return RefineFromTrajectories({{ds.robot, &ds.runs}}, ds.robot, o).refined;
@@ -349,15 +339,31 @@ int Sessions(const fs::path& root) {
   for (double hw : {0.0, 0.5, 1.0, 2.0, 4.0}) {
     cands.push_back({fmt::format("refined, session_frame, heading {}", hw), refined(with(StartPose::kSessionFrame, hw))});
   }
-  const std::vector<TrajectoryData>* no_unseen = nullptr;
-  cands.push_back({"calibrate --ros2 (defaults)", [&](const io::OptiOdomDataset& ds) -> std::optional<RobotParams> {
+  cands.push_back({"calibrate --ros2 (defaults)", [](const io::OptiOdomDataset& ds) -> std::optional<RobotParams> {
                      if (ds.category != "square") return std::nullopt;
-                     return CalibrateWrites(ds, false, no_unseen);
+                     return CalibrateWrites(ds, false, nullptr);
                    }});
-  cands.push_back({"calibrate --ros2 --refine", [&](const io::OptiOdomDataset& ds) -> std::optional<RobotParams> {
+  cands.push_back({"calibrate --ros2 --refine", [](const io::OptiOdomDataset& ds) -> std::optional<RobotParams> {
                      if (ds.category != "square") return std::nullopt;
-                     return CalibrateWrites(ds, true, no_unseen);
+                     return CalibrateWrites(ds, true, nullptr);
                    }});
+  return cands;
+}
+
+/// --sessions: every recording set of the folder (4 square, 6 circular, 4
+/// ivanjko sessions) calibrates in turn; each calibration is tested on
+/// every OTHER set's runs (mean final position error, odometry from the
+/// first ground-truth pose: the OptiOdom protocol). Columns split the
+/// pairs by what calibrated and what was tested.
+int Sessions(const fs::path& root) {
+  std::vector<io::OptiOdomDataset> sets;
+  for (const char* cat : {"square", "circular", "ivanjko"}) {
+    std::vector<fs::path> dirs;
+    for (const auto& e : fs::directory_iterator(root / cat)) dirs.push_back(e.path());
+    std::sort(dirs.begin(), dirs.end());
+    for (const auto& d : dirs) sets.push_back(io::ImportOptiOdom(d.string()));
+  }
+  const std::vector<SessionCandidate> cands = SessionCandidates();
   // err[candidate][source][target] (NaN: not computed).
   const double nan = std::numeric_limits<double>::quiet_NaN();
   std::vector<std::vector<std::vector<double>>> err(cands.size());
