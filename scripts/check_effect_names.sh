@@ -22,8 +22,24 @@ if ((${#names[@]} < 19)); then
   exit 1
 fi
 # Their parameters' fields in Effects (effects/values.hpp): effect-specific code too.
-mapfile -t fields < <(grep -ho '&Effects::[a-z_0-9]*' lib/effects/*.cpp | sed 's/&Effects:://' | sort -u)
-pattern="EffectKind::k[A-Za-z]+|\\b($(IFS='|'; echo "${names[*]}"))\\b|[.>]($(IFS='|'; echo "${fields[*]}"))\\b"
+mapfile -t all_fields < <(grep -ho '&Effects::[a-z_0-9]*' lib/effects/*.cpp | sed 's/&Effects:://' | sort -u)
+# A field name that a public struct of lib/ (a header outside lib/effects/) declares
+# as a member of its own (NoiseParams::bump_rate, the noise model's bump
+# rate) is ambiguous: it counts only when read from an Effects, i.e. through
+# `Effects::`, a member called `effects`, or a name the file declares as an
+# Effects (`Effects& fx_`).
+fields=() ambiguous=()
+for f in "${all_fields[@]}"; do
+  if grep -rqE "^[[:space:]]*(double|float|int|bool)[[:space:]]+([a-z_0-9]+[^,;]*,[[:space:]]*)*$f[[:space:]]*[=;,]" \
+    --include='*.hpp' lib --exclude-dir=effects; then
+    ambiguous+=("$f")
+  else
+    fields+=("$f")
+  fi
+done
+alt() { local IFS='|'; echo "$*"; }
+pattern="EffectKind::k[A-Za-z]+|\\b($(alt "${names[@]}"))\\b"
+((${#fields[@]})) && pattern+="|[.>]($(alt "${fields[@]}"))\\b"
 declare -A pending=()
 if [[ -f scripts/effect_names_pending.txt ]]; then
   while read -r file max; do
@@ -31,6 +47,17 @@ if [[ -f scripts/effect_names_pending.txt ]]; then
     pending[$file]=$max
   done <scripts/effect_names_pending.txt
 fi
+# The pattern for one file: the ambiguous fields through the file's own
+# Effects names.
+file_pattern() {
+  local p=$pattern vars
+  if ((${#ambiguous[@]})); then
+    vars=$(sed 's|//.*$||' "$1" | grep -oE '\bEffects[[:space:]]*&?[[:space:]]*[a-z_][a-z_0-9]*' |
+      sed -E 's/^Effects[[:space:]]*&?[[:space:]]*//' | sort -u | tr '\n' '|')
+    p+="|(Effects::|\\b(${vars}effects)[.])($(alt "${ambiguous[@]}"))\\b"
+  fi
+  echo "$p"
+}
 declare -A count=()
 hits=()
 while IFS= read -r -d '' file; do
@@ -38,7 +65,7 @@ while IFS= read -r -d '' file; do
     [[ -z $hit ]] && continue
     count[$file]=$((${count[$file]:-0} + 1))
     hits+=("$file:$hit")
-  done < <(sed 's|//.*$||' "$file" | grep -nE "$pattern" | cut -c1-160 || true)
+  done < <(sed 's|//.*$||' "$file" | grep -nE "$(file_pattern "$file")" | cut -c1-160 || true)
 done < <(find lib -path lib/effects -prune -o \( -name '*.cpp' -o -name '*.hpp' \) -print0 | sort -z)
 status=0
 for file in "${!count[@]}"; do

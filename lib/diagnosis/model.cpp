@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "core/angles.hpp"
 #include "effects/registry.hpp"
@@ -81,19 +82,65 @@ inline Pose2 Relative(const Pose2& a, const Pose2& b) {
   return {c * dx + s * dy, -s * dx + c * dy, b.theta - a.theta};
 }
 
+/// The effects whose mean model moves the robot after a stop (a coast:
+/// Effect::PredictStop): those with mean terms and at_motion_stops, each
+/// with its parameters' indices in ParamVector (at most kMaxStopTerms).
+constexpr std::size_t kMaxStopEffects = 2, kMaxStopTerms = 6;
+struct StopEffect {
+  const effects::Effect* effect = nullptr;
+  std::size_t count = 0;
+  int terms[kMaxStopTerms] = {};
+};
+struct StopEffectList {
+  StopEffect list[kMaxStopEffects];
+  std::size_t count = 0;
+};
+
+const StopEffectList& StopEffects() {
+  static const StopEffectList all = [] {
+    StopEffectList out;
+    for (const effects::Effect* e : effects::All()) {
+      const effects::Descriptor& d = e->Describe();
+      if (!d.at_motion_stops || d.mean_terms.empty()) continue;
+      if (out.count == kMaxStopEffects || d.mean_terms.size() > kMaxStopTerms)
+        throw std::logic_error("diagnosis/model.cpp: raise kMaxStopEffects or kMaxStopTerms");
+      StopEffect& s = out.list[out.count++];
+      s.effect = e;
+      s.count = d.mean_terms.size();
+      std::copy(d.mean_terms.begin(), d.mean_terms.end(), s.terms);
+    }
+    return out;
+  }();
+  return all;
+}
+
 /// The true robot of `p` (model/true_robot.hpp: c_L, c_R of E_d) plus the
-/// diagnosis' effects on wheel travel and heading.
+/// diagnosis' effects on wheel travel and heading, and the values of the
+/// effects that move it after a stop (StopEffects, those PredictsStop).
 struct TrueFactors {
   double c_L, c_R, scale, back, wheelbase, scrub;
-  double kappa, swivel, slide_d, slide_a;  ///< castor_kick, castor_swivel, stop_slide
-  double slide_arc, slide_back;            ///< stop_slide's shape (model.hpp)
+  double kappa, swivel;  ///< heading kicks where motions start (model.hpp kParamKappa, kParamSwivel)
+  struct Stop {
+    const effects::Effect* effect;
+    double v[kMaxStopTerms];
+  };
+  Stop stop[kMaxStopEffects];
+  std::size_t stops = 0;  ///< of stop[]
 };
 
 TrueFactors Factors(const ParamVector& p, double wheelbase) {
   const double E_d = p[kParamEd];
-  return {CorrectionLeft(E_d),    CorrectionRight(E_d),  1.0 + p[kParamScale], 1.0 + p[kParamAsym],
-          p[kParamEb] * wheelbase, 1.0 - p[kParamScrub], p[kParamKappa],      p[kParamSwivel],
-          p[kParamSlideD],         p[kParamSlideA],       p[kParamSlideArc],   p[kParamSlideBack]};
+  TrueFactors f{CorrectionLeft(E_d),    CorrectionRight(E_d),  1.0 + p[kParamScale], 1.0 + p[kParamAsym],
+                p[kParamEb] * wheelbase, 1.0 - p[kParamScrub], p[kParamKappa],      p[kParamSwivel],
+                {},                      0};
+  const StopEffectList& se = StopEffects();
+  for (std::size_t k = 0; k < se.count; ++k) {
+    TrueFactors::Stop& s = f.stop[f.stops];
+    s.effect = se.list[k].effect;
+    for (std::size_t j = 0; j < se.list[k].count; ++j) s.v[j] = p[static_cast<std::size_t>(se.list[k].terms[j])];
+    if (s.effect->PredictsStop(s.v)) ++f.stops;
+  }
+  return f;
 }
 
 }  // namespace
@@ -131,41 +178,17 @@ inline double HeadingFactor(const TrueFactors& f, signed char cls) {
   return cls == static_cast<signed char>(sim::MotionClass::kTurn) ? f.scrub : 1.0;
 }
 
-/// How far a coast at initial rate `rate` (signed speed or turn rate) with
-/// coefficient k (d or a) has gone tau seconds after the wheels stopped:
-/// uniform deceleration 1 / (2 |k|) until it rests after 2 |k| |rate|,
-/// covering k rate |rate| in all (a negative k, which a fit may try, coasts
-/// backwards: the slide stays smooth in k through 0).
-double CoastProgress(double rate, double k, double tau) {
-  if (k == 0.0 || !(tau > 0.0) || rate == 0.0) return 0.0;
-  const double v = std::abs(rate), kk = std::abs(k), t = std::min(tau, 2.0 * kk * v);
-  return (k > 0.0 ? 1.0 : -1.0) * (rate > 0.0 ? 1.0 : -1.0) * (v * t - t * t / (4.0 * kk));
-}
-
-/// stop_slide at stop `st` from pose q: the coast between tau0 and tau1
-/// seconds after the wheels stopped, at the true speed the motion ended
-/// with (along the heading, or turning in the turn's sense). After an arc
-/// the heading turns on by slide_arc w/v times the distance coasted: 1, the
-/// coast keeps the arc's curvature; 2, the heading keeps turning at the
-/// arc's rate w through the whole coast (2 d v long) while the speed runs
-/// down -- a rigid body on two locked wheels whose contacts both slide
-/// forward (v > w b / 2), so that their friction forces cancel in torque
-/// (DART: 2.1-2.6). A backward coast is (1 + slide_back) times d v^2.
-Pose2 Slide(const DiagRun::Stop& st, const TrueFactors& f, const RunFactors& wheels, Pose2 q, double tau0, double tau1) {
-  double vl, vr;
-  TrueTravel(f, wheels, st.rate_left, st.rate_right, vl, vr);
-  if (st.cls == static_cast<signed char>(sim::MotionClass::kTurn)) {
-    const double w = (vr - vl) / f.wheelbase;
-    q.theta += CoastProgress(w, f.slide_a, tau1) - CoastProgress(w, f.slide_a, tau0);
-    return q;
-  }
-  const double v = 0.5 * (vl + vr);
-  const double d = v < 0.0 ? f.slide_d * (1.0 + f.slide_back) : f.slide_d;
-  const double along = CoastProgress(v, d, tau1) - CoastProgress(v, d, tau0);
-  const double turn = f.slide_arc != 0.0 && std::abs(v) > 1e-9 ? f.slide_arc * (vr - vl) / f.wheelbase / v * along : 0.0;
-  // Along the curve the coast follows (constant curvature): its chord.
-  const double h = 0.5 * turn, chord = along * Sinc(h);
-  return {q.x + chord * std::cos(q.theta + h), q.y + chord * std::sin(q.theta + h), q.theta + turn};
+/// What follows stop `st` from pose q: the effects' coasts (Effect::
+/// PredictStop) between tau0 and tau1 seconds after the wheels stopped, at
+/// the true speeds the motion ended with.
+Pose2 AfterStop(const DiagRun::Stop& st, const TrueFactors& f, const RunFactors& wheels, Pose2 q, double tau0,
+                double tau1) {
+  effects::StopMotion m;
+  m.turn = st.cls == static_cast<signed char>(sim::MotionClass::kTurn);
+  TrueTravel(f, wheels, st.rate_left, st.rate_right, m.vl, m.vr);
+  m.wheelbase = f.wheelbase;
+  for (std::size_t k = 0; k < f.stops; ++k) q = f.stop[k].effect->PredictStop(f.stop[k].v, m, q, tau0, tau1);
+  return q;
 }
 
 /// The pose after fraction `u` in [0, 1] of interval i's time from `q`
@@ -195,17 +218,17 @@ Pose2 AdvanceInterval(const DiagRun& r, std::size_t i, const TrueFactors& f, con
   const double frac = u >= 1.0 ? 1.0 : u <= w0 || w1 <= w0 ? 0.0 : std::min(1.0, (u - w0) / (w1 - w0));
   TrueTravel(f, wheels, frac * dl, frac * dr, l, rr);
   q = TrueStep(q, l, rr, f.wheelbase, HeadingFactor(f, r.interval_class[i]));
-  if (f.slide_d == 0.0 && f.slide_a == 0.0) return q;
-  // stop_slide: the coast from the wheels' stop (at the end of the stop
-  // interval's active window) on into the still intervals after it.
+  if (f.stops == 0) return q;
+  // A coast (Effect::PredictStop) from the wheels' stop (at the end of the
+  // stop interval's active window) on into the still intervals after it.
   const double dt = r.t[i + 1] - r.t[i], t_now = r.t[i] + std::min(u, 1.0) * dt;
   if (const int stop = r.stop_of.empty() ? -1 : r.stop_of[i]; stop >= 0 && frac >= 1.0) {
     const DiagRun::Stop& st = r.stops[static_cast<std::size_t>(stop)];
-    q = Slide(st, f, wheels, q, 0.0, t_now - st.t_stop);
+    q = AfterStop(st, f, wheels, q, 0.0, t_now - st.t_stop);
   }
   if (const int coast = r.coast_of.empty() ? -1 : r.coast_of[i]; coast >= 0) {
     const DiagRun::Stop& st = r.stops[static_cast<std::size_t>(coast)];
-    q = Slide(st, f, wheels, q, r.t[i] - st.t_stop, t_now - st.t_stop);
+    q = AfterStop(st, f, wheels, q, r.t[i] - st.t_stop, t_now - st.t_stop);
   }
   return q;
 }

@@ -11,6 +11,7 @@
 // only, so that both the simulator and the diagnosis can use it.
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <optional>
@@ -19,7 +20,9 @@
 #include <utility>
 #include <vector>
 
+#include "core/pose2.hpp"
 #include "core/robot.hpp"
+#include "effects/run_hooks.hpp"
 #include "effects/values.hpp"
 
 namespace umbmark::effects {
@@ -160,6 +163,10 @@ struct Descriptor {
   std::vector<int> mean_terms{};
   /// The noise component it switches on (a random effect; kNone else).
   NoiseTerm noise_term = NoiseTerm::kNone;
+  /// The id of its own random stream in the simulator (StreamSeed of the
+  /// seed and the run; RandomSource of StartRun). Part of every simulated
+  /// campaign's bits: never change one. 0: 0x10000 + order.
+  std::uint64_t sim_stream = 0;
 };
 
 class Effect {
@@ -216,6 +223,30 @@ class Effect {
   /// Simulation: adds to the point the ground truth reports, in the robot
   /// frame (dx, dy [m]), and to its heading (dtheta [rad]). Default: none.
   virtual void GroundTruthPoint(const Effects& /*e*/, double& /*dx*/, double& /*dy*/, double& /*dtheta*/) const {}
+  /// Simulation: the effect's state in one run (run_hooks.hpp RunEffect:
+  /// kicks where motions start, what it adds to each step's wheel travel,
+  /// a drift of the chassis, a move as the robot comes to a standstill), or
+  /// nullptr (the default: nothing per motion or step). Called once per run
+  /// when Active(e); `rng`: its own stream (Descriptor::sim_stream), to be
+  /// drawn from only when needed.
+  virtual std::unique_ptr<RunEffect> StartRun(const Effects& /*e*/, RandomSource& /*rng*/) const { return nullptr; }
+  /// Simulation: a factor of a wheel's true travel while it turns backwards
+  /// (the simulator multiplies the effects' factors). Default: 1.
+  virtual double BackwardFactor(const Effects& /*e*/) const { return 1.0; }
+  /// Simulation: a factor of the true heading change in spot turns
+  /// (multiplied over the effects). Default: 1.
+  virtual double TurnHeadingFactor(const Effects& /*e*/) const { return 1.0; }
+  /// Simulation: the correlation of the two wheels' noise it adds (summed
+  /// over the effects). Default: 0.
+  virtual double WheelNoiseCorrelation(const Effects& /*e*/) const { return 0.0; }
+  /// Simulation: a coast after a stop (run_hooks.hpp SimCoast) that ends a
+  /// spot turn (`turn`) or a straight or arc motion whose wheels ended at
+  /// true speeds rate_l, rate_r [m/s] on a robot of true wheelbase b [m].
+  /// False: none (the first effect that answers true coasts). Default: none.
+  virtual bool StopCoast(const Effects& /*e*/, bool /*turn*/, double /*rate_l*/, double /*rate_r*/, double /*b*/,
+                         SimCoast& /*c*/) const {
+    return false;
+  }
   /// Simulation: why a campaign of `runs` runs cannot have these values
   /// (e.g. a drift that shrinks a wheel to nothing), or empty.
   virtual std::string CheckCampaign(const Effects& /*e*/, int /*runs*/) const { return {}; }
@@ -233,6 +264,20 @@ class Effect {
   /// fitted counterpart of TrueWheels. Called once per run and prediction,
   /// never per sample. Default: none.
   virtual void PredictWheels(const double* /*v*/, int /*run_index*/, double& /*left*/, double& /*right*/) const {}
+
+  /// Model prediction of what follows a stop (the counterpart of
+  /// StopCoast) for an effect with mean_terms and at_motion_stops: whether
+  /// values `v` (v[k]: the fitted value of mean_terms[k]) move anything
+  /// after a stop. Default: false.
+  virtual bool PredictsStop(const double* /*v*/) const { return false; }
+  /// Model prediction: the pose q moved on by what happens between tau0
+  /// and tau1 seconds after the wheels stopped at the end of motion m, at
+  /// values v (as PredictsStop). Called per interval at or after a stop,
+  /// only when PredictsStop(v). Default: q.
+  virtual Pose2 PredictStop(const double* /*v*/, const StopMotion& /*m*/, Pose2 q, double /*tau0*/,
+                            double /*tau1*/) const {
+    return q;
+  }
 
   /// A note for the report when the campaign's design cannot show the
   /// effect apart from the baseline and it is not named: why, and which

@@ -2,9 +2,13 @@
 // straight or arc motion at speed v the chassis coasts on by d v^2 m along
 // its last direction of travel; after a spot turn at rate w it turns on by
 // a w^2 rad. Beyond the contract its shape (arc, back; values.hpp).
+#include <algorithm>
+#include <cmath>
+
 #include <fmt/format.h>
 
 #include "effects/effect.hpp"
+#include "kinematics/diff_drive.hpp"
 
 namespace umbmark::effects {
 namespace {
@@ -17,6 +21,17 @@ constexpr double kMaxSlideD = 1.0;
 constexpr double kMaxSlideA = 1.0;
 constexpr double kMaxSlideArc = 4.0;
 constexpr double kMinSlideBack = -0.9, kMaxSlideBack = 4.0;
+
+/// How far a coast at initial rate `rate` (signed speed or turn rate) with
+/// coefficient k (d or a) has gone tau seconds after the wheels stopped:
+/// uniform deceleration 1 / (2 |k|) until it rests after 2 |k| |rate|,
+/// covering k rate |rate| in all (a negative k, which a fit may try, coasts
+/// backwards: the slide stays smooth in k through 0).
+double CoastProgress(double rate, double k, double tau) {
+  if (k == 0.0 || !(tau > 0.0) || rate == 0.0) return 0.0;
+  const double v = std::abs(rate), kk = std::abs(k), t = std::min(tau, 2.0 * kk * v);
+  return (k > 0.0 ? 1.0 : -1.0) * (rate > 0.0 ? 1.0 : -1.0) * (v * t - t * t / (4.0 * kk));
+}
 
 class StopSlide final : public Effect {
  public:
@@ -78,6 +93,43 @@ class StopSlide final : public Effect {
 
   std::string PlainProblem(const Params& p) const override {
     return fmt::format("the robot slides on after its wheels stop (d = {:.3g} s^2/m)", Get(p, "d"));
+  }
+
+  // Simulation: the coast at the speed the motion ended with (backward
+  // (1 + back) times as long; after an arc it turns on by arc w/v per metre).
+  bool StopCoast(const Effects& e, bool turn, double rate_l, double rate_r, double b, SimCoast& c) const override {
+    if (e.slide_d == 0.0 && e.slide_a == 0.0) return false;
+    c.rate = turn ? (rate_r - rate_l) / b : 0.5 * (rate_l + rate_r);
+    c.k = turn ? e.slide_a : e.slide_d * (c.rate < 0.0 ? 1.0 + e.slide_back : 1.0);
+    if (!turn && c.rate != 0.0) c.curvature = e.slide_arc * (rate_r - rate_l) / b / c.rate;
+    return true;
+  }
+
+  // Model prediction (v: d, a, arc, back): the coast between tau0 and tau1
+  // seconds after the wheels stopped, at the true speed the motion ended
+  // with (along the heading, or turning in the turn's sense). After an arc
+  // the heading turns on by arc w/v times the distance coasted: 1, the
+  // coast keeps the arc's curvature; 2, the heading keeps turning at the
+  // arc's rate w through the whole coast (2 d v long) while the speed runs
+  // down -- a rigid body on two locked wheels whose contacts both slide
+  // forward (v > w b / 2), so that their friction forces cancel in torque
+  // (DART: 2.1-2.6). A backward coast is (1 + back) times d v^2.
+  bool PredictsStop(const double* v) const override { return v[0] != 0.0 || v[1] != 0.0; }
+  Pose2 PredictStop(const double* v, const StopMotion& m, Pose2 q, double tau0, double tau1) const override {
+    const double slide_d = v[0], slide_a = v[1], slide_arc = v[2], slide_back = v[3];
+    if (m.turn) {
+      const double w = (m.vr - m.vl) / m.wheelbase;
+      q.theta += CoastProgress(w, slide_a, tau1) - CoastProgress(w, slide_a, tau0);
+      return q;
+    }
+    const double speed = 0.5 * (m.vl + m.vr);
+    const double d = speed < 0.0 ? slide_d * (1.0 + slide_back) : slide_d;
+    const double along = CoastProgress(speed, d, tau1) - CoastProgress(speed, d, tau0);
+    const double turn =
+        slide_arc != 0.0 && std::abs(speed) > 1e-9 ? slide_arc * (m.vr - m.vl) / m.wheelbase / speed * along : 0.0;
+    // Along the curve the coast follows (constant curvature): its chord.
+    const double h = 0.5 * turn, chord = along * Sinc(h);
+    return {q.x + chord * std::cos(q.theta + h), q.y + chord * std::sin(q.theta + h), q.theta + turn};
   }
 
   // d [s^2/m] and a [s^2/rad] in their own units; the shape (arc, back) is a
