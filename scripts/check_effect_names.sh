@@ -82,5 +82,11 @@ for file in "${!pending[@]}"; do
     status=1
   fi
 done
-((status == 0)) && echo "effect names: none outside lib/effects/ beyond scripts/effect_names_pending.txt"
+if ((status == 0)); then
+  if ((${#pending[@]} == 0)); then
+    echo "effect names: no file outside lib/effects/ names an effect"
+  else
+    echo "effect names: none outside lib/effects/ beyond scripts/effect_names_pending.txt"
+  fi
+fi
 exit $status

@@ -77,8 +77,28 @@ std::string EvidenceInWords(double gain, double evidence, double heldout_shrink,
 
 namespace {
 
+/// The effects experiment `x` tells apart (Descriptor::separated_by, in
+/// separated_rank order), joined as "a, b and c" (`more`: a last item
+/// after them, e.g. "the wheelbase").
+std::string SeparatedBy(effects::SeparatingExperiment x, const char* more = nullptr) {
+  std::vector<const effects::Effect*> list;
+  for (const effects::Effect* e : effects::All())
+    if (e->Describe().separated_by == x) list.push_back(e);
+  std::stable_sort(list.begin(), list.end(), [](const effects::Effect* a, const effects::Effect* b) {
+    return a->Describe().separated_rank < b->Describe().separated_rank;
+  });
+  std::vector<std::string> names;
+  for (const effects::Effect* e : list) names.emplace_back(e->Name());
+  if (more != nullptr) names.emplace_back(more);
+  std::string out;
+  for (std::size_t k = 0; k < names.size(); ++k)
+    out += (k == 0 ? "" : k + 1 == names.size() ? " and " : ", ") + names[k];
+  return out;
+}
+
 /// The experiments and motions a campaign lacks to tell effects apart.
 std::vector<std::string> MissingDesign(const CampaignData& c) {
+  using X = effects::SeparatingExperiment;
   bool square = false, back_forth = false, free_path = false, pauses = false, arcs = false;
   for (const auto& e : c.experiments) {
     square |= e.kind == ExperimentKind::kSquare;
@@ -96,17 +116,19 @@ std::vector<std::string> MissingDesign(const CampaignData& c) {
   if (!back_forth)
     out.push_back(fmt::format("Add a back_and_forth experiment (drive a straight line out and back, 10 runs): driving "
                               "the same line forwards and backwards "
-                              "separates direction_asymmetry, scale_error and castor_kick{}.",
-                              squares_only ? ", which squares alone confuse" : ""));
+                              "separates {}{}.",
+                              SeparatedBy(X::kBackAndForth), squares_only ? ", which squares alone confuse" : ""));
   if (!square)
     out.push_back("Add squares in both directions (UMBmark, 5+ runs each): they pin E_d and E_b, so the other "
                   "effects stand out against a well-determined baseline.");
   if (!free_path && !arcs)
-    out.push_back("Add free paths with arcs of different radii: turn_scrub, gt_offset and the wheelbase are told "
-                  "apart only when the robot turns while it drives.");
+    out.push_back(fmt::format("Add free paths with arcs of different radii: {} are told apart only when the robot "
+                              "turns while it drives.",
+                              SeparatedBy(X::kTurnsWhileDriving, "the wheelbase")));
   if (!pauses)
-    out.push_back("Stop for 1-2 s between legs: standstills show motion while the encoders are still "
-                  "(standstill_motion) and average the ground truth's noise down.");
+    out.push_back(fmt::format("Stop for 1-2 s between legs: standstills show motion while the encoders are still "
+                              "({}) and average the ground truth's noise down.",
+                              SeparatedBy(X::kStandstills)));
   return out;
 }
 

@@ -9,6 +9,33 @@
 namespace umbmark::effects {
 namespace {
 
+/// A run's bumps: per wheel, the travel left to the next bump (exponential
+/// with mean 1 / rate), each bump N(0, sigma^2) m, from the run's stream.
+class BumpRun final : public RunEffect {
+ public:
+  BumpRun(double rate, double sigma, RandomSource& rng) : rate_(rate), sigma_(sigma), rng_(rng) {
+    to_bump_[0] = rng_.Exponential() / rate_;
+    to_bump_[1] = rng_.Exponential() / rate_;
+  }
+  void StepTravel(const SimMotion& /*m*/, const SimStep& s, double (&travel)[2]) override {
+    for (int w = 0; w < 2; ++w) {
+      double left_to_roll = s.mean_abs[w];
+      while (to_bump_[w] <= left_to_roll) {
+        travel[w] += sigma_ * rng_.Normal();
+        left_to_roll -= to_bump_[w];
+        to_bump_[w] = rng_.Exponential() / rate_;
+        s.bumps[w] += 1;
+      }
+      to_bump_[w] -= left_to_roll;
+    }
+  }
+
+ private:
+  double rate_, sigma_;
+  RandomSource& rng_;
+  double to_bump_[2];
+};
+
 class BumpOutliers final : public Effect {
  public:
   BumpOutliers()
@@ -20,7 +47,12 @@ class BumpOutliers final : public Effect {
                 .definition =
                     "per wheel, Poisson bumps with `rate` per metre of travel, each adding N(0, sigma^2) m of travel",
                 .parameters = {{"rate", &Effects::bump_rate, "1/m"}, {"sigma", &Effects::bump_sigma, "m"}},
-                .noise_term = NoiseTerm::kBumps}) {}
+                .noise_term = NoiseTerm::kBumps,
+                .sim_stream = 102}) {}
+
+  std::unique_ptr<RunEffect> StartRun(const Effects& e, RandomSource& rng) const override {
+    return std::make_unique<BumpRun>(e.bump_rate, e.bump_sigma, rng);
+  }
   Params FromNoise(const NoiseValues& n) const override { return {{"rate", n.bumps_per_m}, {"sigma", std::sqrt(n.bump_var)}}; }
 
   // Bumps need both a rate and a size.

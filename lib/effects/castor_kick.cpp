@@ -9,6 +9,19 @@
 namespace umbmark::effects {
 namespace {
 
+/// A run's kicks: +kappa at a forward start from standstill, -kappa at a
+/// backward one (spot turns excluded).
+class KickRun final : public RunEffect {
+ public:
+  explicit KickRun(double kappa) : kappa_(kappa) {}
+  void MotionStart(const SimMotion& m, Pose2& pose) override {
+    if (m.from_standstill && !m.turn) pose.theta += (m.left_m + m.right_m >= 0.0 ? 1.0 : -1.0) * kappa_;
+  }
+
+ private:
+  double kappa_;
+};
+
 class CastorKick final : public Effect {
  public:
   CastorKick()
@@ -20,7 +33,13 @@ class CastorKick final : public Effect {
                 .definition = "at every start from standstill the true heading jumps by kappa (forward) or -kappa "
                               "(backward); spot turns excluded",
                 .parameters = {{"kappa", &Effects::castor_kappa, "rad", 0.005}},
-                .mean_terms = {kTermKappa}}) {}
+                .mean_terms = {kTermKappa},
+                .separated_by = SeparatingExperiment::kBackAndForth,
+                .separated_rank = 2}) {}
+
+  std::unique_ptr<RunEffect> StartRun(const Effects& e, RandomSource& /*rng*/) const override {
+    return std::make_unique<KickRun>(e.castor_kappa);
+  }
 
   // A heading kick is a pose size already: below the heading floor.
   std::string PracticalFloor(const Params& p, const CampaignScale& c) const override {

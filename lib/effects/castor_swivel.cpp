@@ -14,6 +14,32 @@ namespace {
 // A swivel castor's kick of at most 0.5 rad (29 deg).
 constexpr double kMaxSwivelKappa = 0.5;
 
+/// A run's swivel kicks: it remembers the last spot turn's sign since the
+/// last straight or arc motion (0: none) and that motion's drive sign (0:
+/// none yet); a reversal draws the kick's sign from the run's stream.
+class SwivelRun final : public RunEffect {
+ public:
+  SwivelRun(double kappa, RandomSource& rng) : kappa_(kappa), rng_(rng) {}
+  void MotionStart(const SimMotion& m, Pose2& pose) override {
+    if (!m.motion_start) return;
+    if (m.turn) {
+      last_turn_sign_ = m.sign;
+      return;
+    }
+    if (last_turn_sign_ != 0)
+      pose.theta += last_turn_sign_ * kappa_;
+    else if (last_drive_sign_ != 0 && m.sign != last_drive_sign_)
+      pose.theta += (rng_.Uniform() < 0.5 ? -1.0 : 1.0) * kappa_;
+    last_drive_sign_ = m.sign;
+    last_turn_sign_ = 0;
+  }
+
+ private:
+  double kappa_;
+  RandomSource& rng_;
+  int last_turn_sign_ = 0, last_drive_sign_ = 0;
+};
+
 class CastorSwivel final : public Effect {
  public:
   CastorSwivel()
@@ -27,7 +53,12 @@ class CastorSwivel final : public Effect {
                               "+kappa or -kappa with equal probability",
                 // As castor_kick.
                 .parameters = {{"kappa", &Effects::swivel_kappa, "rad", 0.005}},
-                .mean_terms = {kTermSwivel}}) {}
+                .mean_terms = {kTermSwivel},
+                .sim_stream = 108}) {}
+
+  std::unique_ptr<RunEffect> StartRun(const Effects& e, RandomSource& rng) const override {
+    return std::make_unique<SwivelRun>(e.swivel_kappa, rng);
+  }
 
   // The range first: it catches NaN with the allowed range.
   std::string Check(const Effects& e) const override {

@@ -35,6 +35,9 @@ class CorrelatedNoise final : public Effect {
     return fmt::format("the two wheels' errors are correlated (rho = {:.2f})", Get(p, "rho"));
   }
 
+  // Simulation: the wheels' noise correlated by rho.
+  double WheelNoiseCorrelation(const Effects& e) const override { return e.noise_rho; }
+
  protected:
   std::string Range(const Effects& e) const override {
     if (!(std::abs(e.noise_rho) <= 1.0)) return fmt::format("correlated_noise.rho = {} must be in [-1, 1]", e.noise_rho);

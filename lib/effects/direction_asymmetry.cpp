@@ -18,7 +18,8 @@ class DirectionAsymmetry final : public Effect {
                 .effect_class = EffectClass::kMechanism,
                 .definition = "a wheel turning backwards has (1 + a) times its forward effective diameter",
                 .parameters = {{"a", &Effects::asymmetry_a, "", 0.01}},
-                .mean_terms = {kTermAsym}}) {}
+                .mean_terms = {kTermAsym},
+                .separated_by = SeparatingExperiment::kBackAndForth}) {}
 
   std::string Unphysical(const Params& p, int /*runs*/, const Params& /*se*/) const override {
     if (std::abs(Get(p, "a")) > 0.1)
@@ -41,6 +42,9 @@ class DirectionAsymmetry final : public Effect {
     if (param == "a") return {1e2, " %"};
     return {0.0, ""};
   }
+
+  // Simulation: backward travel 1 + a times the forward.
+  double BackwardFactor(const Effects& e) const override { return 1.0 + e.asymmetry_a; }
 
  protected:
   std::string Range(const Effects& e) const override {

@@ -130,6 +130,35 @@ struct DesignFacts {
   double E_b = 1.0;  ///< the baseline's wheelbase factor
 };
 
+/// What a parameter error of a given model (`diagnose --baseline`) needs to
+/// describe its fit and the change it asks for.
+struct GivenContext {
+  RobotParams recorded;  ///< the campaign's recorded robot
+  RobotParams given;     ///< the given model's (what the simulation uses)
+  /// The given model relative to `recorded` (the mean model's E_d, E_b and
+  /// scale s).
+  double E_d = 1.0, E_b = 1.0, scale = 0.0;
+  double k_L = 0.0, k_R = 0.0;  ///< the given wheel noise [m^1/2]
+};
+
+/// One change of the given model that a parameter error asks for.
+struct GivenCorrection {
+  std::string parameter;  ///< e.g. "wheelbase_m"
+  double given = 0.0;     ///< the simulation's value
+  double corrected = 0.0; ///< what the runs show
+  std::string unit;       ///< "m", "m^1/2"
+  std::string text;       ///< one sentence: what is wrong, by how much, what to set
+};
+
+/// The experiment that tells an effect apart from others (the advice asks
+/// for it, naming the effect, when a campaign lacks it).
+enum class SeparatingExperiment {
+  kNone,
+  kBackAndForth,       ///< a straight line driven out and back
+  kTurnsWhileDriving,  ///< free paths with arcs of different radii
+  kStandstills,        ///< stops of 1-2 s between legs
+};
+
 /// Everything an effect is that needs no code.
 struct Descriptor {
   std::string_view name;      ///< contract name (JSON key, --effect NAME)
@@ -167,6 +196,11 @@ struct Descriptor {
   /// seed and the run; RandomSource of StartRun). Part of every simulated
   /// campaign's bits: never change one. 0: 0x10000 + order.
   std::uint64_t sim_stream = 0;
+  /// The experiment that tells it apart (the advice's sentence for a
+  /// campaign that lacks it names the effects of that experiment in
+  /// separated_rank order).
+  SeparatingExperiment separated_by = SeparatingExperiment::kNone;
+  int separated_rank = 0;
 };
 
 class Effect {
@@ -205,6 +239,19 @@ class Effect {
   virtual std::string NullFit(const Params& /*p*/) const { return {}; }
   /// The concrete change to make, with the fitted numbers, or empty.
   virtual std::string ConcreteChange(const Params& /*p*/, const AdviceContext& /*c*/) const { return {}; }
+  /// `diagnose --baseline`: the fitted values `raw` (the mean model's names:
+  /// E_d, E_b, s, k_L, k_R, ...) as the effect reports them against the
+  /// given model (e.g. the wheelbase in metres). Default: raw.
+  virtual Params DescribeGiven(const Params& raw, const GivenContext& /*g*/) const { return raw; }
+  /// `diagnose --baseline`: their standard errors likewise. Default: raw_se.
+  virtual Params DescribeGivenErrors(const Params& raw_se, const GivenContext& /*g*/) const { return raw_se; }
+  /// `diagnose --baseline`: the changes of the given model it asks for,
+  /// from DescribeGiven's values `d`; `negligible`: the practical threshold
+  /// (DiagnoseOptions::negligible). Default: none.
+  virtual std::vector<GivenCorrection> GivenCorrections(const Params& /*d*/, const GivenContext& /*g*/,
+                                                        double /*negligible*/) const {
+    return {};
+  }
   /// The effect as a plain statement with the numbers. Default: "NAME is off".
   virtual std::string PlainProblem(const Params& p) const;
   /// Simulation: multiplies the true left and right wheel's size (any
@@ -296,6 +343,11 @@ class Effect {
   virtual std::string Range(const Effects& /*e*/) const { return {}; }
   /// A fitted parameter, 0 when absent.
   static double Get(const Params& p, const char* name);
+  /// A parameter, `fallback` when absent.
+  static double GetOr(const Params& p, const char* name, double fallback) {
+    const auto it = p.find(name);
+    return it == p.end() ? fallback : it->second;
+  }
   /// A fitted parameter's magnitude, +inf when absent (never below a floor).
   static double Size(const Params& p, const char* name);
   /// The practical floor of a heading jump (parameter `name`, rad): it is a

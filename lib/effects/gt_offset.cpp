@@ -18,7 +18,9 @@ class GtOffset final : public Effect {
                 .effect_class = EffectClass::kMeasurement,
                 .definition = "ground truth reports the point (dx, dy) of the robot frame instead of the axle midpoint",
                 .parameters = {{"dx", &Effects::gt_dx, "m", 0.01}, {"dy", &Effects::gt_dy, "m", 0.01}},
-                .mean_terms = {kTermDx, kTermDy}}) {}
+                .mean_terms = {kTermDx, kTermDy},
+                .separated_by = SeparatingExperiment::kTurnsWhileDriving,
+                .separated_rank = 1}) {}
 
   // The marker's distance is a position already: below the position floor.
   std::string PracticalFloor(const Params& p, const CampaignScale& c) const override {

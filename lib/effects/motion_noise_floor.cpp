@@ -10,6 +10,25 @@
 namespace umbmark::effects {
 namespace {
 
+/// A run's start and stop slip: half the variance in a motion's first step
+/// when it starts from a standstill, half in its last when it stops before
+/// one, from the run's stream.
+class SlipRun final : public RunEffect {
+ public:
+  SlipRun(double sigma, RandomSource& rng) : sigma_(sigma), rng_(rng) {}
+  void StepTravel(const SimMotion& m, const SimStep& s, double (&travel)[2]) override {
+    const bool start_slip = m.starts && s.first, stop_slip = m.stops && s.last;
+    for (int w = 0; w < 2; ++w) {
+      if (start_slip) travel[w] += sigma_ * std::sqrt(0.5) * rng_.Normal();
+      if (stop_slip) travel[w] += sigma_ * std::sqrt(0.5) * rng_.Normal();
+    }
+  }
+
+ private:
+  double sigma_;
+  RandomSource& rng_;
+};
+
 class MotionNoiseFloor final : public Effect {
  public:
   MotionNoiseFloor()
@@ -21,7 +40,13 @@ class MotionNoiseFloor final : public Effect {
                 .definition = "every motion between two standstills adds N(0, sigma^2) m to each wheel's true travel, "
                               "independently of its length",
                 .parameters = {{"sigma", &Effects::floor_sigma, "m"}},
-                .noise_term = NoiseTerm::kMotionFloor}) {}
+                .noise_term = NoiseTerm::kMotionFloor,
+                .sim_stream = 106}) {}
+
+  std::unique_ptr<RunEffect> StartRun(const Effects& e, RandomSource& rng) const override {
+    if (!(e.floor_sigma > 0.0)) return nullptr;
+    return std::make_unique<SlipRun>(e.floor_sigma, rng);
+  }
   Params FromNoise(const NoiseValues& n) const override { return {{"sigma", std::sqrt(n.floor_s2)}}; }
 
   std::string Unphysical(const Params& p, int /*runs*/, const Params& /*se*/) const override {

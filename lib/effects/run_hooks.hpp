@@ -29,8 +29,8 @@ struct SimStep {
   bool first = false, last = false;  ///< the motion's first, last step
   /// |true wheel travel| of the step before any noise [m] (left, right).
   double mean_abs[2] = {0.0, 0.0};
-  /// Bumps met so far in the run (left, right): an effect that adds bumps
-  /// counts them here.
+  /// The step's bump counters (left, right; two ints the simulator adds to
+  /// the run's counts): an effect that adds bumps counts them here.
   int* bumps = nullptr;
 };
 

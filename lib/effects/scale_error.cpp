@@ -18,7 +18,9 @@ class ScaleError final : public Effect {
                 .effect_class = EffectClass::kMechanism,
                 .definition = "both true wheel diameters are (1 + s) times the model's",
                 .parameters = {{"s", &Effects::scale_s, "", 0.01}},
-                .mean_terms = {kTermScale}}) {}
+                .mean_terms = {kTermScale},
+                .separated_by = SeparatingExperiment::kBackAndForth,
+                .separated_rank = 1}) {}
 
   // Negligible when the travel error over one of the campaign's legs is
   // under the position floor (0.3 mm at the default negligible).
@@ -61,6 +63,19 @@ class ScaleError final : public Effect {
   std::string PlainProblem(const Params& p) const override {
     return fmt::format("both wheels are {:.2f}% {} than the model says", 100.0 * std::abs(Get(p, "s")),
                        Get(p, "s") >= 0.0 ? "larger" : "smaller");
+  }
+
+  // `diagnose --baseline`: s relative to the given model's own mean
+  // diameter.
+  Params DescribeGiven(const Params& raw, const GivenContext& g) const override {
+    Params out = raw;
+    if (const auto it = raw.find("s"); it != raw.end()) out["s"] = (1.0 + it->second) / (1.0 + g.scale) - 1.0;
+    return out;
+  }
+  Params DescribeGivenErrors(const Params& raw_se, const GivenContext& g) const override {
+    Params out = raw_se;
+    if (const auto it = raw_se.find("s"); it != raw_se.end()) out["s"] = it->second / (1.0 + g.scale);
+    return out;
   }
 
  protected:

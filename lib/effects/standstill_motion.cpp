@@ -11,6 +11,26 @@
 namespace umbmark::effects {
 namespace {
 
+/// A run's settling: as a standstill begins after a motion that stops
+/// (not at the run's end), N(0, sigma_xy^2) along each robot axis and
+/// N(0, sigma_theta^2) in heading, from the run's stream.
+class SettleRun final : public RunEffect {
+ public:
+  SettleRun(double sigma_xy, double sigma_theta, RandomSource& rng)
+      : sigma_xy_(sigma_xy), sigma_theta_(sigma_theta), rng_(rng) {}
+  bool AtStop(const SimMotion& m, double& dx, double& dy, double& dtheta) override {
+    if (!m.stops || !m.standstill_follows) return false;
+    dx = sigma_xy_ * rng_.Normal();
+    dy = sigma_xy_ * rng_.Normal();
+    dtheta = sigma_theta_ * rng_.Normal();
+    return true;
+  }
+
+ private:
+  double sigma_xy_, sigma_theta_;
+  RandomSource& rng_;
+};
+
 class StandstillMotion final : public Effect {
  public:
   StandstillMotion()
@@ -24,7 +44,14 @@ class StandstillMotion final : public Effect {
                               "independently per standstill",
                 .parameters = {{"sigma_xy", &Effects::stand_sigma_xy, "m"},
                                {"sigma_theta", &Effects::stand_sigma_theta, "rad"}},
-                .noise_term = NoiseTerm::kStandstill}) {}
+                .noise_term = NoiseTerm::kStandstill,
+                .sim_stream = 105,
+                .separated_by = SeparatingExperiment::kStandstills}) {}
+
+  std::unique_ptr<RunEffect> StartRun(const Effects& e, RandomSource& rng) const override {
+    if (!(e.stand_sigma_xy > 0.0 || e.stand_sigma_theta > 0.0)) return nullptr;
+    return std::make_unique<SettleRun>(e.stand_sigma_xy, e.stand_sigma_theta, rng);
+  }
   Params FromNoise(const NoiseValues& n) const override { return {{"sigma_xy", std::sqrt(n.stand_xy2)}, {"sigma_theta", std::sqrt(n.stand_th2)}}; }
 
   std::string Unphysical(const Params& p, int /*runs*/, const Params& /*se*/) const override {

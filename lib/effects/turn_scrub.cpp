@@ -19,7 +19,8 @@ class TurnScrub final : public Effect {
                 .definition =
                     "in on-the-spot turns the true heading change is (1 - k) times what the true wheel travel implies",
                 .parameters = {{"k", &Effects::scrub_k, "", 0.03}},
-                .mean_terms = {kTermScrub}}) {}
+                .mean_terms = {kTermScrub},
+                .separated_by = SeparatingExperiment::kTurnsWhileDriving}) {}
 
   // Every rotation on the spot: a scrub is a wheelbase there. (Not when a
   // weakly identifiable scrub is told apart on its own held-out evidence:
@@ -57,6 +58,9 @@ class TurnScrub final : public Effect {
   std::string PlainProblem(const Params& p) const override {
     return fmt::format("spot turns turn {:.1f}% less than the wheels say (the wheels scrub)", 100.0 * Get(p, "k"));
   }
+
+  // Simulation: a spot turn turns 1 - k times as far as its wheels say.
+  double TurnHeadingFactor(const Effects& e) const override { return 1.0 - e.scrub_k; }
 
  protected:
   std::string Range(const Effects& e) const override {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include <fmt/format.h>
 
@@ -43,54 +44,71 @@ class NormalSource {
   bool has_spare_ = false;
 };
 
-/// Wheel noise (Chong & Kleeman eq. 4, left/right correlation rho
-/// [correlated_noise]) and bumps (N(0, sigma_b^2) per bump, bumps arriving
-/// per wheel as a Poisson process in travelled distance [bump_outliers]) on
-/// each step's true wheel travel, from the run's own streams.
-class WheelDisturbance {
+/// One effect's random stream (Descriptor::sim_stream) for its hooks.
+class EffectStream final : public effects::RandomSource {
  public:
-  WheelDisturbance(const RunTruth& truth, std::uint64_t seed, std::uint64_t run_index)
-      : wheel_rng_(StreamSeed(seed, run_index, kCampaignStreamWheelNoise)),
-        bump_rng_(StreamSeed(seed, run_index, kCampaignStreamBumps)),
-        k_{truth.k_L, truth.k_R},
-        rho_(truth.effects.noise_rho),
-        rho_c_(std::sqrt(std::max(0.0, 1.0 - rho_ * rho_))),
-        bump_rate_(truth.effects.bump_rate),
-        bump_sigma_(truth.effects.bump_sigma),
-        bumps_(bump_rate_ > 0.0 && bump_sigma_ > 0.0) {
-    if (bumps_) {
-      to_bump_[0] = bump_rng_.Exponential() / bump_rate_;
-      to_bump_[1] = bump_rng_.Exponential() / bump_rate_;
+  explicit EffectStream(std::uint64_t seed) : src_(seed) {}
+  double Normal() override { return src_.Next(); }
+  double Uniform() override { return src_.Uniform(); }
+  double Exponential() override { return src_.Exponential(); }
+
+ private:
+  NormalSource src_;
+};
+
+/// The effects of one run: their per-run state (Effect::StartRun) with
+/// their streams, and the factors and correlation they make of the wheels.
+struct RunEffects {
+  std::vector<std::unique_ptr<EffectStream>> streams;
+  std::vector<std::unique_ptr<effects::RunEffect>> runs;
+  const effects::Effect* coast = nullptr;  ///< the first whose StopCoast may answer (else none)
+  double backward = 1.0;      ///< Effect::BackwardFactor, multiplied
+  double turn_heading = 1.0;  ///< Effect::TurnHeadingFactor, multiplied
+  double rho = 0.0;           ///< Effect::WheelNoiseCorrelation, summed
+};
+
+RunEffects StartEffects(const Effects& fx, std::uint64_t seed, std::uint64_t run_index) {
+  RunEffects out;
+  for (const effects::Effect* e : effects::All()) {
+    if (!e->Simulated()) continue;
+    out.backward *= e->BackwardFactor(fx);
+    out.turn_heading *= e->TurnHeadingFactor(fx);
+    out.rho += e->WheelNoiseCorrelation(fx);
+    if (!e->Active(fx)) continue;
+    const effects::Descriptor& d = e->Describe();
+    const std::uint64_t id = d.sim_stream != 0 ? d.sim_stream : 0x10000u + static_cast<std::uint64_t>(d.order);
+    auto stream = std::make_unique<EffectStream>(StreamSeed(seed, run_index, id));
+    if (auto run = e->StartRun(fx, *stream)) {
+      out.runs.push_back(std::move(run));
+      out.streams.push_back(std::move(stream));
     }
   }
+  return out;
+}
 
-  /// Adds the noise and the bumps of one step to travel[0] (left), travel[1]
-  /// (right) [m]; counts the bumps in out.
-  void Apply(double (&travel)[2], SimulatedRun& out) {
+/// Wheel noise (Chong & Kleeman eq. 4, left/right correlation rho of the
+/// effects, Effect::WheelNoiseCorrelation) on each step's true wheel
+/// travel, from the run's own stream.
+class WheelNoise {
+ public:
+  WheelNoise(const RunTruth& truth, double rho, std::uint64_t seed, std::uint64_t run_index)
+      : wheel_rng_(StreamSeed(seed, run_index, kCampaignStreamWheelNoise)),
+        k_{truth.k_L, truth.k_R},
+        rho_(rho),
+        rho_c_(std::sqrt(std::max(0.0, 1.0 - rho_ * rho_))) {}
+
+  /// Adds the noise of one step to travel[0] (left), travel[1] (right) [m]
+  /// whose size before noise is mean_abs.
+  void Apply(double (&travel)[2], const double (&mean_abs)[2]) {
     const double z0 = wheel_rng_.Next(), z1 = wheel_rng_.Next();
-    const double mean_abs[2] = {std::abs(travel[0]), std::abs(travel[1])};
     travel[0] += k_[0] * std::sqrt(mean_abs[0]) * z0;
     travel[1] += k_[1] * std::sqrt(mean_abs[1]) * (rho_ * z0 + rho_c_ * z1);
-    if (!bumps_) return;
-    for (int w = 0; w < 2; ++w) {
-      double left_to_roll = mean_abs[w];
-      while (to_bump_[w] <= left_to_roll) {
-        travel[w] += bump_sigma_ * bump_rng_.Next();
-        left_to_roll -= to_bump_[w];
-        to_bump_[w] = bump_rng_.Exponential() / bump_rate_;
-        (w == 0 ? out.bumps_left : out.bumps_right) += 1;
-      }
-      to_bump_[w] -= left_to_roll;
-    }
   }
 
  private:
-  NormalSource wheel_rng_, bump_rng_;
+  NormalSource wheel_rng_;
   double k_[2];
   double rho_, rho_c_;
-  double bump_rate_, bump_sigma_;
-  bool bumps_;
-  double to_bump_[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
 };
 
 /// One executed step: enough to re-evaluate the pose at any time inside it.
@@ -98,11 +116,12 @@ struct StepRecord {
   double ta = 0.0, tb = 0.0;
   Pose2 start, end;
   double left_m = 0.0, right_m = 0.0;  ///< true ground travel (noise and bumps included)
-  double heading_factor = 1.0;         ///< 1 - k inside spot turns
+  double heading_factor = 1.0;         ///< of the heading change (Effect::TurnHeadingFactor in spot turns)
   double slide_x_m = 0.0, slide_y_m = 0.0;
 };
 
-/// The true robot's step (TrueStep) plus a sideways slide (floor_slope).
+/// The true robot's step (TrueStep) plus a move of the chassis beside it
+/// (Effect::StepDrift, a coast).
 Pose2 AdvancePose(const Pose2& p, double l, double r, double wheelbase, double heading_factor, double slide_x,
                   double slide_y) {
   const Pose2 q = TrueStep(p, l, r, wheelbase, heading_factor);
@@ -190,7 +209,7 @@ void WriteLog(const std::vector<double>& ts, const std::vector<Pose2>& sample_po
 /// Where the plan's motions meet standstills: a motion starts from one (the
 /// run's first move, or after a pause that lasts) and stops before one (a
 /// pause that lasts, or the run's end); standstill_follows: a lasting pause
-/// comes after it (the run's end does not count; standstill_motion).
+/// comes after it (the run's end does not count).
 struct MotionBoundaries {
   std::vector<char> starts, stops, standstill_follows;
 };
@@ -238,15 +257,11 @@ class RunExecutor {
         ts_(ts),
         out_(out),
         bounds_(FindBoundaries(plan)),
+        effects_(StartEffects(truth.effects, seed, run_index)),
         phase_rng_(StreamSeed(seed, run_index, kCampaignStreamPhase)),
-        stand_rng_(StreamSeed(seed, run_index, kCampaignStreamStandstill)),
-        floor_rng_(StreamSeed(seed, run_index, kCampaignStreamMotionFloor)),
-        swivel_rng_(StreamSeed(seed, run_index, kCampaignStreamSwivel)),
-        disturbance_(truth, seed, run_index),
+        noise_(truth, effects_.rho, seed, run_index),
         nominal_per_tick_{truth.nominal_per_tick_left, truth.nominal_per_tick_right},
-        true_per_tick_{truth.true_per_tick_left, truth.true_per_tick_right},
-        slide_cos_(std::cos(fx_.slope_dir)),
-        slide_sin_(std::sin(fx_.slope_dir)) {
+        true_per_tick_{truth.true_per_tick_left, truth.true_per_tick_right} {
     if (truth.ticks) {
       p_[0] = phase_rng_.Uniform();
       p_[1] = phase_rng_.Uniform();
@@ -272,7 +287,8 @@ class RunExecutor {
         coast_.active = false;  // a motion ends any coast
         double p_end[2];
         WheelTargets(m, p_end);
-        StartKicks(mk);
+        motion_ = Motion(mk);
+        for (auto& e : effects_.runs) e->MotionStart(motion_, pose_);
         RunSteps(mk, t, p_end);
       }
       t = t1;
@@ -309,45 +325,38 @@ class RunExecutor {
     }
   }
 
-  /// castor_kick (a start from standstill that is not a spot turn) and
-  /// castor_swivel (a straight or arc start after a spot turn or a
-  /// reversal) as the motion begins.
-  void StartKicks(std::size_t mk) {
+  /// What the effects' hooks see of motion mk.
+  effects::SimMotion Motion(std::size_t mk) const {
     const PlannedMotion& m = plan_.motions[mk];
-    if (m.from_standstill && m.cls != MotionClass::kTurn && fx_.castor_kappa != 0.0)
-      pose_.theta += (m.left_m + m.right_m >= 0.0 ? 1.0 : -1.0) * fx_.castor_kappa;
-    if (!m.motion_start) return;
-    const int sign = MotionSign(m);
-    if (m.cls != MotionClass::kTurn) {
-      if (fx_.swivel_kappa != 0.0) {
-        if (last_turn_sign_ != 0)
-          pose_.theta += last_turn_sign_ * fx_.swivel_kappa;
-        else if (last_drive_sign_ != 0 && sign != last_drive_sign_)
-          pose_.theta += (swivel_rng_.Uniform() < 0.5 ? -1.0 : 1.0) * fx_.swivel_kappa;
-      }
-      last_drive_sign_ = sign;
-      last_turn_sign_ = 0;
-    } else {
-      last_turn_sign_ = sign;
-    }
+    effects::SimMotion sm;
+    sm.turn = m.cls == MotionClass::kTurn;
+    sm.from_standstill = m.from_standstill;
+    sm.motion_start = m.motion_start;
+    sm.starts = bounds_.starts[mk];
+    sm.stops = bounds_.stops[mk];
+    sm.standstill_follows = bounds_.standstill_follows[mk];
+    sm.sign = MotionSign(m);
+    sm.left_m = m.left_m;
+    sm.right_m = m.right_m;
+    return sm;
   }
 
-  /// One step's true wheel travel with noise, bumps and start / stop slip.
-  void StepTravel(std::size_t mk, bool first_step, bool last, const double (&dp)[2], double (&travel)[2]) {
-    for (int w = 0; w < 2; ++w) {
-      const double asym = dp[w] < 0.0 ? 1.0 + fx_.asymmetry_a : 1.0;
-      travel[w] = dp[w] * true_per_tick_[w] * asym;
-    }
-    disturbance_.Apply(travel, out_);
-    // motion_noise_floor: half its variance in the motion's first step,
-    // half in its last (start and stop slip).
-    if (fx_.floor_sigma > 0.0) {
-      const bool start_slip = bounds_.starts[mk] && first_step, stop_slip = bounds_.stops[mk] && last;
-      for (int w = 0; w < 2; ++w) {
-        if (start_slip) travel[w] += fx_.floor_sigma * std::sqrt(0.5) * floor_rng_.Next();
-        if (stop_slip) travel[w] += fx_.floor_sigma * std::sqrt(0.5) * floor_rng_.Next();
-      }
-    }
+  /// One step's true wheel travel: the wheels' true size (and a backward
+  /// factor, Effect::BackwardFactor), their noise, then what the effects
+  /// add (RunEffect::StepTravel: bumps, start / stop slip).
+  void StepTravel(bool first_step, bool last, const double (&dp)[2], double (&travel)[2]) {
+    for (int w = 0; w < 2; ++w) travel[w] = dp[w] * true_per_tick_[w] * (dp[w] < 0.0 ? effects_.backward : 1.0);
+    int bumps[2] = {0, 0};
+    effects::SimStep st;
+    st.bumps = bumps;
+    st.first = first_step;
+    st.last = last;
+    st.mean_abs[0] = std::abs(travel[0]);
+    st.mean_abs[1] = std::abs(travel[1]);
+    noise_.Apply(travel, st.mean_abs);
+    for (auto& e : effects_.runs) e->StepTravel(motion_, st, travel);
+    out_.bumps_left += bumps[0];
+    out_.bumps_right += bumps[1];
   }
 
   /// The steps of one motion, from t0 to its end: one per sample interval.
@@ -355,7 +364,7 @@ class RunExecutor {
     const PlannedMotion& m = plan_.motions[mk];
     const double t1 = t0 + m.duration_s;
     const double dp_total[2] = {p_end[0] - p_[0], p_end[1] - p_[1]};
-    const double heading_factor = m.cls == MotionClass::kTurn ? 1.0 - fx_.scrub_k : 1.0;
+    const double heading_factor = m.cls == MotionClass::kTurn ? effects_.turn_heading : 1.0;
     double ta = t0;
     double done = 0.0;  // fraction of the motion executed
     while (true) {
@@ -365,7 +374,7 @@ class RunExecutor {
       const bool last = tb >= t1;
       double dp[2], travel[2];
       for (int w = 0; w < 2; ++w) dp[w] = last ? p_end[w] - p_[w] : (f_end - done) * dp_total[w];
-      StepTravel(mk, ta == t0, last, dp, travel);
+      StepTravel(ta == t0, last, dp, travel);
       StepRecord s;
       s.ta = ta;
       s.tb = tb;
@@ -373,9 +382,7 @@ class RunExecutor {
       s.left_m = travel[0];
       s.right_m = travel[1];
       s.heading_factor = heading_factor;
-      const double slope = fx_.slope_g * 0.5 * (std::abs(travel[0]) + std::abs(travel[1]));
-      s.slide_x_m = slope * slide_cos_;
-      s.slide_y_m = slope * slide_sin_;
+      Drift(travel, s.slide_x_m, s.slide_y_m);
       pose_ = AdvancePose(pose_, travel[0], travel[1], truth_.true_wheelbase_m, heading_factor, s.slide_x_m,
                           s.slide_y_m);
       s.end = pose_;
@@ -394,6 +401,19 @@ class RunExecutor {
     }
   }
 
+  /// The chassis' move beside the wheels' over one step (the effects'
+  /// RunEffect::StepDrift, added; 0 without).
+  void Drift(const double (&travel)[2], double& x, double& y) {
+    bool any = false;
+    for (auto& e : effects_.runs) {
+      double dx = 0.0, dy = 0.0;
+      if (!e->StepDrift(travel, dx, dy)) continue;
+      x = any ? x + dx : dx;
+      y = any ? y + dy : dy;
+      any = true;
+    }
+  }
+
   /// An instantaneous change of the true pose at time t (a step of no
   /// duration, so that the pose at any time sees it).
   void Jump(const Pose2& to, double t) {
@@ -405,43 +425,45 @@ class RunExecutor {
     steps_.push_back(s);
   }
 
-  /// At the end of motion mk (time t): standstill_motion, then stop_slide.
+  /// At the end of motion mk (time t): the effects' moves as the robot
+  /// comes to rest (RunEffect::AtStop), then a coast (Effect::StopCoast).
   void StopEffects(std::size_t mk, double t) {
     const PlannedMotion& m = plan_.motions[mk];
-    // standstill_motion: the robot settles as the standstill begins.
-    if ((fx_.stand_sigma_xy > 0.0 || fx_.stand_sigma_theta > 0.0) && bounds_.stops[mk] &&
-        bounds_.standstill_follows[mk]) {
-      const double nx = fx_.stand_sigma_xy * stand_rng_.Next(), ny = fx_.stand_sigma_xy * stand_rng_.Next();
-      const double nt = fx_.stand_sigma_theta * stand_rng_.Next();
+    for (auto& e : effects_.runs) {
+      double nx = 0.0, ny = 0.0, nt = 0.0;
+      if (!e->AtStop(motion_, nx, ny, nt)) continue;
       const double c = std::cos(pose_.theta), sn = std::sin(pose_.theta);
       Jump({pose_.x + c * nx - sn * ny, pose_.y + sn * nx + c * ny, pose_.theta + nt}, t);
     }
-    // stop_slide: the chassis coasts on at the speed the motion ended with,
-    // through the pause that follows (Coast).
-    if ((fx_.slide_d == 0.0 && fx_.slide_a == 0.0) || !m.motion_end || !bounds_.stops[mk]) return;
+    // A coast at the speed the motion ended with, through the pause that
+    // follows (Coast).
+    if (!m.motion_end || !bounds_.stops[mk]) return;
     const double duration = m.duration_s > 0.0 ? m.duration_s : 1.0;
     double rate[2] = {std::isfinite(m.end_rate_left) ? m.end_rate_left : m.left_m / duration,
                       std::isfinite(m.end_rate_right) ? m.end_rate_right : m.right_m / duration};
     for (int w = 0; w < 2; ++w)
-      rate[w] *= true_per_tick_[w] / nominal_per_tick_[w] * (rate[w] < 0.0 ? 1.0 + fx_.asymmetry_a : 1.0);
-    coast_ = {};
-    coast_.t0 = t;
-    coast_.turn = m.cls == MotionClass::kTurn;
-    coast_.rate = coast_.turn ? (rate[1] - rate[0]) / truth_.true_wheelbase_m : 0.5 * (rate[0] + rate[1]);
-    coast_.k = coast_.turn ? fx_.slide_a : fx_.slide_d * (coast_.rate < 0.0 ? 1.0 + fx_.slide_back : 1.0);
-    // After an arc the heading turns on by arc w/v per metre coasted.
-    if (!coast_.turn && coast_.rate != 0.0)
-      coast_.curvature = fx_.slide_arc * (rate[1] - rate[0]) / truth_.true_wheelbase_m / coast_.rate;
-    coast_.active = coast_.k > 0.0 && coast_.rate != 0.0;
+      rate[w] *= true_per_tick_[w] / nominal_per_tick_[w] * (rate[w] < 0.0 ? effects_.backward : 1.0);
+    for (const effects::Effect* e : effects::All()) {
+      effects::SimCoast c;
+      if (!e->Simulated() || !e->StopCoast(fx_, motion_.turn, rate[0], rate[1], truth_.true_wheelbase_m, c)) continue;
+      coast_ = {};
+      coast_.t0 = t;
+      coast_.turn = motion_.turn;
+      coast_.rate = c.rate;
+      coast_.k = c.k;
+      coast_.curvature = c.curvature;
+      coast_.active = coast_.k > 0.0 && coast_.rate != 0.0;
+      break;
+    }
   }
 
-  /// The coast of stop_slide: from t0, uniform deceleration 1 / (2 k)
+  /// A coast after a stop (Effect::StopCoast): from t0, uniform deceleration 1 / (2 k)
   /// (Coulomb friction) from `rate` until it rests after 2 k |rate| s,
   /// having covered k rate |rate| (m along the heading, or rad of turn).
   struct Coast {
     bool active = false, turn = false;
     double t0 = 0.0, rate = 0.0, k = 0.0;
-    double curvature = 0.0;  ///< heading turned per metre coasted (stop_slide.arc w/v)
+    double curvature = 0.0;  ///< heading turned per metre coasted
     double Progress(double t) const {
       const double v = std::abs(rate), tau = std::clamp(t - t0, 0.0, 2.0 * k * v);
       return (rate > 0.0 ? 1.0 : -1.0) * (v * tau - tau * tau / (4.0 * k));
@@ -467,7 +489,7 @@ class RunExecutor {
         s.left_m = -0.5 * step * truth_.true_wheelbase_m;
         s.right_m = 0.5 * step * truth_.true_wheelbase_m;
       } else {
-        // Along the step's mid heading (the coast curves with stop_slide.arc).
+        // Along the step's mid heading (the coast may curve).
         const double mid = pose_.theta + 0.5 * step * coast_.curvature;
         s.slide_x_m = step * std::cos(mid);
         s.slide_y_m = step * std::sin(mid);
@@ -490,18 +512,16 @@ class RunExecutor {
   const std::vector<double>& ts_;
   SimulatedRun& out_;
   const MotionBoundaries bounds_;
-  NormalSource phase_rng_, stand_rng_, floor_rng_, swivel_rng_;
-  WheelDisturbance disturbance_;
+  RunEffects effects_;
+  NormalSource phase_rng_;
+  WheelNoise noise_;
   const double nominal_per_tick_[2], true_per_tick_[2];
-  const double slide_cos_, slide_sin_;
   // Wheel state: continuous position p (ticks, or nominal metres) and the
   // cumulative commanded nominal travel.
   double p_[2] = {0.0, 0.0};
   double commanded_[2] = {0.0, 0.0};
   Pose2 pose_;
-  // castor_swivel: the last spot turn's sign since the last straight or arc
-  // motion (0: none), and that motion's drive sign (0: none yet).
-  int last_turn_sign_ = 0, last_drive_sign_ = 0;
+  effects::SimMotion motion_;  ///< the motion being executed (Motion)
   Coast coast_;
   std::vector<StepRecord> steps_;
   std::vector<Pose2> sample_pose_;
@@ -517,7 +537,6 @@ SimulatedRun SimulateLoggedRun(const RunPlan& plan, const RunTruth& truth, std::
   const std::vector<double> ts = SampleTimes(plan);
   NormalSource gt_rng(StreamSeed(seed, run_index, kCampaignStreamGroundTruth));
   NormalSource run_time_rng(StreamSeed(seed, run_index, kCampaignStreamRunTime));
-  // run_time_offset: this run's tau_i.
   // The ground truth's clock: each effect's GroundTruthDelay (a constant
   // offset, this run's own draw from run_time_rng).
   double delay = 0.0;

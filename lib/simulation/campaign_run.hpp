@@ -68,16 +68,14 @@
 
 namespace umbmark::sim {
 
-/// Random stream ids of the campaign simulator (rng.hpp StreamSeed).
+/// Random stream ids of the campaign simulator (rng.hpp StreamSeed). The
+/// effects' own streams are their Descriptor::sim_stream (102, 105, 106 and
+/// 108 are taken; an effect that declares none gets 0x10000 + its order).
 enum CampaignStream : std::uint64_t {
   kCampaignStreamWheelNoise = 101,
-  kCampaignStreamBumps = 102,
   kCampaignStreamGroundTruth = 103,
   kCampaignStreamPhase = 104,
-  kCampaignStreamStandstill = 105,
-  kCampaignStreamMotionFloor = 106,
   kCampaignStreamRunTime = 107,
-  kCampaignStreamSwivel = 108,
 };
 
 /// One commanded motion, or a pause.
