@@ -1,5 +1,5 @@
-// The parameter values of every effect (zero: absent) and, for the code
-// that has not moved into the effects' own files yet, their kinds. Field
+// The parameter values of every effect (zero: absent) and the kinds by
+// which the diagnosis' results and options still refer to an effect. Field
 // names follow the contract's parameter names; each effect's file says
 // which fields are its own (Parameter::field).
 #pragma once
@@ -10,8 +10,11 @@
 namespace umbmark::effects {
 
 /// Kinds of the built-in effects, in the catalogue's order (transitional:
-/// the simulator and the diagnosis still switch on them; each effect's file
-/// gives its kind, Effect::Kind()).
+/// no library file outside lib/effects names one, but the diagnosis' options
+/// and results (DiagnoseOptions::effects, Candidate::effect,
+/// ExplanationStep::effect), the simulator's catalogue (sim::Describe,
+/// EffectFromString) and the tests still use a kind as an effect's id;
+/// each effect's file gives its kind, Descriptor::kind).
 enum class EffectKind {
   kScaleError,
   kTurnScrub,

@@ -1,8 +1,8 @@
 // wheel_noise_error (contract): a parameter error of a model the user gives
 // (`diagnose --baseline CAL.json`): the given wheel noise k_L, k_R differs from the robot's. A candidate
 // of the diagnosis only, never simulated (simulate the robot with other
-// parameters instead); its fit and correction live in the diagnosis's
-// given-model code (baseline_given.hpp).
+// parameters instead); its fit lives in the diagnosis' given-model code
+// (baseline_given.hpp), its description and correction here.
 #include <cmath>
 
 #include <fmt/format.h>
