@@ -1,6 +1,11 @@
-// The verdict's significance rule (diagnosis/verdict.hpp) on hand-made
-// candidate tables: which likelihood-ratio tests count as evidence.
+// Stage 5 (diagnosis/verdict.hpp) on hand-made candidate tables: which
+// likelihood-ratio tests count as evidence of a significant gap, and the
+// candidates' order, which names nothing: the verdict is the explanation's
+// (docs/diagnosis.md, "The verdict's rule"; test_diagnose_verdict_rule.cpp).
 #include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <vector>
 
 #include "diagnosis/verdict.hpp"
 
@@ -42,34 +47,35 @@ TEST_CASE("verdict: an impossible fit's likelihood-ratio test is no evidence of 
   CHECK_FALSE(v.significant);
   CHECK(v.verdict == "none");
 
-  // The same fit at a possible value is evidence: significant, and found
-  // by its own test (before the rule this stage named the scrub, and
-  // diagnose.cpp's NameEffects turned the impossible name into
-  // `unexplained`).
+  // The same fit at a possible value is evidence: significant, found by
+  // the tests and not by the gap score. (Before the verdict's one rule this
+  // stage named the scrub by its own test, the "likelihood-ratio route";
+  // now the explanation names what it admits, the first step by held-out
+  // evidence like every other.)
   fits.candidates[0].impossible = false;
   const Verdict w = DecideVerdict(fits, score_p, null_q, VerdictOptions{});
   CHECK_THAT(w.tests_p_value, WithinRel(2 * 1.2e-6, 1e-12));
   CHECK_THAT(w.p_value, WithinRel(2 * 2 * 1.2e-6, 1e-12));
   CHECK(w.significant);
-  CHECK(w.verdict == "turn_scrub");
+  CHECK_FALSE(w.found_by_score);
+  CHECK(w.verdict == "unexplained");
 }
 
-TEST_CASE("verdict: an impossible fit is never found by its own likelihood-ratio test", "[diagnose][verdict]") {
-  // A significant gap that no candidate closes (score p = 1e-4), and one
-  // candidate whose own LR test would name it alone (found_alone in
-  // verdict.cpp: significant, gains held out, leaves no significant G).
+TEST_CASE("verdict: the gap score's own route is at half of alpha", "[diagnose][verdict]") {
+  // p = min(1, 2 min(p_G, p_tests)): G found the gap when p_G < alpha / 2.
   CandidateFits fits;
-  Candidate c = Tested(umbmark::sim::EffectKind::kTurnScrub, 1e-8, false);
-  c.heldout_shrink = 0.2;
-  c.gap_after = 3.0;
-  fits.candidates.push_back(c);
+  fits.candidates.push_back(Tested(umbmark::sim::EffectKind::kTurnScrub, 0.5, false));
   fits.projected.resize(1);
-  const Verdict found = DecideVerdict(fits, 1e-4, 13.3, VerdictOptions{});
-  CHECK(found.verdict == "turn_scrub");
-  fits.candidates[0].impossible = true;
-  const Verdict symptom = DecideVerdict(fits, 1e-4, 13.3, VerdictOptions{});
-  CHECK(symptom.significant);  // the gap score alone
-  CHECK(symptom.verdict == "unexplained");
+  const Verdict a = DecideVerdict(fits, 0.004, 13.3, VerdictOptions{});
+  CHECK(a.significant);
+  CHECK(a.found_by_score);
+  const Verdict b = DecideVerdict(fits, 0.0049, 13.3, VerdictOptions{});
+  CHECK(b.significant);  // 2 x 0.0049 < 0.01
+  CHECK(b.found_by_score);
+  const Verdict c = DecideVerdict(fits, 0.006, 13.3, VerdictOptions{});
+  CHECK_FALSE(c.significant);
+  CHECK_FALSE(c.found_by_score);
+  CHECK(c.verdict == "none");
 }
 
 namespace {
@@ -93,45 +99,54 @@ Verdict Decide(const std::vector<Candidate>& cands) {
 
 }  // namespace
 
-TEST_CASE("verdict: a noise effect yields to a start/stop mechanism that also qualifies", "[diagnose][verdict]") {
-  using umbmark::sim::EffectKind;
-  // DART's swivel castor: kicks that vary from start to start read as bumps
-  // with more evidence, but bumps have no turn's sign.
-  CHECK(Decide({Qualifying(EffectKind::kBumpOutliers, 900.0), Qualifying(EffectKind::kCastorSwivel, 600.0)}).verdict ==
-        "castor_swivel");
-  // Not at an impossible value (a symptom), and not when it does not qualify.
-  Candidate impossible = Qualifying(EffectKind::kCastorSwivel, 600.0);
-  impossible.impossible = true;
-  CHECK(Decide({Qualifying(EffectKind::kBumpOutliers, 900.0), impossible}).verdict == "bump_outliers");
-  CHECK(Decide({Qualifying(EffectKind::kBumpOutliers, 900.0), Qualifying(EffectKind::kCastorSwivel, 600.0, 0.05)})
-            .verdict == "bump_outliers");
-  // Mean effects other than the start/stop mechanisms keep the evidence
-  // order (a scale error does not outrank bumps: DART's floor strips).
-  CHECK(Decide({Qualifying(EffectKind::kBumpOutliers, 900.0), Qualifying(EffectKind::kScaleError, 600.0)}).verdict ==
-        "bump_outliers");
-  // The order of the input does not matter (the ranking is one sort, then
-  // the promotion).
-  CHECK(Decide({Qualifying(EffectKind::kCastorSwivel, 600.0), Qualifying(EffectKind::kTimeOffset, 700.0),
-                Qualifying(EffectKind::kBumpOutliers, 900.0)})
-            .verdict == "castor_swivel");
-  CHECK(Decide({Qualifying(EffectKind::kBumpOutliers, 900.0), Qualifying(EffectKind::kTimeOffset, 700.0),
-                Qualifying(EffectKind::kCastorSwivel, 600.0)})
-            .verdict == "castor_swivel");
+namespace {
+
+/// The effects in the order the stage ranks them.
+std::vector<umbmark::sim::EffectKind> Order(const Verdict& v) {
+  std::vector<umbmark::sim::EffectKind> out;
+  for (const Candidate& c : v.candidates) out.push_back(c.effect);
+  return out;
 }
 
-TEST_CASE("verdict: a slide yields to a clock the moving samples support; an unsupported clock is never named",
+}  // namespace
+
+TEST_CASE("verdict: stage 5 names nothing and promotes nothing: candidates rank by evidence",
           "[diagnose][verdict]") {
+  using umbmark::sim::EffectKind;
+  // DART's swivel castor: bumps with more evidence than castor_swivel. The
+  // stage once promoted the start/stop mechanism above the noise effect
+  // (VerdictOptions::mechanism_shrink, 0.8, set between DART campaigns);
+  // now the evidence orders them and the explanation names them both
+  // (test_dart_campaigns).
+  const Verdict v = Decide({Qualifying(EffectKind::kCastorSwivel, 600.0), Qualifying(EffectKind::kBumpOutliers, 900.0)});
+  CHECK(v.significant);
+  CHECK(v.verdict == "unexplained");  // until the explanation names its effects
+  CHECK(Order(v) == std::vector<EffectKind>{EffectKind::kBumpOutliers, EffectKind::kCastorSwivel});
+  // A third candidate does not change the order of two others, wherever it
+  // ranks itself (the order is one sort on each candidate's own numbers).
+  for (double third : {100.0, 700.0, 1000.0}) {
+    const Verdict w = Decide({Qualifying(EffectKind::kCastorSwivel, 600.0), Qualifying(EffectKind::kTimeOffset, third),
+                              Qualifying(EffectKind::kBumpOutliers, 900.0)});
+    const auto o = Order(w);
+    INFO(third);
+    CHECK(std::find(o.begin(), o.end(), EffectKind::kBumpOutliers) <
+          std::find(o.begin(), o.end(), EffectKind::kCastorSwivel));
+  }
+}
+
+TEST_CASE("verdict: a slide and a clock rank by evidence, an unsupported clock ranks last", "[diagnose][verdict]") {
   using umbmark::sim::EffectKind;
   Candidate clock = Qualifying(EffectKind::kRunTimeOffset, 400000.0, 0.999);
   clock.clock.checked = true;
   const Candidate slide = Qualifying(EffectKind::kStopSlide, 411000.0, 0.999);
-  // The ground truth lags on through every stop by v tau: a slide imitates
-  // it at the stops, but only the clock explains the moving samples.
-  CHECK(Decide({slide, clock}).verdict == "run_time_offset");
-  clock.clock.supported = false;  // the moving samples do not show it
-  CHECK(Decide({slide, clock}).verdict == "stop_slide");
-  clock.evidence = 500000.0;
-  CHECK(Decide({clock, slide}).verdict == "stop_slide");
+  // No yield of a slide to a clock (the stage once put a supported clock
+  // first whatever the evidence).
+  CHECK(Order(Decide({clock, slide})).front() == EffectKind::kStopSlide);
+  clock.evidence = 420000.0;
+  CHECK(Order(Decide({slide, clock})).front() == EffectKind::kRunTimeOffset);
+  clock.clock.supported = false;  // the moving samples do not show it: not usable
+  const Verdict v = Decide({clock, slide});
+  CHECK(Order(v).front() == EffectKind::kStopSlide);
 }
 
 TEST_CASE("verdict: a noise effect whose footprint the data contradict is never named", "[diagnose][verdict]") {
@@ -144,27 +159,4 @@ TEST_CASE("verdict: a noise effect whose footprint the data contradict is never 
   CHECK(v.significant);
   CHECK(v.verdict == "unexplained");
   CHECK(v.reason.find("cancel") != std::string::npos);
-}
-
-TEST_CASE("verdict: a start/stop mechanism that closes most of the gap outranks the noise effect that takes its scatter",
-          "[diagnose][verdict]") {
-  using umbmark::sim::EffectKind;
-  // DART's swivel castors whose kicks vary from start to start: bumps close
-  // 99.9 % (+3046 nats), castor_swivel alone 89.7 % (+1880 nats) and leaves
-  // a significant gap, so it does not qualify on its own.
-  Candidate swivel = Qualifying(EffectKind::kCastorSwivel, 1880.0, 0.897);
-  swivel.gap_after = 500.0;
-  const Verdict v = Decide({Qualifying(EffectKind::kBumpOutliers, 3046.0, 0.999), swivel});
-  CHECK(v.verdict == "castor_swivel");
-  CHECK(v.reason.find("ranked before bump_outliers") != std::string::npos);
-  // Below VerdictOptions::mechanism_shrink (0.8) it does not: DART's floor
-  // strips fit castor_swivel at 55-64 % held out.
-  swivel.heldout_shrink = 0.64;
-  CHECK(Decide({Qualifying(EffectKind::kBumpOutliers, 3046.0, 0.999), swivel}).verdict == "bump_outliers");
-  // Nor when nothing qualifies to take the scatter: the mechanism alone
-  // leaves a significant gap, so the verdict is unexplained.
-  swivel.heldout_shrink = 0.897;
-  Candidate bumps = Qualifying(EffectKind::kBumpOutliers, 3046.0, 0.4);
-  bumps.gap_after = 500.0;
-  CHECK(Decide({bumps, swivel}).verdict == "unexplained");
 }

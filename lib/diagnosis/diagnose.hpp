@@ -31,13 +31,15 @@
 //     Bonferroni, p_tests = min(1, m min p_e), and with G's own p-value,
 //     p = min(1, 2 min(p_G, p_tests)), so the false-alarm rate stays at most
 //     alpha.
-//  5. Verdict (verdict.hpp): `none` when p >= alpha; else the top candidate if its
-//     heldout_shrink >= min_heldout_shrink and it leaves no significant gap
-//     (or closes >= full_shrink of it); else, when the likelihood-ratio tests
-//     found the gap, the significant candidate with the smallest p-value if
-//     it gains held-out evidence and leaves no significant G behind; else
-//     `unexplained`. Effects the data cannot tell apart (from the baseline,
-//     or from each other) are listed.
+//  5. Verdict (verdict.hpp): `none` when p >= alpha; else the verdict is
+//     the stepwise explanation's (explanation.hpp; docs/diagnosis.md, "The
+//     verdict's rule"): effects added one at a time by held-out evidence,
+//     the first like every other; its practical effects are named when the
+//     residual G is not significant (or below 1 - full_shrink of the
+//     held-out gap) and, when G found the gap, it closes at least
+//     min_heldout_shrink of it held out; else `unexplained`. This stage
+//     ranks the candidates fitted alone and lists the effects the data
+//     cannot tell apart (from the baseline, or from each other).
 //
 // Gap sizes: gap = max(0, G - G0) with G0 the median of G over the null
 // simulations (what the model's own noise produces), so shrink =
@@ -77,11 +79,14 @@ struct DiagnoseOptions {
   int null_simulations = 500;
   /// False-alarm rate: the gap is significant when p < alpha. Default 0.01.
   double alpha = 0.01;
-  /// A winning effect must close at least this fraction of the gap on
-  /// held-out runs. Default 0.5 ("most of it").
+  /// The named explanation must close at least this fraction of the gap on
+  /// held-out runs when the gap score found the gap. Default 0.5 ("most of
+  /// it").
   double min_heldout_shrink = 0.5;
-  /// ...and leave no significant gap (G after the effect below the null's
-  /// 1 - alpha quantile) unless its heldout_shrink reaches this. Default 0.9.
+  /// ...and leave no significant gap (G after its last step below the
+  /// null's 1 - alpha quantile) unless its cumulative held-out shrink
+  /// reaches this (a residual under a tenth of the gap is a misfit of the
+  /// named effects' shape, not another cause). Default 0.9.
   double full_shrink = 0.9;
   /// Held-out log-likelihood an effect must gain per parameter. Default 2 nats.
   double complexity_penalty_nats = 2.0;

@@ -5,9 +5,13 @@
 // E_d, E_b by weighted least squares; the noise refitted, with rho or bumps
 // when chosen) and cross-validated over runs; the one with the largest
 // held-out log-likelihood gain is added when it gains more than the
-// complexity penalty per parameter. Selection stops when no effect gains
+// complexity penalty per parameter, the first step like every other (no
+// effect of a kind is preferred). Selection stops when no effect gains
 // held-out evidence or the remaining gap is no longer significant (G at or
-// below the null's 1 - alpha quantile).
+// below the null's 1 - alpha quantile); then every chosen effect must
+// still earn its penalty given the others (backward check), else it is
+// left out. The verdict is this explanation (diagnose.cpp NameEffects;
+// docs/diagnosis.md, "The verdict's rule").
 //
 // Practical significance: an effect's size is how far it moves the
 // predicted (measured) pose over a run -- the RMS over a run's ground-truth
@@ -63,7 +67,8 @@ struct ExplanationOptions {
   /// Default false: measured on the injection harness' tuning sessions
   /// (docs/diagnosis.md, "The verdict's rule"), the held-out gap score of
   /// real recordings falls for correct effects (the baseline's noise, fitted
-  /// with the effect unmodelled, is too wide), and the rule dropped them.
+  /// with the effect unmodelled, is too wide), and the rule dropped them;
+  /// the likelihood is the criterion, the shrink is reported as it comes.
   bool keep_heldout_shrink = false;
   /// Progress in effect sets fitted, of at most max_effects x the candidates
   /// (core/progress.hpp); reaches the total when the search stops early.
@@ -117,6 +122,11 @@ struct Explanation {
   /// steps. Each with its params, the reason in `unphysical` and the
   /// held-out gain it showed; at most one entry per effect.
   std::vector<ExplanationStep> symptoms;
+  /// An effect at an impossible value (not a noise effect at zero) had more
+  /// held-out evidence than the first step: the gap's largest part is
+  /// something no listed effect describes at a possible value, and the
+  /// verdict names nothing (docs/diagnosis.md, "The verdict's rule").
+  bool symptom_first = false;
   /// The explained model: the last step's joint fit (the baseline's when
   /// there is no step): mean parameters, noise, and the covariance bases it
   /// is whitened with (run_faults.hpp' second pass is taken under it).
@@ -126,19 +136,21 @@ struct Explanation {
 };
 
 /// The rule that admits a step (docs/diagnosis.md, "The verdict's rule"):
-/// it gains more than the penalty per parameter in held-out log-likelihood,
-/// does not lower the cumulative held-out shrink, and is no symptom (see
-/// Explanation::symptoms); among the admissible trials the largest
-/// held-out gain wins. So every step adds held-out evidence and the
-/// cumulative held-out shrink never drops.
+/// it gains more than the penalty per parameter in held-out log-likelihood
+/// and is no symptom (see Explanation::symptoms); with keep_heldout_shrink
+/// it also may not lower the cumulative held-out shrink. Among the
+/// admissible trials the largest held-out gain wins, at the first step as
+/// at every other. So every step adds held-out evidence; the cumulative
+/// held-out shrink is reported as it comes (the likelihood is the
+/// criterion).
 ///
 /// `known`: mean fits already made (FitCandidates' mean_fits: the same
-/// fits, so not repeated). `first`: the effect to start with (the single-effect verdict), or none
-/// (empty) to select from scratch. gap_score, null_median, null_quantile:
+/// fits, so not repeated). The first step is chosen by the same rule as
+/// every other. gap_score, null_median, null_quantile:
 /// the baseline's G, the null's median G0 and 1 - alpha quantile.
 Explanation Explain(const CampaignData& c, const MeanModel& model, const BaselineFit& baseline,
                     const Folds& folds, const std::vector<Candidate>& candidates,
-                    const std::map<std::vector<int>, MeanFit>& known, const std::vector<sim::EffectKind>& first, double gap_score, double null_median,
+                    const std::map<std::vector<int>, MeanFit>& known, double gap_score, double null_median,
                     double null_quantile, const ExplanationOptions& options);
 
 }  // namespace umbmark::diag

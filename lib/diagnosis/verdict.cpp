@@ -52,7 +52,7 @@ void Significance(const CandidateFits& fits, double score_p_value, const Verdict
 /// identifiable), naming a clock offset the moving samples do not support
 /// when it was the candidate with the most evidence.
 std::string UnexplainedReason(const Verdict& out, const Candidate* best, const std::string& p_text,
-                              double null_quantile_alpha, const VerdictOptions& options) {
+                              double null_quantile_alpha) {
   // The candidate with the most evidence, when it is a clock offset the
   // moving samples do not support: say so (the verdict's footprint rule).
   const Candidate* clock = nullptr;
@@ -61,14 +61,10 @@ std::string UnexplainedReason(const Verdict& out, const Candidate* best, const s
   if (clock && clock->clock.supported) clock = nullptr;
   std::string reason =
       !best ? fmt::format("significant gap ({}) and no identifiable candidate", p_text)
-      : best->heldout_shrink < options.min_heldout_shrink || best->evidence <= 0.0
-          ? fmt::format("significant gap ({}); the best candidate, {}, closes only {:.0f}% of it on "
-                        "held-out runs",
-                        p_text, sim::EffectToString(best->effect), 100.0 * best->heldout_shrink)
-          : fmt::format("significant gap ({}); the best candidate, {}, closes {:.0f}% of it on held-out "
-                        "runs but leaves a significant gap (G = {:.1f} > {:.1f})",
-                        p_text, sim::EffectToString(best->effect), 100.0 * best->heldout_shrink,
-                        best->gap_after, null_quantile_alpha);
+            : fmt::format("significant gap ({}); fitted alone, the best candidate, {}, closes {:.0f}% of it on "
+                          "held-out runs ({:+.1f} nats of held-out evidence) and leaves G = {:.1f} ({} {:.1f})",
+                          p_text, sim::EffectToString(best->effect), 100.0 * best->heldout_shrink, best->evidence,
+                          best->gap_after, best->gap_after > null_quantile_alpha ? ">" : "<=", null_quantile_alpha);
   if (clock)
     reason += fmt::format("; {} would close {:.0f}% held out, but {}", sim::EffectToString(clock->effect),
                               100.0 * clock->heldout_shrink, clock->clock.text);
@@ -82,18 +78,17 @@ std::string UnexplainedReason(const Verdict& out, const Candidate* best, const s
   return reason;
 }
 
-/// The candidates' order, best first (`qualifies`: Decide's rule);
-/// `promoted`: a start/stop mechanism was moved above a qualifying noise
-/// effect without qualifying alone (VerdictOptions::mechanism_shrink).
+/// The candidates' order, best first, for the table and the pairs that
+/// explain the gap about equally well: usable (identifiable; a clock the
+/// moving samples support; a noise effect whose footprint the data do not
+/// contradict) first, then those that would close the gap alone
+/// (`qualifies`), then by held-out evidence. It names nothing: the verdict
+/// is the explanation's (explanation.hpp, docs/diagnosis.md "The verdict's
+/// rule"), whose first step is chosen by evidence alone.
 template <typename Qualifies>
-std::vector<std::size_t> Rank(const CandidateFits& fits, const Qualifies& qualifies, double mechanism_shrink,
-                              bool& promoted) {
-  promoted = false;
+std::vector<std::size_t> Rank(const CandidateFits& fits, const Qualifies& qualifies) {
   std::vector<std::size_t> rank(fits.candidates.size());
   for (std::size_t i = 0; i < rank.size(); ++i) rank[i] = i;
-  // Usable (identifiable; a clock supported by the moving samples; a noise
-  // effect whose footprint the data do not contradict) first, then those
-  // that qualify, then by evidence.
   auto usable = [](const Candidate& cd) { return cd.identifiable && cd.clock.supported && cd.footprint.consistent; };
   std::stable_sort(rank.begin(), rank.end(), [&](std::size_t a, std::size_t b) {
     const Candidate &ca = fits.candidates[a], &cb = fits.candidates[b];
@@ -101,118 +96,40 @@ std::vector<std::size_t> Rank(const CandidateFits& fits, const Qualifies& qualif
     if (qualifies(ca) != qualifies(cb)) return qualifies(ca);
     return ca.evidence > cb.evidence;
   });
-  // A noise effect on top yields to a qualifying mechanism where motions
-  // start or stop (each effect says whether it is one: Descriptor::
-  // at_motion_starts / at_motion_stops, the castor's kicks and the coast at
-  // stops; possible values): kicks or slides that vary from start to start
-  // also read as bumps (DART's swivel castors), but bumps have no turn's or
-  // drive's sign. (Clocks are not noise effects here: a clock the moving
-  // samples support outranks a slide by evidence, as the ground truth lags
-  // on through a stop by v tau.)
-  auto start_stop = [](const Candidate& cd) {
-    const effects::Descriptor& d = effects::Of(cd.effect).Describe();
-    return (d.at_motion_starts || d.at_motion_stops) && !cd.impossible;
-  };
-  auto pure_noise = [](const Candidate& cd) { return effects::Of(cd.effect).PureNoise(); };
-  auto promote_first = [&](auto&& which) {
-    for (std::size_t k = 1; k < rank.size(); ++k)
-      if (which(fits.candidates[rank[k]])) {
-        std::rotate(rank.begin(), rank.begin() + static_cast<std::ptrdiff_t>(k),
-                    rank.begin() + static_cast<std::ptrdiff_t>(k) + 1);
-        return true;
-      }
-    return false;
-  };
-  // The mechanism qualifies, or closes at least mechanism_shrink held out
-  // alone with positive evidence (the noise effect then takes the scatter
-  // left); the best such by evidence (rank's order).
-  if (!rank.empty() && qualifies(fits.candidates[rank.front()]) && pure_noise(fits.candidates[rank.front()])) {
-    if (!promote_first([&](const Candidate& cd) { return qualifies(cd) && start_stop(cd); }))
-      promoted = promote_first([&](const Candidate& cd) {
-        return start_stop(cd) && usable(cd) && cd.evidence > 0.0 && cd.heldout_shrink >= mechanism_shrink;
-      });
-  }
-  // A mechanism at the stops on top (a slide) yields to a qualifying clock
-  // the moving samples support (a clock is what the moving-sample check
-  // applies to, Candidate::clock): the slide cannot explain those samples,
-  // the clock explains the stops too.
-  if (!rank.empty() && effects::Of(fits.candidates[rank.front()].effect).Describe().at_motion_stops &&
-      promote_first([&](const Candidate& cd) { return qualifies(cd) && cd.clock.checked && cd.clock.supported; }))
-    promoted = false;
   return rank;
 }
 
-/// Ranks the candidates and names the verdict with its reason.
+/// Ranks the candidates; `none` without a significant gap, else
+/// `unexplained` until the explanation names its effects (diagnose.cpp
+/// NameEffects), with the reason in terms of the single-effect fits.
 void Decide(const CandidateFits& fits, double score_p_value, double null_quantile_alpha, const VerdictOptions& options,
             Verdict& out) {
-  // Level of each route: half of alpha each when both are combined.
-  const double route_alpha = options.likelihood_tests && out.tests > 0 ? 0.5 * options.alpha : options.alpha;
-  const bool found_by_tests = options.likelihood_tests && out.tests > 0 && out.tests_p_value < route_alpha;
-  // Best first: effects that close most of the held-out gap with positive
-  // evidence, by evidence; then the others by evidence; unidentifiable last.
-  // A winner must also leave no significant gap behind, unless it closes
-  // nearly all of it (a tiny misfit of a huge effect still scores high).
-  // A clock offset whose moving samples do not show it (Candidate::clock)
-  // is a footprint of something at the stops: never named.
+  // Would close the gap alone: closes most of the held-out gap with
+  // positive evidence and leaves no significant gap (or nearly none of it).
   auto qualifies = [&](const Candidate& cd) {
     return cd.identifiable && cd.clock.supported && cd.footprint.consistent && cd.evidence > 0.0 &&
            cd.heldout_shrink >= options.min_heldout_shrink &&
            (cd.gap_after <= null_quantile_alpha || cd.heldout_shrink >= options.full_shrink);
   };
-  // Found by its own likelihood-ratio test (the gap G may be too diffuse to
-  // see it): significant after Bonferroni, gains held out, and leaves no
-  // significant G.
-  auto found_alone = [&](const Candidate& cd) {
-    return found_by_tests && cd.identifiable && cd.clock.supported && cd.footprint.consistent && cd.tested &&
-           !cd.impossible &&
-           out.tests * cd.lr_p_value < route_alpha &&
-           cd.evidence > 0.0 && cd.gap_after <= null_quantile_alpha;
-  };
-  bool promoted = false;
-  std::vector<std::size_t> rank = Rank(fits, qualifies, options.mechanism_shrink, promoted);
-  if (out.significant && !rank.empty() && !qualifies(fits.candidates[rank.front()]) && !promoted) {
-    // No candidate closes the gap G measures: the likelihood-ratio route.
-    std::size_t best = rank.size();
-    for (std::size_t k = 0; k < rank.size(); ++k)
-      if (found_alone(fits.candidates[rank[k]]) && (best == rank.size() || fits.candidates[rank[k]].lr_p_value < fits.candidates[rank[best]].lr_p_value))
-        best = k;
-    if (best < rank.size()) std::rotate(rank.begin(), rank.begin() + static_cast<std::ptrdiff_t>(best),
-                                        rank.begin() + static_cast<std::ptrdiff_t>(best) + 1);
-  }
-  for (std::size_t i : rank) out.candidates.push_back(fits.candidates[i]);
-  const std::string p_text =
+  for (std::size_t i : Rank(fits, qualifies)) out.candidates.push_back(fits.candidates[i]);
+  out.significance =
       options.likelihood_tests && out.tests > 0
           ? fmt::format("{}: gap score {}, likelihood-ratio tests {} (Bonferroni over {})", P(out.p_value),
                         P(score_p_value), P(out.tests_p_value), out.tests)
           : P(out.p_value);
+  // The gap score found the gap on its own (at its half of alpha when both
+  // routes are combined): the explanation must then close it held out too.
+  const double route_alpha = options.likelihood_tests && out.tests > 0 ? 0.5 * options.alpha : options.alpha;
+  out.found_by_score = score_p_value < route_alpha;
   if (!out.significant) {
     out.verdict = "none";
-    out.reason = fmt::format("the gap is not significant ({} >= alpha = {})", p_text, options.alpha);
-  } else {
-    const Candidate* best = out.candidates.empty() || !out.candidates.front().identifiable ? nullptr : &out.candidates.front();
-    if (best && (qualifies(*best) || promoted)) {
-      out.verdict = sim::EffectToString(best->effect);
-      out.reason = fmt::format(
-          "{} closes {:.0f}% of the gap on held-out runs (held-out log-likelihood +{:.1f} nats over the baseline)",
-          out.verdict, 100.0 * best->heldout_shrink, best->heldout_loglik_gain);
-      if (promoted && out.candidates.size() > 1)
-        out.reason += fmt::format("; a mechanism at the starts and stops of motions, ranked before {} (which closes "
-                                  "{:.0f}% as scatter, without the turn's or the drive's sign)",
-                                  sim::EffectToString(out.candidates[1].effect),
-                                  100.0 * out.candidates[1].heldout_shrink);
-    } else if (best && found_alone(*best)) {
-      out.verdict = sim::EffectToString(best->effect);
-      out.reason = fmt::format(
-          "{} is significant on its own likelihood-ratio test (+{:.1f} nats, {}, {} tests) and gains {:.1f} "
-          "nats on held-out runs; the gap score alone ({}) spreads it over too many statistics to see it, "
-          "and none remains with the effect (G = {:.1f} <= {:.1f})",
-          out.verdict, best->loglik_gain, P(best->lr_p_value), out.tests, best->heldout_loglik_gain, P(score_p_value),
-          best->gap_after, null_quantile_alpha);
-    } else {
-      out.verdict = "unexplained";
-      out.reason = UnexplainedReason(out, best, p_text, null_quantile_alpha, options);
-    }
+    out.reason = fmt::format("the gap is not significant ({} >= alpha = {})", out.significance, options.alpha);
+    return;
   }
+  const Candidate* best =
+      out.candidates.empty() || !out.candidates.front().identifiable ? nullptr : &out.candidates.front();
+  out.verdict = "unexplained";
+  out.reason = UnexplainedReason(out, best, out.significance, null_quantile_alpha);
 }
 
 /// The part of a candidate's note from the effect it is "indistinguishable

@@ -6,20 +6,17 @@
 //  (Wilks); the tests are combined by Bonferroni, p_tests = min(1, m min
 //  p_e), and with G's own p-value, p = min(1, 2 min(p_G, p_tests)), so the
 //  false-alarm rate stays at most alpha.
-//  Verdict: `none` when p >= alpha; else the top candidate if it closes
-//  enough of the held-out gap and leaves no significant gap; else the
-//  likelihood-ratio route; else `unexplained`. Candidates rank by whether
-//  they are usable (identifiable; a clock the moving samples support; a
-//  noise effect whose footprint the data do not contradict, footprint.hpp),
-//  then whether they qualify, then by evidence; then a noise effect on top
-//  yields to a qualifying mechanism at the starts and stops of motions
-//  (castor_kick, castor_swivel, stop_slide: a shift with the turn's or the
-//  drive's sign, which kicks that vary imitate as scatter: DART's swivel
-//  castors read as bumps), and a slide on top yields to a qualifying clock
-//  the moving samples support (which explains the stops too). A test whose
-//  fit lies below its practical floor (a 0.2 ms clock), or a clock the
-//  moving samples do not support, counts in the Bonferroni factor but is no
-//  evidence. Effects the data cannot tell apart are listed.
+//  Verdict: `none` when p >= alpha; else `unexplained` until the stepwise
+//  explanation (explanation.hpp) names its effects: the verdict IS the
+//  explanation (docs/diagnosis.md, "The verdict's rule"), whose first step
+//  is chosen by held-out evidence like every other step. This stage ranks
+//  the candidates, each fitted alone, for the table (usable first:
+//  identifiable; a clock the moving samples support; a noise effect whose
+//  footprint the data do not contradict, footprint.hpp; then those that
+//  would close the gap alone; then by evidence), and names nothing. A test
+//  whose fit lies below its practical floor (a 0.2 ms clock), or a clock
+//  the moving samples do not support, counts in the Bonferroni factor but
+//  is no evidence. Effects the data cannot tell apart are listed.
 #pragma once
 
 #include <string>
@@ -33,7 +30,8 @@ namespace umbmark::diag {
 struct VerdictOptions {
   /// False-alarm rate. Default 0.01.
   double alpha = 0.01;
-  /// A winner closes at least this fraction of the held-out gap. Default 0.5.
+  /// A candidate "would close the gap alone" (the table's order) when it
+  /// closes at least this fraction of the held-out gap... Default 0.5.
   double min_heldout_shrink = 0.5;
   /// ...and leaves no significant gap unless it closes this much. Default 0.9.
   double full_shrink = 0.9;
@@ -46,12 +44,6 @@ struct VerdictOptions {
   /// The campaign's speeds and distances for those floors (its negligible
   /// is this struct's). Default: CampaignScale's.
   effects::CampaignScale campaign;
-  /// A mechanism at the starts and stops of motions (castor_kick,
-  /// castor_swivel, stop_slide) that closes at least this fraction of the
-  /// held-out gap alone outranks a qualifying noise effect even when it
-  /// leaves scatter behind (kicks that vary from start to start: the noise
-  /// effect beside it takes the scatter). Default 0.8.
-  double mechanism_shrink = 0.8;
 };
 
 struct Verdict {
@@ -60,8 +52,16 @@ struct Verdict {
   int tests = 0;
   bool significant = false;
   std::vector<Candidate> candidates;  ///< ranked, best first
-  std::string verdict;                ///< effect name | none | unexplained
+  std::string verdict;                ///< none | unexplained (the explanation names effects)
   std::string reason;
+  /// The combined p-value in words ("p = ...: gap score ..., likelihood-ratio
+  /// tests ... (Bonferroni over m)").
+  std::string significance;
+  /// Whether the gap score G alone found the gap (p_G below its share of
+  /// alpha): the explanation must then also close the held-out gap G
+  /// measures; when only the likelihood-ratio tests found it, G is no
+  /// measure of it and held-out evidence with the residual test decide.
+  bool found_by_score = false;
   std::vector<std::string> indistinguishable;
 };
 
