@@ -102,11 +102,17 @@ Command SetupDiagnose(CLI::App& parent) {
       "--fit-ground-truth-noise", [opts] { opts->o.diag.baseline_fit.ground_truth = diag::GroundTruthNoiseSource::kFitted; },
       "Fit the ground truth's noise with the wheel noise on the pieces (before issue 28; an unmodelled effect can "
       "widen it) instead of taking the scatter inside the standstills (default), when the manifest states none");
-  app->add_flag_callback(
+  CLI::Option* hold = app->add_flag_callback(
       "--hold-wheel-noise", [opts] { opts->o.diag.baseline_fit.wheel = diag::WheelNoiseSource::kRepeats; },
       "Hold the wheel noise k_L, k_R at the scatter of repeated runs about their own mean, where the design supports "
-      "it (a mean effect cannot widen it; noise effects that differ from run to run are then in it), instead of "
-      "fitting it jointly with E_d, E_b on the pieces (default)");
+      "it (a mean effect cannot widen it; each candidate re-measures it there jointly with its own run-to-run "
+      "variance), instead of fitting it jointly with E_d, E_b on the pieces (the default)");
+  app->add_flag_callback(
+      "--fit-wheel-noise", [opts] { opts->o.diag.baseline_fit.wheel = diag::WheelNoiseSource::kFitted; },
+      "Fit the wheel noise k_L, k_R jointly with E_d, E_b on the pieces (the default; a mean effect the baseline "
+      "leaves out can widen it) instead of holding it at the scatter of repeated runs; that scatter is still "
+      "measured, with a warning when the two disagree")
+      ->excludes(hold);
   app->add_flag("--monotone-shrink,!--no-monotone-shrink", d.keep_heldout_shrink,
                 "A step of the explanation may not lower the cumulative held-out shrink (default: off)");
   app->add_option("--max-effects", d.max_explanation_effects, "Most effects in the stepwise explanation (default 4)")

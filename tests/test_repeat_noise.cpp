@@ -247,3 +247,115 @@ TEST_CASE("repeat noise: the baseline holds it with --hold-wheel-noise, reports 
   INFO("fitted k_L " << fitted.baseline.k_L << ", k_R " << fitted.baseline.k_R);
   CHECK(warned == off);
 }
+
+namespace {
+
+/// The repeated runs' k fitted jointly with the run-to-run variance terms
+/// `fit` enables (FitRepeatWheelNoise), at the nominal robot as Measure.
+RepeatWheelFit MeasureJoint(const CampaignData& c, PieceNoiseFitOptions fit, bool bumps = false) {
+  const MeanModel model(c);
+  std::vector<double> eps;
+  const ParamVector p = NominalParams();
+  model.Residuals(p, eps);
+  const std::vector<PieceBases> bases = ComputeBases(c, model, p);
+  NoiseParams start;
+  start.sxy2 = 3e-4 * 3e-4;
+  start.sth2 = 1.5e-3 * 1.5e-3;
+  fit.min_sigma_xy2 = fit.min_sigma_theta2 = 1e-12;
+  const RepeatNoiseOptions o;
+  return FitRepeatWheelNoise(BuildRepeatDesign(c, bases, o), BuildRepeatDesign(c, bases, o, true), c, eps, bases,
+                             start, fit, bumps);
+}
+
+}  // namespace
+
+TEST_CASE("repeat noise: k fitted jointly with a run-to-run variance on the contrasts recovers both",
+          "[repeat_noise]") {
+  // 6 campaigns (seeds 301..306) with k_L = 1.5e-3, k_R = 2.5e-3 m^1/2 and a
+  // motion_noise_floor of sigma = 3 mm (a start and stop slip per motion,
+  // independent from run to run). The wheels-only contrasts give k the
+  // floor's variance too (k_R^2 off by more than 3 of its sd on average).
+  // Fitted jointly with the floor's sigma^2 (its basis F enters each
+  // contrast as sum h_i^2 F_i, as the wheels' do), each k^2 is within 3 of
+  // its stated sd (the joint Fisher information's) of the truth, their mean
+  // within 3 sd / sqrt(6), and the mean sigma within 15 % of 3 mm.
+  const double kL2 = 1.5e-3 * 1.5e-3, kR2 = 2.5e-3 * 2.5e-3, floor = 3e-3;
+  const int n = 6;
+  double sumL = 0, sumR = 0, sdL = 0, sdR = 0, sum_floor = 0, wheels_only_R = 0;
+  for (int i = 0; i < n; ++i) {
+    testing::SmallCampaign s = Campaign(301 + static_cast<std::uint64_t>(i));
+    s.sim.effects.floor_sigma = floor;
+    const CampaignData c = testing::BuildSmallCampaign(s);
+    const RepeatNoise wheels = Measure(c);
+    REQUIRE(wheels.measured);
+    PieceNoiseFitOptions fit;
+    fit.motion_floor = true;
+    const RepeatWheelFit joint = MeasureJoint(c, fit);
+    INFO("seed " << 301 + i << ": wheels only " << RepeatNoiseSummary(wheels) << "; joint k_L^2 "
+                 << joint.noise.kL2 << " +- " << joint.sd_kL2 << ", k_R^2 " << joint.noise.kR2 << " +- "
+                 << joint.sd_kR2 << ", floor " << std::sqrt(joint.noise.floor_s2));
+    CHECK(std::abs(joint.noise.kL2 - kL2) < 3.0 * joint.sd_kL2);
+    CHECK(std::abs(joint.noise.kR2 - kR2) < 3.0 * joint.sd_kR2);
+    sumL += joint.noise.kL2 / n;
+    sumR += joint.noise.kR2 / n;
+    sdL += joint.sd_kL2 / n;
+    sdR += joint.sd_kR2 / n;
+    sum_floor += std::sqrt(joint.noise.floor_s2) / n;
+    wheels_only_R += (wheels.k_R * wheels.k_R - kR2) / (wheels.sd_kR2 * n);
+  }
+  INFO("mean joint k_L^2 " << sumL << " (sd " << sdL << "), k_R^2 " << sumR << " (sd " << sdR << "), floor "
+                           << sum_floor << "; wheels-only k_R^2 off by " << wheels_only_R << " sd on average");
+  CHECK(wheels_only_R > 3.0);
+  CHECK(std::abs(sumL - kL2) < 3.0 * sdL / std::sqrt(n));
+  CHECK(std::abs(sumR - kR2) < 3.0 * sdR / std::sqrt(n));
+  CHECK(std::abs(sum_floor - floor) < 0.15 * floor);
+}
+
+TEST_CASE("repeat noise: a per-run clock is taken by its tau_sd, a marker or scale error moves k by under its sd",
+          "[repeat_noise]") {
+  // Seeds 311..316 with run_time_offset tau_sd = 40 ms (each run's clock
+  // N(0, tau_sd^2), the same for all its pieces): fitted jointly with
+  // tau_sd^2 (basis T) on the contrasts, each k^2 within 3 of its stated sd
+  // of the truth and the mean tau_sd within 25 % of 40 ms. Then seed 311
+  // with the floor of the test above, with a 36 mm marker offset and with a
+  // 1.5 % scale error added: both the same in every run, so k (fitted
+  // jointly with the floor) moves by less than 1.5 of its stated sd (the
+  // marker's second-order shift, "a marker offset ..." above) and 1 sd.
+  const double kL2 = 1.5e-3 * 1.5e-3, kR2 = 2.5e-3 * 2.5e-3, tau = 0.04;
+  const int n = 6;
+  double sum_tau = 0;
+  for (int i = 0; i < n; ++i) {
+    testing::SmallCampaign s = Campaign(311 + static_cast<std::uint64_t>(i));
+    s.sim.effects.run_tau_sd = tau;
+    const CampaignData c = testing::BuildSmallCampaign(s);
+    PieceNoiseFitOptions fit;
+    fit.run_time = true;
+    const RepeatWheelFit joint = MeasureJoint(c, fit);
+    INFO("seed " << 311 + i << ": joint k_L^2 " << joint.noise.kL2 << " +- " << joint.sd_kL2 << ", k_R^2 "
+                 << joint.noise.kR2 << " +- " << joint.sd_kR2 << ", tau_sd " << std::sqrt(joint.noise.run_tau2));
+    CHECK(std::abs(joint.noise.kL2 - kL2) < 3.0 * joint.sd_kL2);
+    CHECK(std::abs(joint.noise.kR2 - kR2) < 3.0 * joint.sd_kR2);
+    sum_tau += std::sqrt(joint.noise.run_tau2) / n;
+  }
+  INFO("mean tau_sd " << sum_tau);
+  CHECK(std::abs(sum_tau - tau) < 0.25 * tau);
+
+  testing::SmallCampaign s = Campaign(311);
+  s.sim.effects.floor_sigma = 3e-3;
+  PieceNoiseFitOptions fit;
+  fit.motion_floor = true;
+  const RepeatWheelFit clean = MeasureJoint(testing::BuildSmallCampaign(s), fit);
+  s.sim.effects.gt_dx = 0.03;
+  s.sim.effects.gt_dy = -0.02;
+  const RepeatWheelFit marker = MeasureJoint(testing::BuildSmallCampaign(s), fit);
+  s.sim.effects.gt_dx = s.sim.effects.gt_dy = 0.0;
+  s.sim.effects.scale_s = 0.015;
+  const RepeatWheelFit scale = MeasureJoint(testing::BuildSmallCampaign(s), fit);
+  INFO("clean k^2 " << clean.noise.kL2 << " +- " << clean.sd_kL2 << ", " << clean.noise.kR2 << " +- " << clean.sd_kR2
+                    << "; marker " << marker.noise.kL2 << ", " << marker.noise.kR2 << "; scale " << scale.noise.kL2
+                    << ", " << scale.noise.kR2);
+  CHECK(std::abs(marker.noise.kL2 - clean.noise.kL2) < 1.5 * clean.sd_kL2);
+  CHECK(std::abs(marker.noise.kR2 - clean.noise.kR2) < 1.5 * clean.sd_kR2);
+  CHECK(std::abs(scale.noise.kL2 - clean.noise.kL2) < clean.sd_kL2);
+  CHECK(std::abs(scale.noise.kR2 - clean.noise.kR2) < clean.sd_kR2);
+}

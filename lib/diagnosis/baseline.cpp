@@ -124,12 +124,24 @@ void StartWheelNoise(const CampaignData& c, const std::vector<double>& eps, cons
   b.wheel_noise_source = "fitted";
   if (options.wheel != WheelNoiseSource::kRepeats || !b.repeat.measured) return;
   b.wheel_noise_source = "repeats";
+  b.repeat_design = BuildRepeatDesign(c, b.bases, options.repeat);
+  b.repeat_pairs = BuildRepeatDesign(c, b.bases, options.repeat, /*pairs=*/true);
   noise.kL2 = std::max(b.repeat.k_L * b.repeat.k_L, b.noise_fit.min_k2);
   noise.kR2 = std::max(b.repeat.k_R * b.repeat.k_R, b.noise_fit.min_k2);
   b.noise_fit.fit_wheel_noise = false;
 }
 
 }  // namespace
+
+NoiseParams HeldWheelNoise(const CampaignData& c, const BaselineFit& b, const std::vector<double>& eps,
+                           const std::vector<PieceBases>& bases, NoiseParams start, const PieceNoiseFitOptions& fit,
+                           bool bumps) {
+  if (b.wheel_noise_source != "repeats" || b.repeat_design.contrasts.empty()) return start;
+  const NoiseParams r = FitRepeatWheelNoise(b.repeat_design, b.repeat_pairs, c, eps, bases, start, fit, bumps).noise;
+  start.kL2 = std::max(r.kL2, fit.min_k2);
+  start.kR2 = std::max(r.kR2, fit.min_k2);
+  return start;
+}
 
 BaselineFit FitBaseline(const CampaignData& c, const MeanModel& model, const BaselineStart& start,
                         const BaselineFitOptions& options) {

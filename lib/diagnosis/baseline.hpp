@@ -119,6 +119,10 @@ struct BaselineFit {
   /// Source "repeats": k_L, k_R the pieces would fit jointly with the mean
   /// [m^1/2] (0 otherwise).
   double pieces_k_L = 0.0, pieces_k_R = 0.0;
+  /// Source "repeats": the repeated runs' contrasts (all of them, and the
+  /// disjoint pairs for bumps), on which every later refit re-measures the
+  /// held k with its own variance terms (HeldWheelNoise); empty otherwise.
+  RepeatDesign repeat_design, repeat_pairs;
   std::vector<PieceBases> bases;
   std::vector<double> eps;            ///< piece residuals at p
   std::vector<Eigen::Matrix3d> W;     ///< whiteners at `noise`
@@ -129,6 +133,18 @@ struct BaselineFit {
 
 BaselineFit FitBaseline(const CampaignData& c, const MeanModel& model, const BaselineStart& start,
                         const BaselineFitOptions& options);
+
+/// The start of a later refit's noise (a candidate's, an explanation
+/// step's) with residuals `eps` at `bases` and the variance terms `fit`
+/// enables (and bumps): with the wheel noise held at the repeated runs'
+/// scatter (source "repeats"), its k_L, k_R re-measured on the contrasts of
+/// these residuals jointly with those terms (FitRepeatWheelNoise), so that
+/// the held k holds no run-to-run variance the refit gives to an effect of
+/// its own (a per-run clock, a motion floor, settling, bumps) and no
+/// run-to-run mean it models (a parameter drift); otherwise `start`.
+NoiseParams HeldWheelNoise(const CampaignData& c, const BaselineFit& b, const std::vector<double>& eps,
+                           const std::vector<PieceBases>& bases, NoiseParams start, const PieceNoiseFitOptions& fit,
+                           bool bumps);
 
 /// The ground truth's noise at the start of a baseline's noise fit, and
 /// whether that fit estimates it: the manifest's (floored at 1 um, 1 urad),

@@ -348,6 +348,7 @@ MeanFit FitMeanEffect(const Shared& x, const std::vector<int>& eparams, Candidat
   // variance there, from the fitted kappa.
   NoiseParams start = x.b.noise;
   start.swivel_rev2 = mf.p[kParamSwivel] * mf.p[kParamSwivel];
+  start = HeldWheelNoise(c, x.b, mf.eps, bases, start, x.b.noise_fit, /*bumps=*/false);
   NoiseParams ne = FitPieceNoise(mf.eps, bases, c.pieces, {}, start, x.b.noise_fit);
   const std::vector<Eigen::Matrix3d> We = Whiteners(bases, c.pieces, ne);
   // Parameter standard errors with the refitted noise.
@@ -459,8 +460,10 @@ void FitNoiseEffect(const Shared& x, sim::EffectKind kind, Candidate& cd) {
   EnableNoiseEffect(kind, cf);
   PieceNoiseFitOptions cf_fold = x.fold_fit;
   EnableNoiseEffect(kind, cf_fold);
-  NoiseParams ne = corr ? FitPieceNoise(x.b.eps, x.b.bases, c.pieces, {}, x.b.noise, cf)
-                        : FitBumps(x.b.eps, x.b.bases, c.pieces, {}, x.b.noise, /*start_only=*/false,
+  // A held wheel noise is re-measured with this effect's variance (baseline.hpp).
+  const NoiseParams start = HeldWheelNoise(c, x.b, x.b.eps, x.b.bases, x.b.noise, cf, !corr);
+  NoiseParams ne = corr ? FitPieceNoise(x.b.eps, x.b.bases, c.pieces, {}, start, cf)
+                        : FitBumps(x.b.eps, x.b.bases, c.pieces, {}, start, /*start_only=*/false,
                                    cf.fit_wheel_noise);
   // run_time_offset: its levers at the fitted tau_sd (run_block.hpp).
   std::vector<PieceBases> rescaled;

@@ -116,33 +116,27 @@ std::vector<int> Align(const CampaignData& c, const std::vector<PieceBases>& bas
 
 /// The contrasts of one stretch of the path: `pieces` (one per run, in
 /// campaign order) with their runs' places in the campaign `place`.
-void AddPosition(const CampaignData& c, const std::vector<double>& eps, const std::vector<PieceBases>& bases,
-                 const std::vector<int>& pieces, const std::vector<double>& place, const RepeatNoiseOptions& o,
-                 RepeatContrasts& out) {
+void AddPosition(const CampaignData& c, const std::vector<int>& pieces, const std::vector<double>& place,
+                 const RepeatNoiseOptions& o, bool pairs, RepeatDesign& out) {
   const Eigen::Index n = static_cast<Eigen::Index>(pieces.size());
+  int components = 3;
+  for (int j : pieces) components = std::min(components, c.pieces[static_cast<std::size_t>(j)].components);
+  if (pairs) {
+    const double h = 1.0 / std::sqrt(2.0);
+    for (std::size_t i = 0; i + 1 < pieces.size(); i += 2)
+      out.contrasts.push_back({{pieces[i], pieces[i + 1]}, {h, -h}, components});
+    return;
+  }
   Eigen::MatrixXd X(n, o.detrend ? 2 : 1);
   for (Eigen::Index i = 0; i < n; ++i) {
     X(i, 0) = 1.0;
     if (o.detrend) X(i, 1) = place[static_cast<std::size_t>(i)];
   }
   const Eigen::MatrixXd H = Contrasts(X);
-  int components = 3;
-  for (int j : pieces) components = std::min(components, c.pieces[static_cast<std::size_t>(j)].components);
   for (Eigen::Index k = 0; k < H.rows(); ++k) {
-    Eigen::Vector3d z = Eigen::Vector3d::Zero();
-    PieceBases B;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const std::size_t j = static_cast<std::size_t>(pieces[static_cast<std::size_t>(i)]);
-      const double h = H(k, i);
-      z += h * Eigen::Vector3d(eps[3 * j], eps[3 * j + 1], eps[3 * j + 2]);
-      AddBases(B, bases[j], h * h);
-    }
-    if (components < 3) z[2] = 0.0;
-    out.eps.insert(out.eps.end(), {z[0], z[1], z[2]});
-    out.bases.push_back(B);
-    Piece p = c.pieces[static_cast<std::size_t>(pieces.front())];
-    p.components = components;
-    out.pieces.push_back(p);
+    RepeatDesign::Contrast z{pieces, std::vector<double>(pieces.size()), components};
+    for (Eigen::Index i = 0; i < n; ++i) z.h[static_cast<std::size_t>(i)] = H(k, i);
+    out.contrasts.push_back(std::move(z));
   }
 }
 
@@ -165,9 +159,9 @@ Eigen::Matrix2d WheelInformation(const RepeatContrasts& rc, const NoiseParams& n
 
 }  // namespace
 
-RepeatContrasts FormRepeatContrasts(const CampaignData& c, const std::vector<double>& eps,
-                                    const std::vector<PieceBases>& bases, const RepeatNoiseOptions& options) {
-  RepeatContrasts out;
+RepeatDesign BuildRepeatDesign(const CampaignData& c, const std::vector<PieceBases>& bases,
+                               const RepeatNoiseOptions& options, bool pairs) {
+  RepeatDesign out;
   const std::size_t fewest = options.detrend ? 3 : 2;  // runs at a position: more than the contrasts' constraints
   for (auto& [key, group] : GroupRuns(c)) {
     // Runs of one label may drive different paths (the June circles: cw and
@@ -198,7 +192,7 @@ RepeatContrasts FormRepeatContrasts(const CampaignData& c, const std::vector<dou
             place.push_back(c.runs[static_cast<std::size_t>(c.pieces[static_cast<std::size_t>(a[m])].run)].campaign_index);
           }
         if (pieces.size() < fewest) continue;
-        AddPosition(c, eps, bases, pieces, place, options, out);
+        AddPosition(c, pieces, place, options, pairs, out);
         ++used;
       }
       if (used == 0) continue;
@@ -207,6 +201,82 @@ RepeatContrasts FormRepeatContrasts(const CampaignData& c, const std::vector<dou
       out.positions += used;
     }
   }
+  return out;
+}
+
+RepeatContrasts ApplyRepeatDesign(const RepeatDesign& design, const CampaignData& c, const std::vector<double>& eps,
+                                  const std::vector<PieceBases>& bases) {
+  RepeatContrasts out;
+  out.groups = design.groups;
+  out.runs = design.runs;
+  out.positions = design.positions;
+  out.eps.reserve(3 * design.contrasts.size());
+  out.bases.reserve(design.contrasts.size());
+  out.pieces.reserve(design.contrasts.size());
+  for (const RepeatDesign::Contrast& k : design.contrasts) {
+    Eigen::Vector3d z = Eigen::Vector3d::Zero();
+    PieceBases B;
+    for (std::size_t i = 0; i < k.pieces.size(); ++i) {
+      const std::size_t j = static_cast<std::size_t>(k.pieces[i]);
+      z += k.h[i] * Eigen::Vector3d(eps[3 * j], eps[3 * j + 1], eps[3 * j + 2]);
+      AddBases(B, bases[j], k.h[i] * k.h[i]);
+    }
+    if (k.components < 3) z[2] = 0.0;
+    out.eps.insert(out.eps.end(), {z[0], z[1], z[2]});
+    out.bases.push_back(B);
+    Piece p = c.pieces[static_cast<std::size_t>(k.pieces.front())];
+    p.components = k.components;
+    out.pieces.push_back(p);
+  }
+  return out;
+}
+
+RepeatContrasts FormRepeatContrasts(const CampaignData& c, const std::vector<double>& eps,
+                                    const std::vector<PieceBases>& bases, const RepeatNoiseOptions& options) {
+  return ApplyRepeatDesign(BuildRepeatDesign(c, bases, options), c, eps, bases);
+}
+
+RepeatWheelFit FitRepeatWheelNoise(const RepeatDesign& design, const RepeatDesign& pairs, const CampaignData& c,
+                                   const std::vector<double>& eps, const std::vector<PieceBases>& bases,
+                                   const NoiseParams& start, const PieceNoiseFitOptions& fit, bool bumps) {
+  PieceNoiseFitOptions o = fit;
+  o.fit_wheel_noise = true;
+  RepeatWheelFit out;
+  NoiseParams n = start;
+  if (bumps) {
+    const RepeatContrasts rc = ApplyRepeatDesign(pairs, c, eps, bases);
+    n.c_LR = n.floor_s2 = n.stand_xy2 = n.stand_th2 = n.run_tau2 = 0.0;
+    out.noise = FitBumps(rc.eps, rc.bases, rc.pieces, {}, n, /*start_only=*/false, /*fit_wheel_noise=*/true);
+    out.contrasts = static_cast<int>(rc.pieces.size());
+    return out;
+  }
+  const RepeatContrasts rc = ApplyRepeatDesign(design, c, eps, bases);
+  n.bump_rate = n.bump_s2 = 0.0;
+  out.noise = FitPieceNoise(rc.eps, rc.bases, rc.pieces, {}, n, o);
+  out.contrasts = static_cast<int>(rc.pieces.size());
+  // Fisher information of the fitted variances: the wheels first, then each
+  // enabled term's basis.
+  std::vector<Eigen::Matrix3d PieceBases::*> terms = {&PieceBases::A_L, &PieceBases::A_R};
+  if (o.correlated) terms.push_back(&PieceBases::A_LR);
+  if (o.motion_floor) terms.push_back(&PieceBases::F);
+  if (o.standstill) terms.insert(terms.end(), {&PieceBases::S_xy, &PieceBases::S_theta});
+  if (o.run_time) terms.push_back(&PieceBases::T);
+  const Eigen::Index m = static_cast<Eigen::Index>(terms.size());
+  Eigen::MatrixXd I = Eigen::MatrixXd::Zero(m, m);
+  for (std::size_t j = 0; j < rc.pieces.size(); ++j) {
+    const int d = rc.pieces[j].components;
+    const Eigen::MatrixXd Ci = PieceCovariance(rc.bases[j], out.noise).topLeftCorner(d, d).inverse();
+    std::vector<Eigen::MatrixXd> M;
+    for (auto t : terms) M.push_back(Ci * (rc.bases[j].*t).topLeftCorner(d, d));
+    for (Eigen::Index a = 0; a < m; ++a)
+      for (Eigen::Index b = 0; b < m; ++b)
+        I(a, b) += 0.5 * (M[static_cast<std::size_t>(a)] * M[static_cast<std::size_t>(b)]).trace();
+  }
+  // A variance term at its floor (0) carries no information in practice:
+  // its row is kept, the pseudo-inverse keeps the wheels' part finite.
+  const Eigen::MatrixXd V = I.completeOrthogonalDecomposition().pseudoInverse();
+  out.sd_kL2 = std::sqrt(std::max(0.0, V(0, 0)));
+  out.sd_kR2 = std::sqrt(std::max(0.0, V(1, 1)));
   return out;
 }
 

@@ -109,10 +109,62 @@ struct RepeatContrasts {
   int groups = 0, runs = 0, positions = 0;
 };
 
+/// Which pieces form each contrast, with which weights h: the grouping and
+/// alignment, done once per campaign (they depend on the pieces' types,
+/// signs, travel and turns, not on the residuals), applied to any residuals
+/// and bases by ApplyRepeatDesign.
+struct RepeatDesign {
+  struct Contrast {
+    std::vector<int> pieces;  ///< one per run at the stretch, campaign order
+    std::vector<double> h;    ///< sum h = 0, sum h^2 = 1
+    int components = 3;
+  };
+  std::vector<Contrast> contrasts;
+  int groups = 0, runs = 0, positions = 0;
+};
+
+/// The contrasts' design. pairs = false: n - 1 orthonormal contrasts of the
+/// n runs at a stretch (as FormRepeatContrasts). pairs = true: floor(n / 2)
+/// disjoint differences of consecutive runs, (eps_a - eps_b) / sqrt(2): a
+/// bump_outliers process in them is again one (rate x 2 over the piece's
+/// travel, sigma_b^2 / 2), which a Helmert contrast's unequal weights are not.
+RepeatDesign BuildRepeatDesign(const CampaignData& c, const std::vector<PieceBases>& bases,
+                               const RepeatNoiseOptions& options, bool pairs = false);
+
+/// The contrasts of residuals `eps` (3 per piece of c) and their bases
+/// sum_i h_i^2 B_i under `design`.
+RepeatContrasts ApplyRepeatDesign(const RepeatDesign& design, const CampaignData& c, const std::vector<double>& eps,
+                                  const std::vector<PieceBases>& bases);
+
 /// Groups the runs by experiment and direction, matches their pieces by
 /// position and forms the contrasts of residuals `eps` (3 per piece of c).
 RepeatContrasts FormRepeatContrasts(const CampaignData& c, const std::vector<double>& eps,
                                     const std::vector<PieceBases>& bases, const RepeatNoiseOptions& options);
+
+/// The wheel noise of a refit that adds run-to-run variance of its own
+/// (issue 28): k_L^2, k_R^2 fitted on the contrasts of the refit's
+/// residuals `eps` jointly with every variance term `fit` enables
+/// (correlated_noise's c, motion_noise_floor's sigma^2, standstill_motion's
+/// sigma_xy^2, sigma_theta^2, run_time_offset's tau_sd^2; with `bumps` the
+/// bump mixture, on the `pairs` design). Each such term's covariance enters
+/// a contrast as sum_i h_i^2 of its per-run footprint (its basis F, S_xy,
+/// S_theta, T, A_LR), exactly as the wheels' do, so the contrasts' scatter
+/// is split between k and the term instead of being given to k whole; a
+/// mean the same in every run still drops out. The ground truth's noise and
+/// swivel_rev2 stay at `start`'s.
+struct RepeatWheelFit {
+  /// The contrasts' fit: its k are the ones to hold; its other terms are the
+  /// contrasts' own estimates of the enabled variances.
+  NoiseParams noise;
+  /// Standard errors of k_L^2, k_R^2 [m] from the contrasts' Fisher
+  /// information of every fitted variance (the enabled terms' uncertainty
+  /// included); 0 for the bump mixture.
+  double sd_kL2 = 0.0, sd_kR2 = 0.0;
+  int contrasts = 0;
+};
+RepeatWheelFit FitRepeatWheelNoise(const RepeatDesign& design, const RepeatDesign& pairs, const CampaignData& c,
+                                const std::vector<double>& eps, const std::vector<PieceBases>& bases,
+                                const NoiseParams& start, const PieceNoiseFitOptions& fit, bool bumps);
 
 /// k_L, k_R from the contrasts of `eps` at bases `bases`; `start` carries the
 /// ground truth's noise (held fixed unless fit.fit_ground_truth) and the
