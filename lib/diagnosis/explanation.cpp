@@ -97,9 +97,11 @@ SetFit FitSet(const CampaignData& c, const MeanModel& model, const BaselineFit& 
   NoiseParams start = b.noise, warm_start = warm ? *warm : b.noise;
   start.swivel_rev2 = warm_start.swivel_rev2 = swivel_rev2;
   // A held wheel noise is re-measured with the set's variances (baseline.hpp).
-  start = HeldWheelNoise(c, b, mf.eps, mean_bases, start, nf, bumps);
-  warm_start.kL2 = start.kL2;
-  warm_start.kR2 = start.kR2;
+  if (b.wheel_noise_source == "repeats") {
+    start = HeldWheelNoise(c, b, mf.eps, mean_bases, start, nf, bumps);
+    warm_start.kL2 = start.kL2;
+    warm_start.kR2 = start.kR2;
+  }
   if (bumps)
     out.noise = FitBumps(mf.eps, mean_bases, c.pieces, {}, warm ? warm_start : start, /*start_only=*/warm != nullptr,
                          nf.fit_wheel_noise);
