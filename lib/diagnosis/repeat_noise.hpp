@@ -36,7 +36,9 @@
 // What the within-group scatter does NOT hold out: effects that differ
 // from run to run (run_time_offset's per-run clocks, bump_outliers,
 // correlated_noise, standstill_motion, motion_noise_floor): they are noise,
-// and widen the repeat scatter as they widen the pieces' fit.
+// and widen the repeat scatter as they widen the pieces' fit. A refit that
+// gives such variance to an effect of its own fits k jointly with it on the
+// contrasts (FitRepeatWheelNoise below), so the held k does not hold it.
 //
 // The design supports it when the campaign has at least min_contrasts
 // contrast pieces and the contrasts separate k_L from k_R (the correlation
