@@ -54,6 +54,7 @@
 //                       [--json FILE] [--write-dir DIR] [--only-case I]
 //                       [--pause S]  (standstill between motions, default 1 s)
 //                       [--arc-fraction F]  (campaigns with figure-eights, default 0.5)
+//                       [--hold-wheel-noise]  (diagnose --hold-wheel-noise)
 // --write-dir also writes every campaign (manifest + CSV; truth.json beside,
 // not inside) so the same cases can be diagnosed through the CLI.
 #include <algorithm>
@@ -97,6 +98,7 @@ struct Args {
   int only_case = -1;
   double pause_s = 1.0;
   double arc_fraction = 0.5;
+  bool hold_wheel_noise = false;  ///< diagnose --hold-wheel-noise
 };
 
 Args Parse(int argc, char** argv) {
@@ -116,6 +118,7 @@ Args Parse(int argc, char** argv) {
     else if (k == "--threads") a.threads = std::stoi(next());
     else if (k == "--null-sims") a.null_sims = std::stoi(next());
     else if (k == "--extended") a.extended = true;
+    else if (k == "--hold-wheel-noise") a.hold_wheel_noise = true;
     else if (k == "--json") a.json = next();
     else if (k == "--write-dir") a.write_dir = next();
     else if (k == "--only-case") a.only_case = std::stoi(next());
@@ -618,6 +621,7 @@ int main(int argc, char** argv) {
   diag::DiagnoseOptions dopt;
   dopt.threads = args.threads;
   dopt.null_simulations = args.null_sims;
+  if (args.hold_wheel_noise) dopt.baseline_fit.wheel = diag::WheelNoiseSource::kRepeats;
   Tally t;
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const Case& c = cases[i];
