@@ -251,7 +251,6 @@ RepeatWheelFit FitRepeatWheelNoise(const RepeatDesign& design, const RepeatDesig
     return out;
   }
   const RepeatContrasts rc = ApplyRepeatDesign(design, c, eps, bases);
-  n.bump_rate = n.bump_s2 = 0.0;
   out.noise = FitPieceNoise(rc.eps, rc.bases, rc.pieces, {}, n, o);
   out.contrasts = static_cast<int>(rc.pieces.size());
   // Fisher information of the fitted variances: the wheels first, then each
