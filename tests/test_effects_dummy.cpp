@@ -22,6 +22,7 @@
 #include "effects/registry.hpp"
 #include "simulation/campaign_sim.hpp"
 #include "support/diag_campaign.hpp"
+#include "support/effect_campaign.hpp"
 
 using namespace umbmark;
 using Catch::Matchers::WithinAbs;
@@ -40,9 +41,13 @@ class LeftTyreWear final : public effects::Effect {
                 .definition = "the left wheel is (1 - w) times its size",
                 .parameters = {}}),
         w_(w) {}
+  bool Active(const effects::Effects& /*e*/) const override { return on; }
   void TrueWheels(const effects::Effects& /*e*/, int /*run*/, double& left, double& /*right*/) const override {
-    left *= 1.0 - w_;
+    if (on) left *= 1.0 - w_;
   }
+  /// Off when its test case ends (the registry keeps it for the process:
+  /// the other test cases of this file must not see a worn tyre).
+  bool on = true;
   std::string Unphysical(const effects::Params& p, int /*runs*/, const effects::Params& /*se*/) const override {
     return Get(p, "w") > 0.2 ? fmt::format("a tyre worn by {:.0f} %: flat", 100.0 * Get(p, "w")) : std::string();
   }
@@ -54,32 +59,25 @@ class LeftTyreWear final : public effects::Effect {
   double w_;
 };
 
-const TrajectoryRun& FirstBackAndForthRun(const sim::SimulatedCampaign& c) {
-  REQUIRE(c.data.size() == 2);
-  REQUIRE(std::holds_alternative<TrajectoryData>(c.data[1]));
-  REQUIRE_FALSE(std::get<TrajectoryData>(c.data[1]).runs.empty());
-  return std::get<TrajectoryData>(c.data[1]).runs.front();
-}
-
 }  // namespace
 
 TEST_CASE("effects: a dummy effect added at run time is simulated and judged by name") {
-  RobotParams r;
-  r.wheelbase_m = 0.3;
-  r.wheel_diameter_left_m = r.wheel_diameter_right_m = 0.1;
-  r.ticks_per_rev = 4096;
-  sim::CampaignSimOptions o;
-  o.seed = 5;
-  o.square_runs_per_direction = 1;
-  o.back_and_forth_runs = 1;
-  o.truth.k_L = o.truth.k_R = 0.0;  // noise-free: the closed form holds exactly
-  const double L = 2.0, w = 0.01;
-  const Manifest m = sim::StandardCampaignManifest(r, 1.0, L, GroundTruthNoise{});
+  testing::NoiseFreeCampaign setup = testing::MakeNoiseFreeCampaign(5);  // the closed form holds exactly
+  const RobotParams& r = setup.robot;
+  sim::CampaignSimOptions& o = setup.options;
+  const double L = setup.leg_m, w = 0.01;
+  const Manifest& m = setup.manifest;
   const sim::SimulatedCampaign before = sim::SimulateCampaign(m, o);
   const nlohmann::json truth0 = sim::CampaignTruthJson(before, o).at("truth").at("true_robot_run0");
 
   const std::size_t n = effects::All().size();
-  effects::Register(std::make_unique<LeftTyreWear>(w));
+  auto owned = std::make_unique<LeftTyreWear>(w);
+  LeftTyreWear* wear = owned.get();
+  const struct Off {
+    LeftTyreWear* e;
+    ~Off() { e->on = false; }
+  } off{wear};
+  effects::Register(std::move(owned));
   REQUIRE(effects::All().size() == n + 1);
   const effects::Effect* e = effects::Find("left_tyre_wear");
   REQUIRE(e != nullptr);
@@ -96,20 +94,7 @@ TEST_CASE("effects: a dummy effect added at run time is simulated and judged by 
   CHECK_THAT(truth.at("wheel_diameter_left_m").get<double>(),
              WithinRel((1.0 - w) * truth0.at("wheel_diameter_left_m").get<double>(), 1e-12));
   CHECK(truth.at("wheel_diameter_right_m").get<double>() == truth0.at("wheel_diameter_right_m").get<double>());
-  double turned[2] = {0.0, 0.0};
-  for (int k = 0; k < 2; ++k) {
-    const TrajectoryRun& run = FirstBackAndForthRun(k == 0 ? before : after);
-    // The first sample with the nominal travel of the leg (the encoders
-    // count the same ticks with and without the dummy).
-    REQUIRE(run.ticks_left.size() == run.t_s.size());
-    REQUIRE(run.gt_theta_rad.size() == run.t_s.size());
-    const double per_tick = r.MetresPerTickLeft();
-    std::size_t end = 0;
-    while (end + 1 < run.t_s.size() &&
-           0.5 * per_tick * static_cast<double>(run.ticks_left[end] + run.ticks_right[end]) < L - 1e-3)
-      ++end;
-    turned[k] = run.gt_theta_rad[end] - run.gt_theta_rad[0];
-  }
+  const double turned[2] = {testing::TurnOverFirstLeg(before, setup), testing::TurnOverFirstLeg(after, setup)};
   // Without it the leg is straight up to the controller's last tick (0.15
   // mrad measured); with it the robot turns by w L / b = 66.7 mrad.
   CHECK(std::abs(turned[0]) < 1e-3);

@@ -14,6 +14,7 @@
 
 #include "effects/registry.hpp"
 #include "simulation/campaign_sim.hpp"
+#include "support/effect_campaign.hpp"
 
 using namespace umbmark;
 using Catch::Matchers::WithinAbs;
@@ -72,29 +73,16 @@ class StartNudge final : public effects::Effect {
   double delta_, w_;
 };
 
-const TrajectoryRun& FirstBackAndForthRun(const sim::SimulatedCampaign& c) {
-  REQUIRE(c.data.size() == 2);
-  REQUIRE(std::holds_alternative<TrajectoryData>(c.data[1]));
-  REQUIRE_FALSE(std::get<TrajectoryData>(c.data[1]).runs.empty());
-  return std::get<TrajectoryData>(c.data[1]).runs.front();
-}
-
 }  // namespace
 
 TEST_CASE("effects: a dummy effect's per-run hooks (StartRun) are simulated in its own file") {
-  RobotParams r;
-  r.wheelbase_m = 0.3;
-  r.wheel_diameter_left_m = r.wheel_diameter_right_m = 0.1;
-  r.ticks_per_rev = 4096;
-  sim::CampaignSimOptions o;
-  o.seed = 9;
-  o.square_runs_per_direction = 1;
-  o.back_and_forth_runs = 1;
-  o.truth.k_L = o.truth.k_R = 0.0;  // noise-free: the closed form holds exactly
+  testing::NoiseFreeCampaign setup = testing::MakeNoiseFreeCampaign(9);  // the closed form holds exactly
+  const RobotParams& r = setup.robot;
+  sim::CampaignSimOptions& o = setup.options;
   o.effects.bump_rate = 0.5;        // bumps (their own stream) stay the same with the dummy on
   o.effects.bump_sigma = 0.002;
-  const double L = 2.0, delta = 0.004, w = 0.01;
-  const Manifest m = sim::StandardCampaignManifest(r, 1.0, L, GroundTruthNoise{});
+  const double L = setup.leg_m, delta = 0.004, w = 0.01;
+  const Manifest& m = setup.manifest;
 
   auto owned = std::make_unique<StartNudge>(delta, w);
   StartNudge* nudge = owned.get();
@@ -115,19 +103,7 @@ TEST_CASE("effects: a dummy effect's per-run hooks (StartRun) are simulated in i
   for (const auto& e : after.bumps)
     for (int b : e) bumps += b;
   CHECK(bumps > 0);
-  double turned[2] = {0.0, 0.0};
-  for (int k = 0; k < 2; ++k) {
-    const TrajectoryRun& run = FirstBackAndForthRun(k == 0 ? before : after);
-    REQUIRE(run.ticks_left.size() == run.t_s.size());
-    // The first sample with the leg's nominal travel (the encoders count
-    // the same ticks with and without the dummy).
-    const double per_tick = r.MetresPerTickLeft();
-    std::size_t end = 0;
-    while (end + 1 < run.t_s.size() &&
-           0.5 * per_tick * static_cast<double>(run.ticks_left[end] + run.ticks_right[end]) < L - 1e-3)
-      ++end;
-    turned[k] = run.gt_theta_rad[end] - run.gt_theta_rad[0];
-  }
+  const double turned[2] = {testing::TurnOverFirstLeg(before, setup), testing::TurnOverFirstLeg(after, setup)};
   // delta + w L / b = 4 + 66.7 mrad (70.667; measured 70.672: the same
   // bumps in both, worn by w too, and the controller's last tick). Without
   // the kick or the wear it would be off by 4 or 67 mrad.

@@ -27,18 +27,29 @@ testing::SmallCampaign Campaign(std::uint64_t seed) {
 /// The repeated runs' k at the nominal robot (E_d = E_b = 1, wrong by 0.4 %
 /// and 1.2 %: a mean the contrasts must not see), the manifest's
 /// ground-truth noise.
-RepeatNoise Measure(const CampaignData& c, const RepeatNoiseOptions& o = {}) {
-  const MeanModel model(c);
+/// The residuals and bases at the nominal robot, and the noise fits' start
+/// (0.3 mm, 1.5 mrad).
+struct Nominal {
   std::vector<double> eps;
-  const ParamVector p = NominalParams();
-  model.Residuals(p, eps);
-  const std::vector<PieceBases> bases = ComputeBases(c, model, p);
+  std::vector<PieceBases> bases;
   NoiseParams start;
-  start.sxy2 = 3e-4 * 3e-4;
-  start.sth2 = 1.5e-3 * 1.5e-3;
+};
+Nominal AtNominal(const CampaignData& c) {
+  const MeanModel model(c);
+  Nominal n;
+  const ParamVector p = NominalParams();
+  model.Residuals(p, n.eps);
+  n.bases = ComputeBases(c, model, p);
+  n.start.sxy2 = 3e-4 * 3e-4;
+  n.start.sth2 = 1.5e-3 * 1.5e-3;
+  return n;
+}
+
+RepeatNoise Measure(const CampaignData& c, const RepeatNoiseOptions& o = {}) {
+  const Nominal n = AtNominal(c);
   PieceNoiseFitOptions fit;
   fit.min_sigma_xy2 = fit.min_sigma_theta2 = 1e-12;
-  return MeasureRepeatNoise(c, eps, bases, start, fit, o);
+  return MeasureRepeatNoise(c, n.eps, n.bases, n.start, fit, o);
 }
 
 }  // namespace
@@ -253,18 +264,11 @@ namespace {
 /// The repeated runs' k fitted jointly with the run-to-run variance terms
 /// `fit` enables (FitRepeatWheelNoise), at the nominal robot as Measure.
 RepeatWheelFit MeasureJoint(const CampaignData& c, PieceNoiseFitOptions fit, bool bumps = false) {
-  const MeanModel model(c);
-  std::vector<double> eps;
-  const ParamVector p = NominalParams();
-  model.Residuals(p, eps);
-  const std::vector<PieceBases> bases = ComputeBases(c, model, p);
-  NoiseParams start;
-  start.sxy2 = 3e-4 * 3e-4;
-  start.sth2 = 1.5e-3 * 1.5e-3;
+  const Nominal n = AtNominal(c);
   fit.min_sigma_xy2 = fit.min_sigma_theta2 = 1e-12;
   const RepeatNoiseOptions o;
-  return FitRepeatWheelNoise(BuildRepeatDesign(c, bases, o), BuildRepeatDesign(c, bases, o, true), c, eps, bases,
-                             start, fit, bumps);
+  return FitRepeatWheelNoise(BuildRepeatDesign(c, n.bases, o), BuildRepeatDesign(c, n.bases, o, true), c, n.eps,
+                             n.bases, n.start, fit, bumps);
 }
 
 }  // namespace

@@ -1,0 +1,57 @@
+// A small noise-free campaign for the effect-interface tests (a dummy effect
+// registered at run time): one square per direction and one back-and-forth
+// run of 2 m, no wheel noise, so that closed forms hold exactly.
+#pragma once
+
+#include <catch2/catch.hpp>
+
+#include <cstdint>
+#include <variant>
+
+#include "simulation/campaign_sim.hpp"
+
+namespace umbmark::testing {
+
+struct NoiseFreeCampaign {
+  RobotParams robot;
+  sim::CampaignSimOptions options;
+  Manifest manifest;
+  double leg_m = 2.0;  ///< the back-and-forth leg
+};
+
+inline NoiseFreeCampaign MakeNoiseFreeCampaign(std::uint64_t seed) {
+  NoiseFreeCampaign c;
+  c.robot.wheelbase_m = 0.3;
+  c.robot.wheel_diameter_left_m = c.robot.wheel_diameter_right_m = 0.1;
+  c.robot.ticks_per_rev = 4096;
+  c.options.seed = seed;
+  c.options.square_runs_per_direction = 1;
+  c.options.back_and_forth_runs = 1;
+  c.options.truth.k_L = c.options.truth.k_R = 0.0;
+  c.manifest = sim::StandardCampaignManifest(c.robot, 1.0, c.leg_m, GroundTruthNoise{});
+  return c;
+}
+
+inline const TrajectoryRun& FirstBackAndForthRun(const sim::SimulatedCampaign& c) {
+  REQUIRE(c.data.size() == 2);
+  REQUIRE(std::holds_alternative<TrajectoryData>(c.data[1]));
+  REQUIRE_FALSE(std::get<TrajectoryData>(c.data[1]).runs.empty());
+  return std::get<TrajectoryData>(c.data[1]).runs.front();
+}
+
+/// The ground truth's heading change over the first back-and-forth leg, up
+/// to the first sample with the leg's nominal travel (the encoders count
+/// the same ticks whatever the ground truth did).
+inline double TurnOverFirstLeg(const sim::SimulatedCampaign& c, const NoiseFreeCampaign& setup) {
+  const TrajectoryRun& run = FirstBackAndForthRun(c);
+  REQUIRE(run.ticks_left.size() == run.t_s.size());
+  REQUIRE(run.gt_theta_rad.size() == run.t_s.size());
+  const double per_tick = setup.robot.MetresPerTickLeft();
+  std::size_t end = 0;
+  while (end + 1 < run.t_s.size() &&
+         0.5 * per_tick * static_cast<double>(run.ticks_left[end] + run.ticks_right[end]) < setup.leg_m - 1e-3)
+    ++end;
+  return run.gt_theta_rad[end] - run.gt_theta_rad[0];
+}
+
+}  // namespace umbmark::testing
