@@ -9,7 +9,9 @@
 # the engine (truth.md), not from its class label.
 #
 # ROBOT=B generates the same set for robot B (the second design) on seeds
-# 9301-9316.
+# 9301-9316. SEED_BASE=N generates the same sixteen cases on seeds N+1 ..
+# N+16 instead (a fresh set: robot A 9401-9416 and robot B 9501-9516 were
+# generated in session 15, after the rules they measure were frozen).
 #
 # Usage: bench/dart_scatter_set.sh [BUILD_DIR] [KEEP_DIR] [JOBS]
 #   (about 10-15 minutes on 2 cores; KEEP_DIR keeps the campaigns, and a
@@ -20,7 +22,7 @@ KEEP=${2:-$(mktemp -d "${TMPDIR:-/tmp}/umbmark-dart-scatter.XXXXXX")}
 JOBS=${3:-2}
 HERE=$(cd "$(dirname "$0")" && pwd)
 # robot A: seeds 9201-9216; ROBOT=B (the second design): seeds 9301-9316
-base=$([[ "${ROBOT:-A}" == B ]] && echo 9300 || echo 9200)
+base=${SEED_BASE:-$([[ "${ROBOT:-A}" == B ]] && echo 9300 || echo 9200)}
 CASES=""
 i=0
 for cls in clean clean stop_slide swivel_castor floor_strips turn_scrub marker_offset clock_fixed clock_per_run \
