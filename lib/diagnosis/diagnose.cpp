@@ -173,6 +173,21 @@ StopChoice ChooseStopModel(const CampaignData& recorded, const BaselineStart& st
   return out;
 }
 
+/// The explanation's steps in the order the verdict names them: first the
+/// effect that earns most held-out evidence given all the others
+/// (ExplanationStep::earned_given_others_nats), the one whose absence would
+/// reopen most of the gap. The steps' own order is the greedy path, where a
+/// noise effect that imitated part of a mean effect may come first and be
+/// needed far less once that effect is in.
+std::vector<const ExplanationStep*> ByEarnings(const Explanation& ex) {
+  std::vector<const ExplanationStep*> order;
+  for (const ExplanationStep& s : ex.steps) order.push_back(&s);
+  std::stable_sort(order.begin(), order.end(), [](const ExplanationStep* x, const ExplanationStep* y) {
+    return x->earned_given_others_nats > y->earned_given_others_nats;
+  });
+  return order;
+}
+
 /// The verdict from the explanation (docs/diagnosis.md, "The verdict's
 /// rule"): its effects that are neither negligible nor fitted at impossible
 /// values (advice.hpp UnphysicalFit, e.g. a negative turn scrub: a symptom
@@ -188,7 +203,8 @@ StopChoice ChooseStopModel(const CampaignData& recorded, const BaselineStart& st
 void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Verdict& v, DiagnoseSummary& out) {
   std::vector<std::string> named, negligible, impossible, symptoms;
   double gain = 0.0;
-  for (const ExplanationStep& s : ex.steps) {
+  for (const ExplanationStep* step : ByEarnings(ex)) {
+    const ExplanationStep& s = *step;
     const std::string name = sim::EffectToString(s.effect);
     gain += s.heldout_gain_nats;
     if (!s.unphysical.empty())

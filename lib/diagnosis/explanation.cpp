@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include <fmt/format.h>
@@ -496,16 +497,16 @@ std::vector<sim::EffectKind> Pool(const std::vector<Candidate>& candidates) {
 /// The backward check of the explanation (docs/diagnosis.md, "The
 /// verdict's rule"): for each chosen effect, the held-out log-likelihood
 /// lost when it is left out and the others refitted, less the penalty of
-/// its parameters. Returns the index of the effect that earns least when
-/// that is not positive (it no longer earns its place given the others),
-/// else -1; `earned`: what it earns.
+/// its parameters (`earns`, in the order of `chosen`). Returns the index of
+/// the effect that earns least when that is not positive (it no longer
+/// earns its place given the others), else -1.
 int LeastEarning(const CampaignData& c, const MeanModel& model, const BaselineFit& b, const Folds& folds,
                  MeanPartCache& means, const std::vector<sim::EffectKind>& chosen, const SetFit& current,
-                 const ExplanationOptions& options, double& earned) {
+                 const ExplanationOptions& options, std::vector<double>& earns) {
   std::vector<std::vector<sim::EffectKind>> sets(chosen.size(), chosen);
   for (std::size_t k = 0; k < chosen.size(); ++k) sets[k].erase(sets[k].begin() + static_cast<std::ptrdiff_t>(k));
   means.Prepare(sets);
-  std::vector<double> earns(chosen.size());
+  earns.assign(chosen.size(), 0.0);
   ParallelFor(options.threads, static_cast<int>(chosen.size()), [&](int i) {
     const auto k = static_cast<std::size_t>(i);
     const SetFit without = FitSet(c, model, b, folds, sets[k], means.Get(sets[k]), options.gap);
@@ -513,7 +514,6 @@ int LeastEarning(const CampaignData& c, const MeanModel& model, const BaselineFi
                options.complexity_penalty_nats * EffectParameterCount(chosen[k]);
   });
   const auto least = std::min_element(earns.begin(), earns.end());
-  earned = *least;
   return *least > 0.0 ? -1 : static_cast<int>(least - earns.begin());
 }
 
@@ -528,13 +528,52 @@ std::vector<const Candidate*> ByEvidence(const std::vector<Candidate>& candidate
   return out;
 }
 
+/// The backward check (LeastEarning) after the forward selection: while an
+/// effect no longer earns its held-out evidence given the others (a later
+/// step took over what it imitated), it is left out and the others are
+/// replayed by `add` from `base`, the first by the rule of the first step.
+/// Then each step's `earned_given_others_nats` is what it earns given the
+/// others (with one effect: its held-out gain over the baseline, less its
+/// penalty), by which the verdict orders the effects it names.
+void BackwardCheck(const CampaignData& c, const MeanModel& model, const BaselineFit& b, const Folds& folds,
+                   const std::vector<Candidate>& candidates, MeanPartCache& means, const ExplanationOptions& options,
+                   const SetFit& base, const std::function<void(sim::EffectKind, const SetFit&)>& add,
+                   std::vector<sim::EffectKind>& chosen, SetFit& current, Explanation& ex) {
+  std::vector<double> earns;
+  for (int k = 0; chosen.size() > 1 && (k = LeastEarning(c, model, b, folds, means, chosen, current, options, earns)) >= 0;) {
+    std::vector<sim::EffectKind> keep = chosen;
+    ex.stop_reason += fmt::format("; {} left out again: given the others it earns {:+.1f} nats held out",
+                                  sim::EffectToString(chosen[static_cast<std::size_t>(k)]),
+                                  earns[static_cast<std::size_t>(k)]);
+    keep.erase(keep.begin() + k);
+    // The first step again by the rule of the first step; the others in
+    // their order.
+    if (const auto lead = ByEvidence(candidates, keep); !lead.empty()) {
+      const auto at = std::find(keep.begin(), keep.end(), lead.front()->effect);
+      std::rotate(keep.begin(), at, at + 1);
+    }
+    chosen.clear();
+    ex.steps.clear();
+    current = base;
+    for (sim::EffectKind e : keep) {
+      std::vector<sim::EffectKind> set = chosen;
+      set.push_back(e);
+      means.Prepare({set});
+      const NoiseParams* warm = HasNoise(chosen, effects::NoiseTerm::kBumps) ? &current.noise : nullptr;
+      add(e, FitSet(c, model, b, folds, set, means.Get(set), options.gap, warm));
+    }
+  }
+  if (chosen.size() == 1)
+    earns = {ex.steps.front().heldout_gain_nats - options.complexity_penalty_nats * EffectParameterCount(chosen[0])};
+  for (std::size_t k = 0; k < ex.steps.size() && k < earns.size(); ++k) ex.steps[k].earned_given_others_nats = earns[k];
+}
+
 }  // namespace
 
-// Longer than 80 lines on purpose (116 with its lambdas, near the 120 limit: the next addition
-// should move the backward check into a function of its own): one greedy forward selection, then the backward check, whose steps
-// share the chosen set, the current fit and the cache of mean parts; its
-// pieces with state of their own (set fits, sizing, weights) are the
-// helpers above.
+// Longer than 80 lines on purpose: one greedy forward selection, then the
+// backward check (BackwardCheck), whose steps share the chosen set, the
+// current fit and the cache of mean parts; its pieces with state of their
+// own (set fits, sizing, weights) are the helpers above.
 Explanation Explain(const CampaignData& c, const MeanModel& model, const BaselineFit& b, const Folds& folds,
                     const std::vector<Candidate>& candidates, const std::map<std::vector<int>, MeanFit>& known,
                     double gap_score, double null_median, double null_quantile, const ExplanationOptions& options) {
@@ -555,7 +594,7 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
   const double gap_before = Gap(gap_score, null_median), gap_cv_before = Gap(base.heldout_gap, null_median);
   std::vector<sim::EffectKind> chosen;
   SetFit current = base;
-  auto add = [&](sim::EffectKind e, const SetFit& f) {
+  const std::function<void(sim::EffectKind, const SetFit&)> add = [&](sim::EffectKind e, const SetFit& f) {
     ExplanationStep s;
     s.effect = e;
     s.params = ParamsOf(e, f);
@@ -622,33 +661,7 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
     }
     add(remaining[static_cast<std::size_t>(best)], trial[static_cast<std::size_t>(best)]);
   }
-  // Backward: every effect must still earn its held-out evidence given the
-  // others (a later step can take over what an earlier one imitated); one
-  // that does not is left out and the others replayed.
-  double earned = 0.0;
-  for (int k = 0; chosen.size() > 1 &&
-                  (k = LeastEarning(c, model, b, folds, means, chosen, current, options, earned)) >= 0;) {
-    std::vector<sim::EffectKind> keep = chosen;
-    ex.stop_reason += fmt::format("; {} left out again: given the others it earns {:+.1f} nats held out",
-                                  sim::EffectToString(chosen[static_cast<std::size_t>(k)]), earned);
-    keep.erase(keep.begin() + k);
-    // The first step again by the rule of the first step; the others in
-    // their order.
-    if (const auto lead = ByEvidence(candidates, keep); !lead.empty()) {
-      const auto at = std::find(keep.begin(), keep.end(), lead.front()->effect);
-      std::rotate(keep.begin(), at, at + 1);
-    }
-    chosen.clear();
-    ex.steps.clear();
-    current = base;
-    for (sim::EffectKind e : keep) {
-      std::vector<sim::EffectKind> set = chosen;
-      set.push_back(e);
-      means.Prepare({set});
-      const NoiseParams* warm = HasNoise(chosen, effects::NoiseTerm::kBumps) ? &current.noise : nullptr;
-      add(e, FitSet(c, model, b, folds, set, means.Get(set), options.gap, warm));
-    }
-  }
+  BackwardCheck(c, model, b, folds, candidates, means, options, base, add, chosen, current, ex);
   progress.Finish();
   ex.gap_left = current.gap_after > null_quantile;
   SizeSteps(c, model, b, means.Get(chosen), current, options.negligible, ex);

@@ -86,6 +86,11 @@ struct ExplanationStep {
   double cumulative_shrink = 0.0;          ///< in-sample
   double cumulative_heldout_shrink = 0.0;  ///< on held-out runs
   double heldout_gain_nats = 0.0;          ///< over the previous step, held out
+  /// Held-out log-likelihood the final explanation loses without this
+  /// effect (the others refitted), less its parameters' penalty: what it
+  /// earns given all the others. The verdict names its effects in this
+  /// order (the first closes most of the gap given the rest).
+  double earned_given_others_nats = 0.0;
   /// Practical size (see the file comment), at the last step's joint fit.
   double size_mm = 0.0, size_mrad = 0.0;
   double relative_size = 0.0;

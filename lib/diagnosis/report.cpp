@@ -57,6 +57,7 @@ nlohmann::json ExplanationJson(const DiagnoseSummary& s) {
                      {"cumulative_shrink", Num(e.cumulative_shrink)},
                      {"cumulative_heldout_shrink", Num(e.cumulative_heldout_shrink)},
                      {"heldout_gain_nats", Num(e.heldout_gain_nats)},
+                     {"earned_given_others_nats", Num(e.earned_given_others_nats)},
                      {"gap_after", Num(e.gap_after)},
                      {"size_mm", Num(e.size_mm)},
                      {"size_mrad", Num(e.size_mrad)},
