@@ -144,4 +144,24 @@ TEST_CASE("diagnose pairs: time offset + 4 cm marker offset are not negligible",
   // Centimetres against a piece noise of about a millimetre.
   CHECK(tau->relative_size > 1.0);
   CHECK(gt->relative_size > 1.0);
+  // The verdict's order (diagnose.cpp ByEarnings): what each named effect
+  // earns held out given all the others, most first. For the last step
+  // that is an identity: leaving it out gives back the previous step's fit,
+  // so it earns its own step's held-out gain less 2 nats per parameter.
+  const ExplanationStep& last = d.explanation.back();
+  REQUIRE(d.explanation.size() >= 2);
+  CHECK_THAT(last.earned_given_others_nats,
+             WithinAbs(last.heldout_gain_nats - 2.0 * static_cast<double>(last.params.size()),
+                       1e-9 * std::abs(last.heldout_gain_nats) + 1e-9));
+  for (const auto& st : d.explanation) CHECK(st.earned_given_others_nats > 0.0);  // the backward check's guarantee
+  REQUIRE(d.verdict_effects.size() >= 2);
+  for (std::size_t i = 1; i < d.verdict_effects.size(); ++i) {
+    const auto earned = [&](const std::string& name) {
+      for (const auto& st : d.explanation)
+        if (sim::EffectToString(st.effect) == name) return st.earned_given_others_nats;
+      return -1e300;
+    };
+    CHECK(earned(d.verdict_effects[i - 1]) >= earned(d.verdict_effects[i]));
+  }
+  CHECK(d.verdict == d.verdict_effects.front());
 }
