@@ -462,9 +462,15 @@ void FitNoiseEffect(const Shared& x, sim::EffectKind kind, Candidate& cd) {
   EnableNoiseEffect(kind, cf_fold);
   // A held wheel noise is re-measured with this effect's variance (baseline.hpp).
   const NoiseParams start = HeldWheelNoise(c, x.b, x.b.eps, x.b.bases, x.b.noise, cf, !corr);
+  BumpFitOptions bf = BumpFitOptions::Terms(cf);
+  if (x.b.repeat.measured) {
+    bf.repeat_kL2 = x.b.repeat.k_L * x.b.repeat.k_L;
+    bf.repeat_kR2 = x.b.repeat.k_R * x.b.repeat.k_R;
+  }
   NoiseParams ne = corr ? FitPieceNoise(x.b.eps, x.b.bases, c.pieces, {}, start, cf)
-                        : FitBumps(x.b.eps, x.b.bases, c.pieces, {}, start, /*start_only=*/false,
-                                   cf.fit_wheel_noise);
+                        : FitBumps(x.b.eps, x.b.bases, c.pieces, {}, start, bf);
+  BumpFitOptions bf_fold = BumpFitOptions::Terms(cf_fold);
+  bf_fold.start_only = true;
   // run_time_offset: its levers at the fitted tau_sd (run_block.hpp).
   std::vector<PieceBases> rescaled;
   if (NoiseTermOf(kind) == effects::NoiseTerm::kRunTime)
@@ -483,7 +489,7 @@ void FitNoiseEffect(const Shared& x, sim::EffectKind kind, Candidate& cd) {
   const CrossValidation cv = CrossValidate(
       c, bases, x.folds, x.b.eps, x.b.D, x.b.W, [&](const std::vector<double>& e, const std::vector<char>& use) {
         return corr ? FitPieceNoise(e, bases, c.pieces, use, ne, cf_fold)
-                    : FitBumps(e, bases, c.pieces, use, ne, /*start_only=*/true, cf_fold.fit_wheel_noise);
+                    : FitBumps(e, bases, c.pieces, use, ne, bf_fold);
       });
   cd.heldout_loglik_gain = cv.loglik - x.cv_ll_base;
   const double gcv = ComputeGap(c, cv.scores, x.options.gap).score;

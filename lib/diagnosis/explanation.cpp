@@ -103,9 +103,21 @@ SetFit FitSet(const CampaignData& c, const MeanModel& model, const BaselineFit& 
     warm_start.kL2 = start.kL2;
     warm_start.kR2 = start.kR2;
   }
+  // Bumps are fitted jointly with the set's other variance terms (its
+  // motion floor, standstill motion, per-run clock), so that a noise effect
+  // chosen before the bumps keeps its variance when they join, and one tried
+  // after them is not held at the baseline's zero (docs/diagnosis.md, "Bumps
+  // fitted jointly").
+  BumpFitOptions bf = BumpFitOptions::Terms(nf);
+  bf.start_only = warm != nullptr;
+  if (b.repeat.measured) {
+    bf.repeat_kL2 = b.repeat.k_L * b.repeat.k_L;
+    bf.repeat_kR2 = b.repeat.k_R * b.repeat.k_R;
+  }
+  BumpFitOptions bf_fold = BumpFitOptions::Terms(nf);
+  bf_fold.start_only = true;
   if (bumps)
-    out.noise = FitBumps(mf.eps, mean_bases, c.pieces, {}, warm ? warm_start : start, /*start_only=*/warm != nullptr,
-                         nf.fit_wheel_noise);
+    out.noise = FitBumps(mf.eps, mean_bases, c.pieces, {}, warm ? warm_start : start, bf);
   else
     out.noise = FitPieceNoise(mf.eps, mean_bases, c.pieces, {}, start, nf);
   if (!bumps && HasNoise(set, effects::NoiseTerm::kRunTime))
@@ -122,7 +134,7 @@ SetFit FitSet(const CampaignData& c, const MeanModel& model, const BaselineFit& 
   const NoiseParams& ne = out.noise;
   const CrossValidation cv =
       CrossValidate(c, bases, folds, mf.eps, mf.D, W, [&](const std::vector<double>& e, const std::vector<char>& use) {
-        return bumps ? FitBumps(e, bases, c.pieces, use, ne, /*start_only=*/true, fold_fit.fit_wheel_noise)
+        return bumps ? FitBumps(e, bases, c.pieces, use, ne, bf_fold)
                      : FitPieceNoise(e, bases, c.pieces, use, ne, fold_fit);
       });
   out.cv_loglik = cv.loglik;

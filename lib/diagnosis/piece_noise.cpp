@@ -31,27 +31,36 @@ BumpMixture PieceMixture(const PieceBases& B, const NoiseParams& n) {
   m.cov[0] = PieceCovariance(B, n);
   const double travel = B.travel_left_m + B.travel_right_m;
   if (!(n.bump_rate > 0.0 && n.bump_s2 > 0.0 && travel > 0.0)) return m;
-  Eigen::Matrix3d per_bump = Eigen::Matrix3d::Zero();
-  int wheels = 0;
-  if (B.travel_left_m > 0.0) {
-    per_bump += B.A_L / B.travel_left_m;
-    ++wheels;
-  }
-  if (B.travel_right_m > 0.0) {
-    per_bump += B.A_R / B.travel_right_m;
-    ++wheels;
-  }
-  per_bump *= n.bump_s2 / wheels;
+  // One bump strikes the left wheel with probability travel_L / travel
+  // (bumps per metre of each wheel's travel), anywhere along it: its
+  // covariance averaged over both is sigma_b^2 (A_L + A_R) / travel, so
+  // that lambda bumps make rate sigma_b^2 (A_L + A_R), the Gaussian limit.
+  // (Averaging the two wheels with equal weight instead over-weighted the
+  // slower wheel of an arc: 2 A_L + 0.67 A_R for travels 0.5 and 1.5 m.)
+  const Eigen::Matrix3d per_bump = (n.bump_s2 / travel) * (B.A_L + B.A_R);
   const double lambda = n.bump_rate * travel;
   m.components = kMaxBumpsPerPiece + 1;
-  double term = std::exp(-lambda), used = 0.0;
+  // Poisson weights of 0 .. M-1 bumps; the tail m >= M is one component at
+  // its conditional mean count E[m | m >= M] = (lambda - sum_{k<M} k p_k) /
+  // P(m >= M), so that the mixture's covariance is C + lambda x per_bump for
+  // every lambda (the second moment of the bumps exactly). Lumped at M
+  // instead, the variance of long pieces saturates at M bumps: at high rates
+  // the fit preferred that different shape of variance over travel to any
+  // real tail and ended on its rate bound (2 per metre on June s1, 1 m arcs
+  // with lambda = 4).
+  double term = std::exp(-lambda), used = 0.0, mean_below = 0.0;
   for (int k = 0; k < kMaxBumpsPerPiece; ++k) {
     m.weight[k] = term;
     used += term;
+    mean_below += k * term;
     term *= lambda / (k + 1);
   }
-  m.weight[kMaxBumpsPerPiece] = std::max(0.0, 1.0 - used);
-  for (int k = 1; k <= kMaxBumpsPerPiece; ++k) m.cov[k] = m.cov[0] + k * per_bump;
+  const double tail = std::max(0.0, 1.0 - used);
+  m.weight[kMaxBumpsPerPiece] = tail;
+  const double tail_count = tail > 1e-300 ? std::max(static_cast<double>(kMaxBumpsPerPiece), (lambda - mean_below) / tail)
+                                          : static_cast<double>(kMaxBumpsPerPiece);
+  for (int k = 1; k < kMaxBumpsPerPiece; ++k) m.cov[k] = m.cov[0] + k * per_bump;
+  m.cov[kMaxBumpsPerPiece] = m.cov[0] + tail_count * per_bump;
   return m;
 }
 
@@ -140,6 +149,8 @@ constexpr double kTrimConsistency = 1.0051;
 constexpr double kBumpFitXTolerance = 1e-4;
 constexpr double kBumpFitFTolerance = 1e-7;
 constexpr int kBumpFitMaxEvaluations = 1000;
+/// Starts FitBumps searches from (the best of its grid, BumpStarts).
+constexpr std::size_t kBumpSearches = 3;
 
 /// Gaussian log-likelihood without constants: -1/2 sum (m_j + log det C_j).
 double Objective(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
@@ -403,60 +414,164 @@ NoiseParams FitPieceNoise(const std::vector<double>& eps, const std::vector<Piec
   return out;
 }
 
-NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
-                     const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start,
-                     bool start_only, bool fit_wheel_noise) {
-  // Bounded minimisation (NLopt Sbplx) of -log L over x = [log kL2, log kR2,
-  // log rate, log sb2], from up to three starts; the box is the header's
-  // physical bumps. With k_L, k_R given the first two have no effect.
-  auto unpack = [&](const std::vector<double>& x) {
+BumpFitOptions BumpFitOptions::Terms(const PieceNoiseFitOptions& fit) {
+  BumpFitOptions o;
+  o.fit_wheel_noise = fit.fit_wheel_noise;
+  o.motion_floor = fit.motion_floor;
+  o.standstill = fit.standstill;
+  o.run_time = fit.run_time;
+  return o;
+}
+
+namespace {
+
+/// FitBumps' search space: x = [log kL2, log kR2, log rate, log sb2, then
+/// the log of each free Gaussian term]; with k_L, k_R given the first two
+/// have no effect (held at the start's).
+struct BumpSpace {
+  const NoiseParams& start;
+  bool fit_wheel_noise = true;
+  std::vector<int> extra;  ///< Slot indices of the free Gaussian terms
+  std::vector<double> lower, upper;
+
+  BumpSpace(const NoiseParams& s, const BumpFitOptions& o, const std::vector<PieceBases>& bases,
+            const std::vector<Piece>& pieces, const std::vector<char>& use)
+      : start(s), fit_wheel_noise(o.fit_wheel_noise) {
+    lower = {-60.0, -60.0, std::log(1e-4), std::log(1e-10)};
+    upper = {60.0, 60.0, std::log(kMaxBumpRatePerMetre), std::log(1e-2)};
+    // Slot, floor (~0: the term off) and ceiling of each term.
+    auto add = [&](bool on, int slot, double lo, double hi) {
+      if (!on) return;
+      for (std::size_t j = 0; j < pieces.size(); ++j)
+        if (Used(use, j) && Basis(bases[j], slot).trace() > 0.0) {
+          extra.push_back(slot);
+          lower.push_back(std::log(lo));
+          upper.push_back(std::log(hi));
+          return;
+        }
+    };
+    add(o.motion_floor, 5, 1e-14, 1e-4);  // sigma up to 10 mm
+    add(o.standstill, 6, 1e-14, 1e-4);
+    add(o.standstill, 7, 1e-14, 1e-2);
+    add(o.run_time, 8, 1e-12, 1.0);  // tau_sd 1 us .. 1 s
+  }
+  NoiseParams Unpack(const std::vector<double>& x) const {
     NoiseParams n = start;
     n.c_LR = 0.0;
-    n.kL2 = fit_wheel_noise ? std::exp(x[0]) : start.kL2;
-    n.kR2 = fit_wheel_noise ? std::exp(x[1]) : start.kR2;
+    if (fit_wheel_noise) {
+      n.kL2 = std::exp(x[0]);
+      n.kR2 = std::exp(x[1]);
+    }
     n.bump_rate = std::exp(x[2]);
     n.bump_s2 = std::exp(x[3]);
+    for (std::size_t e = 0; e < extra.size(); ++e) Slot(n, extra[e]) = std::exp(x[4 + e]);
     return n;
-  };
-  auto cost = [&](const std::vector<double>& x) { return -TotalLogLik(eps, bases, pieces, use, unpack(x)); };
-  const std::vector<double> lower = {-60.0, -60.0, std::log(1e-4), std::log(1e-10)};
-  const std::vector<double> upper = {60.0, 60.0, std::log(kMaxBumpRatePerMetre), std::log(1e-2)};
-  const double k2 = std::max(0.5 * (start.kL2 + start.kR2), 1e-12);
-  std::vector<std::vector<double>> starts = {
-      {std::log(std::max(start.kL2, 1e-14) * 0.7), std::log(std::max(start.kR2, 1e-14) * 0.7), std::log(0.2),
-       std::log(30.0 * k2)},
-      {std::log(std::max(start.kL2, 1e-14) * 0.9), std::log(std::max(start.kR2, 1e-14) * 0.9), std::log(1.0),
-       std::log(6.0 * k2)}};
-  // With k_L, k_R given, also start from the Gaussian limit (many bumps
-  // of one metre's wheel noise each): more wheel noise than given is found
-  // there, at the rate bound, and not missed by starts among rare bumps.
-  if (!fit_wheel_noise)
-    starts.push_back({std::log(std::max(start.kL2, 1e-14)), std::log(std::max(start.kR2, 1e-14)),
-                      std::log(kMaxBumpRatePerMetre), std::log(k2)});
-  if (start.bump_rate > 0.0 && start.bump_s2 > 0.0) {
-    if (start_only) starts.clear();
-    starts.insert(starts.begin(), {std::log(start.kL2), std::log(start.kR2), std::log(start.bump_rate),
-                                   std::log(start.bump_s2)});
   }
-  for (auto& x : starts) {
-    x[2] = std::clamp(x[2], std::log(2e-4), std::log(1.9));
-    x[3] = std::clamp(x[3], std::log(2e-10), std::log(0.5e-2));
+  /// x for k^2 (kL2, kR2), the bumps and the Gaussian terms of `g`.
+  std::vector<double> Pack(double kL2, double kR2, double rate, double sb2, const NoiseParams& g) const {
+    std::vector<double> x = {std::log(std::max(kL2, 1e-14)), std::log(std::max(kR2, 1e-14)), std::log(rate),
+                             std::log(std::max(sb2, 1e-12))};
+    NoiseParams terms = g;
+    for (std::size_t e = 0; e < extra.size(); ++e)
+      x.push_back(std::log(std::max(Slot(terms, extra[e]), std::exp(lower[4 + e]))));
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] = std::clamp(x[i], lower[i] + 0.05, upper[i] - 0.05);
+    return x;
   }
-  BoundedMinimizeOptions options;
-  options.initial_step = {0.5, 0.5, 1.0, 1.0};
-  options.x_tolerance = kBumpFitXTolerance;
-  options.f_tolerance = kBumpFitFTolerance;
-  options.max_evaluations = kBumpFitMaxEvaluations;
+};
+
+/// Starts of the bump search: the Gaussian fit g of the same terms, with
+/// the bumps taking a share of its k^2 (per metre of wheel travel, as
+/// rate x sigma_b^2) at a grid of rates, and (when given) k at the repeated
+/// runs' scatter with the bumps holding the excess; plus the two starts
+/// among rare large bumps used before. Sorted by their likelihood.
+std::vector<std::vector<double>> BumpStarts(const BumpSpace& sp, const NoiseParams& g, const BumpFitOptions& o,
+                                            const std::function<double(const std::vector<double>&)>& cost) {
+  const double k2 = std::max(0.5 * (g.kL2 + g.kR2), 1e-12);
+  std::vector<std::vector<double>> starts;
+  for (const double rate : {0.05, 0.2, 0.8, 1.8})
+    for (const double share : {0.3, 0.6, 0.9})
+      starts.push_back(sp.Pack(g.kL2 * (1.0 - share), g.kR2 * (1.0 - share), rate, share * k2 / rate, g));
+  if (o.fit_wheel_noise && o.repeat_kL2 > 0.0 && o.repeat_kR2 > 0.0) {
+    const double excess = 0.5 * (std::max(g.kL2 - o.repeat_kL2, 0.0) + std::max(g.kR2 - o.repeat_kR2, 0.0));
+    if (excess > 0.0)
+      for (const double rate : {0.2, 0.8})
+        starts.push_back(sp.Pack(std::min(o.repeat_kL2, g.kL2), std::min(o.repeat_kR2, g.kR2), rate, excess / rate, g));
+  }
+  starts.push_back(sp.Pack(g.kL2 * 0.7, g.kR2 * 0.7, 0.2, 30.0 * k2, g));
+  starts.push_back(sp.Pack(g.kL2 * 0.9, g.kR2 * 0.9, 1.0, 6.0 * k2, g));
+  std::vector<std::pair<double, std::size_t>> order;
+  for (std::size_t i = 0; i < starts.size(); ++i) order.emplace_back(cost(starts[i]), i);
+  std::sort(order.begin(), order.end());
+  std::vector<std::vector<double>> out;
+  for (const auto& [f, i] : order) out.push_back(starts[i]);
+  return out;
+}
+
+}  // namespace
+
+NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
+                     const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start,
+                     const BumpFitOptions& options) {
+  const BumpSpace sp(start, options, bases, pieces, use);
+  auto cost = [&](const std::vector<double>& x) { return -TotalLogLik(eps, bases, pieces, use, sp.Unpack(x)); };
+  const bool warm = start.bump_rate > 0.0 && start.bump_s2 > 0.0;
+  // A free term the start holds at ~0 (a term the set adds to bumps fitted
+  // before) starts from the Gaussian fit's value instead: from the floor,
+  // the search would need many steps of its log to reach it.
+  bool missing = false;
+  {
+    NoiseParams s0 = start;
+    for (std::size_t e = 0; e < sp.extra.size(); ++e)
+      missing = missing || Slot(s0, sp.extra[e]) <= 10.0 * std::exp(sp.lower[4 + e]);
+  }
+  std::vector<std::vector<double>> starts;
+  const bool grid = !(options.start_only && warm);
+  if (grid || missing) {
+    // The Gaussian fit of the same terms (no bumps): where the grid starts.
+    PieceNoiseFitOptions gf;
+    gf.fit_wheel_noise = options.fit_wheel_noise;
+    gf.motion_floor = options.motion_floor;
+    gf.standstill = options.standstill;
+    gf.run_time = options.run_time;
+    gf.min_k2 = 1e-14;
+    NoiseParams g0 = start;
+    g0.bump_rate = g0.bump_s2 = 0.0;
+    g0.c_LR = 0.0;
+    const NoiseParams g = FitPieceNoise(eps, bases, pieces, use, g0, gf);
+    if (warm) {
+      NoiseParams w = start;
+      for (std::size_t e = 0; e < sp.extra.size(); ++e) {
+        NoiseParams gg = g;
+        if (Slot(w, sp.extra[e]) <= 10.0 * std::exp(sp.lower[4 + e])) Slot(w, sp.extra[e]) = Slot(gg, sp.extra[e]);
+      }
+      starts.push_back(sp.Pack(w.kL2, w.kR2, w.bump_rate, w.bump_s2, w));
+    }
+    if (grid) {
+      // The best kBumpSearches of the grid, searched (the rest are rarely
+      // better and each search costs up to kBumpFitMaxEvaluations).
+      std::vector<std::vector<double>> best = BumpStarts(sp, g, options, cost);
+      best.resize(std::min<std::size_t>(best.size(), kBumpSearches));
+      starts.insert(starts.end(), best.begin(), best.end());
+    }
+  } else {
+    starts.push_back(sp.Pack(start.kL2, start.kR2, start.bump_rate, start.bump_s2, start));
+  }
+  BoundedMinimizeOptions mo;
+  mo.initial_step.assign(sp.lower.size(), 1.0);
+  mo.initial_step[0] = mo.initial_step[1] = 0.5;
+  mo.x_tolerance = kBumpFitXTolerance;
+  mo.f_tolerance = kBumpFitFTolerance;
+  mo.max_evaluations = kBumpFitMaxEvaluations;
   std::vector<double> best_x = starts.front();
   double best_f = std::numeric_limits<double>::infinity();
   for (const auto& x0 : starts) {
-    const BoundedMinimum m = MinimizeBounded(cost, x0, lower, upper, options);
+    const BoundedMinimum m = MinimizeBounded(cost, x0, sp.lower, sp.upper, mo);
     if (m.f < best_f) {
       best_f = m.f;
       best_x = m.x;
     }
   }
-  return unpack(best_x);
+  return sp.Unpack(best_x);
 }
 
 }  // namespace umbmark::diag

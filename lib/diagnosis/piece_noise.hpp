@@ -15,10 +15,14 @@
 //
 // bump_outliers (a per-wheel Poisson process of travel errors N(0, sigma_b^2),
 // `rate` per metre) makes eps_j a scale mixture: with m bumps on the piece
-// (m ~ Poisson(rate (|L| + |R|)), truncated at kMaxBumpsPerPiece) its covariance is
-//   C_j + m sigma_b^2 (A_L / |L| + A_R / |R|) / 2
+// (m ~ Poisson(rate (|L| + |R|)); the tail beyond kMaxBumpsPerPiece - 1 one
+// component at its mean count) its covariance is
+//   C_j + m sigma_b^2 (A_L + A_R) / (|L| + |R|)
 // (a bump's effect averaged over where on the piece, and which wheel, it
-// strikes). FitBumps maximises that mixture likelihood (NLopt Sbplx, bounded).
+// strikes: wheel L with probability |L| / (|L| + |R|)), so that the mixture's
+// covariance is C_j + rate sigma_b^2 (A_L + A_R), wheel noise's. FitBumps
+// maximises that mixture likelihood (NLopt Sbplx, bounded) jointly with the
+// other variance terms (docs/diagnosis.md, "Bumps fitted jointly").
 #pragma once
 
 #include <string>
@@ -102,17 +106,40 @@ NoiseParams FitPieceNoise(const std::vector<double>& eps, const std::vector<Piec
                      const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start,
                      const PieceNoiseFitOptions& options);
 
-/// As FitPieceNoise, plus bump_outliers' rate and sigma_b (mixture likelihood,
-/// bounded Sbplx over log k_L^2, log k_R^2, log rate, log sigma_b^2; ground
-/// truth noise fixed at `start`'s). The search is bounded to physical
-/// bumps: rate in [1e-4, 2] per metre, sigma_b in [0.01, 100] mm.
-/// start_only: one search from `start` (which must carry bumps) instead of
-/// the multi-start -- for refits near a known answer, such as the
-/// cross-validation folds of a full-data fit.
-/// fit_wheel_noise false: k_L, k_R stay at `start`'s (a given model's).
+/// What FitBumps estimates beside bump_outliers' rate and sigma_b.
+struct BumpFitOptions {
+  /// One search from `start` (which must carry bumps) instead of the
+  /// multi-start -- for refits near a known answer, such as the
+  /// cross-validation folds of a full-data fit. Default false.
+  bool start_only = false;
+  /// Estimate k_L^2, k_R^2 (else held at `start`'s: a given model's wheel
+  /// noise). Default true.
+  bool fit_wheel_noise = true;
+  /// Estimate motion_noise_floor's sigma^2, standstill_motion's sigma_xy^2
+  /// and sigma_theta^2, run_time_offset's tau_sd^2 jointly with the bumps
+  /// (else held at `start`'s). Default false: a candidate fitted alone.
+  bool motion_floor = false, standstill = false, run_time = false;
+  /// The wheel noise of the repeated runs' scatter [m] (0: not measured):
+  /// one more start, k at it and the bumps holding the rest of the Gaussian
+  /// fit's k^2 (a mean effect the pieces' k takes in cannot reach it).
+  double repeat_kL2 = 0.0, repeat_kR2 = 0.0;
+  /// The Gaussian variance components of `fit` (motion_floor, standstill,
+  /// run_time, fit_wheel_noise) as the terms fitted with the bumps.
+  static BumpFitOptions Terms(const PieceNoiseFitOptions& fit);
+};
+
+/// As FitPieceNoise, plus bump_outliers' rate and sigma_b: the mixture
+/// likelihood (PieceLogLik) maximised over log k_L^2, log k_R^2, log rate,
+/// log sigma_b^2 and the log of every other variance term `options` frees,
+/// jointly (bounded Sbplx), from several starts: the Gaussian fit of the
+/// same terms without bumps, with the bumps taking a share of its k^2 on a
+/// grid of rates and shares (and of the repeated runs' excess over their
+/// k^2, when given), the best few of the grid searched. Ground-truth noise
+/// and correlation are held at `start`'s (c_LR at 0). The search is bounded
+/// to physical bumps: rate in [1e-4, 2] per metre, sigma_b in [0.01, 100] mm.
 NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBases>& bases,
                      const std::vector<Piece>& pieces, const std::vector<char>& use, const NoiseParams& start,
-                     bool start_only = false, bool fit_wheel_noise = true);
+                     const BumpFitOptions& options);
 
 /// Log-likelihood of piece j's residual (Gaussian, or the bump mixture when
 /// n.bump_rate > 0).

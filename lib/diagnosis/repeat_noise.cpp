@@ -246,7 +246,7 @@ RepeatWheelFit FitRepeatWheelNoise(const RepeatDesign& design, const RepeatDesig
   if (bumps) {
     const RepeatContrasts rc = ApplyRepeatDesign(pairs, c, eps, bases);
     n.c_LR = n.floor_s2 = n.stand_xy2 = n.stand_th2 = n.run_tau2 = 0.0;
-    out.noise = FitBumps(rc.eps, rc.bases, rc.pieces, {}, n, /*start_only=*/false, /*fit_wheel_noise=*/true);
+    out.noise = FitBumps(rc.eps, rc.bases, rc.pieces, {}, n, BumpFitOptions{});
     out.contrasts = static_cast<int>(rc.pieces.size());
     return out;
   }
