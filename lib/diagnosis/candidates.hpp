@@ -62,8 +62,10 @@ struct Candidate {
   /// slide at a stop (stop_slide) moves only the samples after the stop.
   struct ClockCheck {
     bool checked = false;
-    /// The moving samples show the clock offset too: the refit stands 3
-    /// standard errors out with the full fit's sign (time_offset), or keeps
+    /// The moving samples show the clock offset too: the refit has the full
+    /// fit's sign and its likelihood ratio against no clock there (deviance
+    /// over the samples' dispersion) exceeds chi^2_1 at 0.27 %, the level of
+    /// 3 standard errors (time_offset), or keeps
     /// at least half the full fit's tau_sd or gains more than 5.4 nats there
     /// (run_time_offset).
     bool supported = true;

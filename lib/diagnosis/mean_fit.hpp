@@ -4,6 +4,7 @@
 // of piece j's covariance (piece_noise.hpp), by Ceres' Levenberg-Marquardt.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -27,6 +28,17 @@ void Whiten(const std::vector<Eigen::Matrix3d>& W, const std::vector<double>& ep
 struct MeanFitOptions {
   /// Levenberg-Marquardt iterations at most. Default 10.
   int iterations = 10;
+  /// When time_offset.tau is among the fitted parameters, its start is the
+  /// best of a grid tau = k clock_step_s, |tau| <= clock_scan_s, the other
+  /// parameters at their start (a clock's cost has a dip at every sample
+  /// interval: a local fit from tau = 0 stops in the nearest). Defaults
+  /// 0.5 s (six times the largest clock the injection-recovery sessions
+  /// hold) in steps of 10 ms (a fifth of a 20 Hz sample interval); 0 scans
+  /// nothing.
+  double clock_scan_s = 0.5;
+  double clock_step_s = 0.01;
+  /// "" when valid, else what is wrong, naming the field.
+  std::string Check() const;
 };
 
 struct MeanFit {
