@@ -58,19 +58,6 @@ class WhitenedPieceCost final : public ceres::CostFunction {
   const std::vector<Eigen::Matrix3d>& W_;
 };
 
-/// Whitened cost sum |W_j eps_j|^2 at p (infinite when a residual is not
-/// finite).
-double WhitenedCost(const MeanModel& model, const ParamVector& p, const std::vector<Eigen::Matrix3d>& W) {
-  std::vector<double> eps;
-  model.Residuals(p, eps);
-  double cost = 0.0;
-  for (std::size_t j = 0; j < W.size(); ++j) {
-    const Eigen::Vector3d r = W[j] * Eigen::Vector3d(eps[3 * j], eps[3 * j + 1], eps[3 * j + 2]);
-    cost += r.squaredNorm();
-  }
-  return std::isfinite(cost) ? cost : std::numeric_limits<double>::infinity();
-}
-
 /// The clock offset's start: the best of a grid over [-clock_scan_s,
 /// clock_scan_s] (the others at `start`), or start's own value when no grid
 /// value is better. A clock's cost is not convex in tau: the pose at t - tau
@@ -81,18 +68,23 @@ double WhitenedCost(const MeanModel& model, const ParamVector& p, const std::vec
 /// recording was fitted at +31.6 ms that way).
 double ClockStart(const MeanModel& model, const ParamVector& start, const std::vector<Eigen::Matrix3d>& W,
                   const MeanFitOptions& o) {
-  ParamVector p = start;
-  double best_tau = start[kParamTau], best = WhitenedCost(model, p, W);
   const int n = static_cast<int>(std::ceil(o.clock_scan_s / o.clock_step_s));
-  for (int k = -n; k <= n; ++k) {
-    p[kParamTau] = k * o.clock_step_s;
-    const double cost = WhitenedCost(model, p, W);
-    if (cost < best) {
-      best = cost;
-      best_tau = p[kParamTau];
+  std::vector<double> taus{start[kParamTau]};
+  for (int k = -n; k <= n; ++k) taus.push_back(k * o.clock_step_s);
+  std::vector<std::vector<double>> eps;
+  model.ResidualsAtClocks(start, taus, eps);
+  std::size_t best = 0;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < taus.size(); ++k) {
+    double cost = 0.0;
+    for (std::size_t j = 0; j < W.size(); ++j)
+      cost += (W[j] * Eigen::Vector3d(eps[k][3 * j], eps[k][3 * j + 1], eps[k][3 * j + 2])).squaredNorm();
+    if (std::isfinite(cost) && cost < best_cost) {
+      best_cost = cost;
+      best = k;
     }
   }
-  return best_tau;
+  return taus[best];
 }
 
 }  // namespace

@@ -30,13 +30,14 @@ struct MeanFitOptions {
   int iterations = 10;
   /// When time_offset.tau is among the fitted parameters, its start is the
   /// best of a grid tau = k clock_step_s, |tau| <= clock_scan_s, the other
-  /// parameters at their start (a clock's cost has a dip at every sample
-  /// interval: a local fit from tau = 0 stops in the nearest). Defaults
-  /// 0.5 s (six times the largest clock the injection-recovery sessions
-  /// hold) in steps of 10 ms (a fifth of a 20 Hz sample interval); 0 scans
-  /// nothing.
-  double clock_scan_s = 0.5;
-  double clock_step_s = 0.01;
+  /// parameters at their start (a clock's cost is not convex in tau: a
+  /// local fit from tau = 0 stops in the nearest dip). Defaults 0.3 s
+  /// (four times the largest clock of the injection-recovery sessions; a
+  /// clock beyond is a run fault's size) in steps of 25 ms (half a 20 Hz
+  /// sample interval; the dips seen on the June recordings are 60 ms or
+  /// more wide); 0 scans nothing.
+  double clock_scan_s = 0.3;
+  double clock_step_s = 0.025;
   /// "" when valid, else what is wrong, naming the field.
   std::string Check() const;
 };

@@ -262,13 +262,14 @@ Pose2 MeanModel::PoseAt(int run, const ParamVector& p, const std::vector<Pose2>&
   const std::size_t i = static_cast<std::size_t>(std::upper_bound(r.t.begin(), r.t.end(), t) - r.t.begin()) - 1;
   if (i + 1 >= n) return poses.back();
   const double u = (t - r.t[i]) / (r.t[i + 1] - r.t[i]);
+  // Before the wheels move in the interval nothing has happened, not even
+  // the castor kick (checked first: most samples a clock scan reads lie in
+  // standstills).
+  const bool junction = !r.junction_of.empty() && r.junction_of[i] >= 0;
+  if (!junction && (u <= r.window_start[i] || r.window_end[i] <= r.window_start[i])) return poses[i];
   const TrueFactors f = Factors(p, campaign_.robot.wheelbase_m);
   RunFactors wheels;
   RunWheels(run, p, wheels.left, wheels.right);
-  // Before the wheels move in the interval nothing has happened, not even
-  // the castor kick.
-  const bool junction = !r.junction_of.empty() && r.junction_of[i] >= 0;
-  if (!junction && (u <= r.window_start[i] || r.window_end[i] <= r.window_start[i])) return poses[i];
   return AdvanceInterval(r, i, f, wheels, poses[i], u);
 }
 
@@ -306,6 +307,43 @@ std::vector<Pose2> MeanModel::PredictedPieceMotion(const ParamVector& p) const {
     }
   }
   return out;
+}
+
+void MeanModel::ResidualsAtClocks(const ParamVector& p, const std::vector<double>& taus,
+                                  std::vector<std::vector<double>>& eps) const {
+  const std::size_t np = campaign_.pieces.size();
+  eps.assign(taus.size(), std::vector<double>(3 * np, 0.0));
+  // Pieces of no run keep the predicted motion Pose2{} (PredictedPieceMotion).
+  for (std::vector<double>& e : eps)
+    for (std::size_t j = 0; j < np; ++j) {
+      e[3 * j] = observed_[j].x;
+      e[3 * j + 1] = observed_[j].y;
+      e[3 * j + 2] = WrapAngle(observed_[j].theta);
+    }
+  std::vector<Pose2> poses;
+  const double dx = p[kParamDx], dy = p[kParamDy];
+  for (std::size_t run = 0; run < campaign_.runs.size(); ++run) {
+    if (pieces_of_run_[run].empty()) continue;
+    ReplayRun(static_cast<int>(run), p, poses);
+    const DiagRun& r = campaign_.runs[run];
+    auto has = [&](std::size_t i) { return static_cast<bool>(r.has_gt[i]); };
+    for (std::size_t k = 0; k < taus.size(); ++k) {
+      const double tau = taus[k];
+      auto predicted = [&](std::size_t i) {
+        const Pose2 q = tau != 0.0 ? PoseAt(static_cast<int>(run), p, poses, r.t[i] - tau) : poses[i];
+        const double c = std::cos(q.theta), s = std::sin(q.theta);
+        return Pose2{q.x + c * dx - s * dy, q.y + s * dx + c * dy, q.theta};
+      };
+      for (int j : pieces_of_run_[run]) {
+        const Piece& pc = campaign_.pieces[j];
+        const Pose2 pred = Relative(MeanPose(pc.a_lo, pc.a_hi, predicted, has), MeanPose(pc.b_lo, pc.b_hi, predicted, has));
+        const auto J = static_cast<std::size_t>(3 * j);
+        eps[k][J] = observed_[j].x - pred.x;
+        eps[k][J + 1] = observed_[j].y - pred.y;
+        eps[k][J + 2] = WrapAngle(observed_[j].theta - pred.theta);
+      }
+    }
+  }
 }
 
 void MeanModel::Residuals(const ParamVector& p, std::vector<double>& eps) const {

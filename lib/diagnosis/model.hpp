@@ -108,6 +108,13 @@ class MeanModel {
   /// Residuals for `p` (size 3 * pieces).
   void Residuals(const ParamVector& p, std::vector<double>& eps) const;
 
+  /// Residuals for `p` with time_offset.tau set to each of `taus` in turn
+  /// (eps[k] for taus[k], each as Residuals gives them): the runs are
+  /// replayed once, since tau moves only the samples the ground truth is
+  /// read at (a scan of the clock, FitMean).
+  void ResidualsAtClocks(const ParamVector& p, const std::vector<double>& taus,
+                         std::vector<std::vector<double>>& eps) const;
+
   /// d eps / d p_k for k in `params` (forward differences), as a
   /// (3 * pieces) x params.size() matrix, at `p` whose residuals are `eps0`.
   Eigen::MatrixXd Jacobian(const ParamVector& p, const std::vector<int>& params, const std::vector<double>& eps0) const;
