@@ -133,9 +133,13 @@ std::vector<std::string> MissingDesign(const CampaignData& c) {
 }
 
 
-/// The campaign and baseline numbers an effect's advice needs.
+/// The campaign and model numbers an effect's advice needs: E_d, E_b of
+/// the explained model (fitted with the named effects) when there is an
+/// explanation and no given model, else the baseline's.
 effects::AdviceContext AdviceOf(const CampaignData& c, const DiagnoseSummary& s) {
-  return {c.robot, s.baseline.E_d, s.baseline.E_b, s.baseline.runs};
+  const bool explained = !s.explanation.empty() && !s.baseline.given;
+  return {c.robot, explained ? s.explained_E_d : s.baseline.E_d, explained ? s.explained_E_b : s.baseline.E_b,
+          s.baseline.runs};
 }
 
 /// The concrete change for one named effect, in the numbers the explanation

@@ -311,6 +311,10 @@ void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit
       st.unphysical = UnphysicalFit(sim::EffectToString(st.effect), st.params, static_cast<int>(c.runs.size()), se);
     }
     out.explanation = ex.steps;
+    if (!ex.steps.empty()) {
+      out.explained_E_d = ex.p[kParamEd];
+      out.explained_E_b = ex.p[kParamEb];
+    }
     out.explanation_stop = ex.stop_reason;
     out.symptoms = ex.symptoms;
     NameEffects(ex, options, v, out);

@@ -206,6 +206,12 @@ struct DiagnoseSummary {
   /// Stepwise explanation (explanation.hpp), in the order added; empty
   /// without a significant gap.
   std::vector<ExplanationStep> explanation;
+  /// The explained model's E_d, E_b: fitted jointly with the explanation's
+  /// effects (its last step), which the advice's concrete changes use; the
+  /// baseline's when there is no step. A marker offset or a clock the
+  /// baseline leaves out can drive its E_b far off (s4 of the June
+  /// sessions with a 47 mm marker: E_b 1.245; explained, 1.00).
+  double explained_E_d = 1.0, explained_E_b = 1.0;
   std::string explanation_stop;
   /// Fits the explanation met that no robot can have, or noise effects at
   /// zero (Explanation::symptoms): symptoms, never steps (JSON `symptoms`).

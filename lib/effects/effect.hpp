@@ -114,8 +114,8 @@ struct CampaignScale {
 /// What the advice needs of the campaign and its baseline model.
 struct AdviceContext {
   RobotParams robot;       ///< the campaign's nominal robot
-  double E_d = 1.0;        ///< the baseline's diameter ratio
-  double E_b = 1.0;        ///< the baseline's wheelbase factor
+  double E_d = 1.0;        ///< the explained model's diameter ratio (fitted with the named effects)
+  double E_b = 1.0;        ///< the explained model's wheelbase factor
   int runs = 0;            ///< runs in the campaign
 };
 

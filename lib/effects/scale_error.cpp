@@ -40,15 +40,16 @@ class ScaleError final : public Effect {
     return {};
   }
 
-  // The baseline's E_d, E_b turned into wheel diameters (contract: c_L =
-  // 2 / (E_d + 1), c_R = 2 / (1 / E_d + 1)) and the wheelbase E_b b.
+  // The explained model's E_d, E_b (AdviceContext) turned into wheel
+  // diameters (contract: c_L = 2 / (E_d + 1), c_R = 2 / (1 / E_d + 1)) and
+  // the wheelbase E_b b.
   std::string ConcreteChange(const Params& p, const AdviceContext& c) const override {
     const double s = Get(p, "s"), f = 1.0 + s;
     const double cl = 2.0 / (c.E_d + 1.0), cr = 2.0 / (1.0 / c.E_d + 1.0);
     return fmt::format(
         "Wheel diameters: both wheels are {:.2f}% {} than the model's. Set wheel_diameter_left_m = {:.5f} and "
         "wheel_diameter_right_m = {:.5f} (the diameters x (1 + s) = x {:.5f}, with the fitted ratio E_d = {:.5f}; "
-        "now {:.5f} / {:.5f}), wheelbase_m = {:.5f} (E_b = {:.5f}); or re-measure the wheels on a tape-measured "
+        "now {:.5f} / {:.5f}), wheelbase_m = {:.5f} (E_b = {:.5f}, fitted with the named effects); or re-measure the wheels on a tape-measured "
         "straight run.",
         100.0 * std::abs(s), s >= 0.0 ? "larger" : "smaller", cl * c.robot.wheel_diameter_left_m * f,
         cr * c.robot.wheel_diameter_right_m * f, f, c.E_d, c.robot.wheel_diameter_left_m,
