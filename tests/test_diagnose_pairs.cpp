@@ -190,7 +190,7 @@ TEST_CASE("diagnose pairs: the advice's wheelbase is the explained model's, not 
   // test tells the two apart at the printed five decimals).
   INFO("baseline E_b " << d.baseline.E_b << ", explained " << d.explained_E_b);
   CHECK(std::abs(d.baseline.E_b - d.explained_E_b) > 1e-4);
-  const std::string wheelbase = fmt::format("wheelbase_m = {:.5f} (E_b = {:.5f}, fitted with the named effects)",
+  const std::string wheelbase = fmt::format("wheelbase_m = {:.5f} (E_b = {:.5f}; E_d, E_b fitted jointly with the named effects",
                                             d.explained_E_b * 0.30, d.explained_E_b);
   INFO(wheelbase);
   CHECK(std::any_of(d.next_steps.begin(), d.next_steps.end(),

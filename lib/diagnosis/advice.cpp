@@ -139,7 +139,7 @@ std::vector<std::string> MissingDesign(const CampaignData& c) {
 effects::AdviceContext AdviceOf(const CampaignData& c, const DiagnoseSummary& s) {
   const bool explained = !s.explanation.empty() && !s.baseline.given;
   return {c.robot, explained ? s.explained_E_d : s.baseline.E_d, explained ? s.explained_E_b : s.baseline.E_b,
-          s.baseline.runs};
+          s.baseline.runs, explained};
 }
 
 /// The concrete change for one named effect, in the numbers the explanation

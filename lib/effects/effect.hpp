@@ -117,6 +117,9 @@ struct AdviceContext {
   double E_d = 1.0;        ///< the explained model's diameter ratio (fitted with the named effects)
   double E_b = 1.0;        ///< the explained model's wheelbase factor
   int runs = 0;            ///< runs in the campaign
+  /// E_d, E_b are the explained model's; false: the baseline's (no
+  /// explanation) or the given model's (`--baseline`).
+  bool explained = false;
 };
 
 /// What the campaign's design shows, for an effect's design note

@@ -48,12 +48,13 @@ class ScaleError final : public Effect {
     const double cl = 2.0 / (c.E_d + 1.0), cr = 2.0 / (1.0 / c.E_d + 1.0);
     return fmt::format(
         "Wheel diameters: both wheels are {:.2f}% {} than the model's. Set wheel_diameter_left_m = {:.5f} and "
-        "wheel_diameter_right_m = {:.5f} (the diameters x (1 + s) = x {:.5f}, with the fitted ratio E_d = {:.5f}; "
-        "now {:.5f} / {:.5f}), wheelbase_m = {:.5f} (E_b = {:.5f}, fitted with the named effects); or re-measure the wheels on a tape-measured "
+        "wheel_diameter_right_m = {:.5f} (the diameters x (1 + s) = x {:.5f}, with E_d = {:.5f}; now {:.5f} / "
+        "{:.5f}), wheelbase_m = {:.5f} (E_b = {:.5f}; E_d, E_b {}); or re-measure the wheels on a tape-measured "
         "straight run.",
         100.0 * std::abs(s), s >= 0.0 ? "larger" : "smaller", cl * c.robot.wheel_diameter_left_m * f,
         cr * c.robot.wheel_diameter_right_m * f, f, c.E_d, c.robot.wheel_diameter_left_m,
-        c.robot.wheel_diameter_right_m, c.E_b * c.robot.wheelbase_m, c.E_b);
+        c.robot.wheel_diameter_right_m, c.E_b * c.robot.wheelbase_m, c.E_b,
+        c.explained ? "fitted jointly with the named effects, not the baseline's" : "of the model compared with");
   }
 
   void TrueWheels(const Effects& e, int /*run_index*/, double& left, double& right) const override {
