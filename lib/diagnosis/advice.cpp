@@ -214,10 +214,11 @@ std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSu
   if (fixes_first) out.insert(out.end(), changes.begin(), changes.end());
   if (!s.where.empty()) {
     const WhereItem& w = s.where.front();
+    // The subset names "all experiments" itself when the item pools them.
     const std::string exp = w.experiment >= 0 && w.experiment < static_cast<int>(s.experiment_labels.size())
-                                ? "experiment " + s.experiment_labels[w.experiment]
-                                : std::string("all experiments");
-    out.push_back(fmt::format("{} {}, {}: its {} of the {} component is {:.1f} standard errors off the "
+                                ? "experiment " + s.experiment_labels[w.experiment] + ", "
+                                : std::string(w.subset.starts_with("all experiments") ? "" : "all experiments, ");
+    out.push_back(fmt::format("{} {}{}: its {} of the {} component is {:.1f} standard errors off the "
                               "model. Plot those runs' odometry against the ground truth (umbmark evaluate --report) "
                               "and check the ground truth there (marker swaps, dropped samples, timing).",
                               fixes_first ? "Then, for what those changes leave, look at" : "Look first at", exp,
