@@ -232,6 +232,14 @@ std::string PText(double p) {
   return v.rfind("<", 0) == 0 ? "p " + v : "p = " + v;
 }
 
+/// The verdict's reason as a sentence after another: its first letter in
+/// upper case (the reason starts in lower case: it follows "verdict: ..."
+/// in the text report).
+std::string Sentence(std::string s) {
+  if (!s.empty() && s[0] >= 'a' && s[0] <= 'z') s[0] = static_cast<char>(s[0] - 'a' + 'A');
+  return s;
+}
+
 /// Fitted parameters with units (and standard errors when given).
 std::string ParamsText(const nlohmann::json& params, const nlohmann::json& se, const std::string& effect) {
   std::string out;
@@ -431,11 +439,11 @@ std::string DiagnoseReportHtml(const nlohmann::json& j, const std::string& manif
   const std::string plain = j.value("summary", std::string());
   std::string stats;
   if (effect == "none") {
-    stats = fmt::format("No gap that matters between the runs and the model ({}). {}", PText(p), v.value("reason", ""));
+    stats = fmt::format("No gap that matters between the runs and the model ({}). {}", PText(p), Sentence(v.value("reason", "")));
   } else if (effect == "unexplained") {
-    stats = fmt::format("The runs leave the model ({}) and no known effect explains it. {}", PText(p), v.value("reason", ""));
+    stats = fmt::format("The runs leave the model ({}) and no known effect explains it. {}", PText(p), Sentence(v.value("reason", "")));
   } else {
-    stats = fmt::format("The runs leave the model ({}); the cause: {}. {}", PText(p), effect, v.value("reason", ""));
+    stats = fmt::format("The runs leave the model ({}); the cause: {}. {}", PText(p), effect, Sentence(v.value("reason", "")));
   }
   rep.Headline(plain.empty() ? stats : plain, effect == "none"          ? io::HtmlReport::Level::kGood
                                               : effect == "unexplained" ? io::HtmlReport::Level::kBad

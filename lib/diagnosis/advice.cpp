@@ -233,12 +233,17 @@ std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSu
   // the answer, not the answer (the verdict's reason says why: a
   // significant gap is left, or too little is closed held out).
   if (!s.verdict_effects.empty())
-    out.push_back(fmt::format("No listed effect explains this gap (the verdict). The candidates {} close {:.0f}% of "
-                              "it on held-out runs, and what they leave is still significant or too large: check "
-                              "them one at a time (model {}, diagnose again) and look at what is left; it is "
+  {
+    const bool one = s.verdict_effects.size() == 1;
+    out.push_back(fmt::format("No listed effect explains this gap (the verdict). {} {} {} {:.0f}% of "
+                              "it on held-out runs, and what {} is still significant or too large: {} "
+                              "(model {}, diagnose again) and look at what is left; it is "
                               "something the list does not name.",
-                              fmt::join(s.verdict_effects, " + "), 100.0 * (1.0 - s.unexplained_fraction),
-                              s.verdict_effects.size() > 1 ? "them" : "it"));
+                              one ? "The candidate" : "The candidates", fmt::join(s.verdict_effects, " + "),
+                              one ? "closes" : "close", 100.0 * (1.0 - s.unexplained_fraction),
+                              one ? "it leaves" : "they leave", one ? "check it" : "check them one at a time",
+                              one ? "it" : "them"));
+  }
   out.push_back("Check the recording itself: one clock for encoders and ground truth, the marker rigidly on the "
                 "robot, the same floor and load for every run. docs/diagnosis.md lists what each effect looks like.");
   return out;
