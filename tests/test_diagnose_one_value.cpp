@@ -46,6 +46,17 @@ TEST_CASE("diagnose: one value per quantity in text, JSON, HTML and simulate; a 
   const auto& ex = j.at("explanation");
   REQUIRE_FALSE(ex.empty());
   CHECK(j.at("verdict").at("effect") == "castor_kick");
+  // What is left, where: the gap statistics of the explained model, whose G
+  // the explanation's last step computed in its own fit (FitSet), largest
+  // first, in the JSON and the text.
+  const auto& left = j.at("verdict").at("remaining_where");
+  REQUIRE_FALSE(left.empty());
+  CHECK(j.at("verdict").at("remaining_score").get<double>() ==
+        Approx(ex.back().at("gap_after").get<double>()).epsilon(1e-9));
+  for (std::size_t i = 1; i < left.size(); ++i)
+    CHECK(std::abs(left[i - 1].at("size_se").get<double>()) >= std::abs(left[i].at("size_se").get<double>()));
+  CHECK(text.find("what is left after the explanation, where (G = " +
+                  fmt::format("{:.1f}", j.at("verdict").at("remaining_score").get<double>())) != std::string::npos);
   for (const auto& e : ex) {
     const std::string effect = e.at("effect");
     INFO(effect);

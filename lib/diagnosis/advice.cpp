@@ -213,7 +213,8 @@ std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSu
   const bool fixes_first = !changes.empty() && 1.0 - s.unexplained_fraction >= 0.5;
   if (fixes_first) out.insert(out.end(), changes.begin(), changes.end());
   if (!s.where.empty()) {
-    const WhereItem& w = s.where.front();
+    // What those changes leave is the explained model's largest part.
+    const WhereItem& w = fixes_first && !s.remaining_where.empty() ? s.remaining_where.front() : s.where.front();
     // The subset names "all experiments" itself when the item pools them.
     const std::string exp = w.experiment >= 0 && w.experiment < static_cast<int>(s.experiment_labels.size())
                                 ? "experiment " + s.experiment_labels[w.experiment] + ", "

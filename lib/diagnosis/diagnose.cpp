@@ -317,6 +317,14 @@ void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit
     }
     out.explanation_stop = ex.stop_reason;
     out.symptoms = ex.symptoms;
+    if (!ex.steps.empty() && ex.bases.size() == c.pieces.size()) {
+      // What is left, where: the gap statistics of the explained model.
+      std::vector<double> eps;
+      model.Residuals(ex.p, eps);
+      const GapSummary left = ComputeGap(c, PieceScores(eps, ex.bases, c.pieces, ex.noise), options.gap);
+      out.remaining_gap_score = left.score;
+      out.remaining_where = LocateGap(c, left, options.where_top);
+    }
     NameEffects(ex, options, v, out);
     explained = std::move(ex);
     timer.Lap("stepwise explanation");
@@ -401,6 +409,16 @@ std::string StandstillNote(const BaselineSummary& b) {
                                 "{:.3g} mrad) levels off at lags of {} and {} samples ({:.3g} mm, {:.3g} mrad)",
                                 1e3 * s.lag1_sigma_xy_m, 1e3 * s.lag1_sigma_theta_rad, s.lag_xy, s.lag_theta,
                                 1e3 * s.sigma_xy_m, 1e3 * s.sigma_theta_rad));
+  // Normal noise has sd / robust scale 1 within the sampling error (about
+  // 20 % at the fewest 30 differences): 1.5 is well beyond it.
+  if (s.sigma_xy_m > 1.5 * s.robust_sigma_xy_m || s.sigma_theta_rad > 1.5 * s.robust_sigma_theta_rad)
+    parts.push_back(fmt::format("the capture noise is heavy-tailed (the pose jumps now and then, e.g. a rigid body "
+                                "re-fitted to other markers): its sd ({:.3g} mm, {:.3g} mrad), which the model uses, is "
+                                "{:.2g} x / {:.2g} x the width of its core (1.4826 x the median absolute deviation: {:.3g} "
+                                "mm, {:.3g} mrad)",
+                                1e3 * s.sigma_xy_m, 1e3 * s.sigma_theta_rad, s.sigma_xy_m / std::max(s.robust_sigma_xy_m, 1e-12),
+                                s.sigma_theta_rad / std::max(s.robust_sigma_theta_rad, 1e-12), 1e3 * s.robust_sigma_xy_m,
+                                1e3 * s.robust_sigma_theta_rad));
   if (!s.plateau_xy || !s.plateau_theta)
     parts.push_back("the scatter still grows at the longest lag measured (a drift inside the standstills): it is an "
                     "upper end of the capture noise");

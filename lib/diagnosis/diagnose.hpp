@@ -197,6 +197,12 @@ struct DiagnoseSummary {
   bool significant = false;
   std::array<double, kNumStatKinds> gap_by_kind{};
   std::vector<WhereItem> where;
+  /// What is left after the explanation: the same statistics as `where`,
+  /// of the explained model (its last step's joint fit: mean parameters,
+  /// noise, covariance bases), largest first; G of that model in
+  /// remaining_gap_score. Empty (and NaN) without an explanation step.
+  std::vector<WhereItem> remaining_where;
+  double remaining_gap_score = NAN;
   /// Every piece's standardised residual under the baseline
   /// (piece_residuals.hpp), in campaign order: where the runs leave the model.
   std::vector<PieceResidual> piece_residuals;

@@ -84,9 +84,9 @@ nlohmann::json SymptomsJson(const DiagnoseSummary& s) {
   return out;
 }
 
-nlohmann::json WhereJson(const DiagnoseSummary& s) {
+nlohmann::json WhereJson(const DiagnoseSummary& s, const std::vector<WhereItem>& items) {
   nlohmann::json where = nlohmann::json::array();
-  for (const auto& w : s.where) {
+  for (const auto& w : items) {
     where.push_back({{"experiment", w.experiment + 1},
                      {"experiment_label", w.experiment >= 0 ? s.experiment_labels[w.experiment] : "all experiments"},
                      {"subset", w.subset},
@@ -194,6 +194,8 @@ nlohmann::json BaselineJson(const BaselineSummary& b) {
                                                   {"sigma_theta_rad", Num(b.standstill.sigma_theta_rad)},
                                                   {"lag1_sigma_xy_m", Num(b.standstill.lag1_sigma_xy_m)},
                                                   {"lag1_sigma_theta_rad", Num(b.standstill.lag1_sigma_theta_rad)},
+                                                  {"robust_sigma_xy_m", Num(b.standstill.robust_sigma_xy_m)},
+                                                  {"robust_sigma_theta_rad", Num(b.standstill.robust_sigma_theta_rad)},
                                                   {"plateau_lag_xy", b.standstill.lag_xy},
                                                   {"plateau_lag_theta", b.standstill.lag_theta},
                                                   {"plateau", b.standstill.plateau_xy && b.standstill.plateau_theta},
@@ -265,10 +267,12 @@ void BaselineSection(TextReport& o, const DiagnoseSummary& s) {
   o.line(fmt::format("  ground truth: sigma_xy = {:.3g} mm, sigma_theta = {:.3g} mrad; start: {}", 1e3 * b.sigma_xy_m,
                      1e3 * b.sigma_theta_rad, b.start));
   if (b.standstill.measured)
-    o.line(fmt::format("  ground truth's scatter inside standstills: sigma_xy = {:.3g} mm, sigma_theta = {:.3g} mrad ({} "
-                       "sample-to-sample differences in {} standstills; plateau at lags {} and {} samples)",
+    o.line(fmt::format("  ground truth's scatter inside standstills: sigma_xy = {:.3g} mm, sigma_theta = {:.3g} mrad, the "
+                       "differences' sd ({} sample-to-sample differences in {} standstills; plateau at lags {} and {} "
+                       "samples; robust core 1.4826 MAD: {:.3g} mm, {:.3g} mrad)",
                        1e3 * b.standstill.sigma_xy_m, 1e3 * b.standstill.sigma_theta_rad, b.standstill.differences,
-                       b.standstill.standstills, b.standstill.lag_xy, b.standstill.lag_theta));
+                       b.standstill.standstills, b.standstill.lag_xy, b.standstill.lag_theta,
+                       1e3 * b.standstill.robust_sigma_xy_m, 1e3 * b.standstill.robust_sigma_theta_rad));
   if (b.ground_truth_source == "standstills")
     o.line(fmt::format("  fitted to the pieces with the wheel noise instead: sigma_xy = {:.3g} mm, sigma_theta = {:.3g} "
                        "mrad (not used)",
@@ -310,6 +314,14 @@ void BaselineSection(TextReport& o, const DiagnoseSummary& s) {
   o.line("");
 }
 
+void WhereLines(TextReport& o, const std::vector<WhereItem>& items) {
+  for (const auto& w : items) {
+    o.line(fmt::format("    {:+8.2f} SE  {:<6} {:<40} {:<11} {}", w.z,
+                       w.experiment >= 0 ? fmt::format("exp {}", w.experiment + 1) : std::string("all"), w.subset,
+                       StatKindToString(w.statistic), w.component));
+  }
+}
+
 void WhereSection(TextReport& o, const DiagnoseSummary& s) {
   o.line(fmt::format("2. Where: gap score G = {:.2f} (null median {:.2f}, {:.0f}% quantile {:.2f}); p = {} from {} "
                      "simulations of the baseline",
@@ -321,11 +333,7 @@ void WhereSection(TextReport& o, const DiagnoseSummary& s) {
                        FormatP(s.tests_p_value), s.tests, FormatP(s.p_value), s.significant ? "significant" : "not significant"));
   else
     o.line(fmt::format("   p = {} -> {}", FormatP(s.p_value), s.significant ? "significant" : "not significant"));
-  for (const auto& w : s.where) {
-    o.line(fmt::format("    {:+8.2f} SE  {:<6} {:<40} {:<11} {}", w.z,
-                       w.experiment >= 0 ? fmt::format("exp {}", w.experiment + 1) : std::string("all"), w.subset,
-                       StatKindToString(w.statistic), w.component));
-  }
+  WhereLines(o, s.where);
   o.line("");
 }
 
@@ -394,6 +402,13 @@ void VerdictSection(TextReport& o, const DiagnoseSummary& s) {
   o.line("4. Verdict: " + s.verdict +
          (s.verdict_effects.size() > 1 ? fmt::format(" (effects: {})", fmt::join(s.verdict_effects, ", ")) : ""));
   o.line("  " + s.verdict_reason);
+  if (!s.remaining_where.empty()) {
+    o.line(fmt::format("  what is left after the explanation, where (G = {:.1f} with its effects fitted, null {:.0f}% "
+                       "quantile {:.1f}):",
+                       s.remaining_gap_score, 100.0 * (1.0 - s.alpha), s.null_quantile_alpha));
+    WhereLines(o, std::vector<WhereItem>(s.remaining_where.begin(),
+                                         s.remaining_where.begin() + std::min<std::ptrdiff_t>(6, std::ssize(s.remaining_where))));
+  }
   for (const auto& i : s.indistinguishable) o.line("  cannot tell apart: " + i);
   for (const auto& n : s.notes) o.line("  note: " + n);
   if (const Candidate* w = Winner(s); w && s.verdict != "none")
@@ -422,7 +437,7 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
   nlohmann::json j = {{"gap",
            {{"score", Num(s.gap_score)},
             {"p_value", Num(s.p_value)},
-            {"where", WhereJson(s)},
+            {"where", WhereJson(s, s.where)},
             {"score_p_value", Num(s.score_p_value)},
             {"tests_p_value", Num(s.tests_p_value)},
             {"tests", s.tests},
@@ -441,6 +456,8 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
            {{"effect", s.verdict},
             {"effects", s.verdict_effects},
             {"unexplained_fraction", Num(s.unexplained_fraction)},
+            {"remaining_score", Num(s.remaining_gap_score)},
+            {"remaining_where", WhereJson(s, s.remaining_where)},
             {"reason", s.verdict_reason},
             {"negligible_threshold", Num(s.negligible_threshold)}}},
           {"run_faults", RunFaultsJson(s)},

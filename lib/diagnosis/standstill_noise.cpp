@@ -41,6 +41,17 @@ double RobustSd(std::vector<double> v) {
   return 1.482602218505602 * median(v);
 }
 
+/// The sd of the values about their mean (n - 1 degrees of freedom).
+double Sd(const std::vector<double>& v) {
+  if (v.size() < 2) return 0.0;
+  double mean = 0.0;
+  for (double x : v) mean += x;
+  mean /= static_cast<double>(v.size());
+  double ss = 0.0;
+  for (double x : v) ss += (x - mean) * (x - mean);
+  return std::sqrt(ss / static_cast<double>(v.size() - 1));
+}
+
 /// The samples of one standstill that count: run samples first..last.
 struct Stretch {
   const DiagRun* run = nullptr;
@@ -99,11 +110,13 @@ void LagDifferences(const std::vector<Stretch>& st, std::size_t lag, std::vector
   }
 }
 
-/// sigma(k) = robust sd / sqrt 2 of the differences over k samples, for
-/// k = 1, 2, 4, ... up to max_lag while each has min_differences.
+/// sigma(k) = sd / sqrt 2 of the differences over k samples (xy, th), for
+/// k = 1, 2, 4, ... up to max_lag while each has min_differences (robust
+/// ones with StandstillNoiseOptions::robust); the robust scale beside them
+/// (xy_other, th_other).
 struct StructureFunction {
   std::vector<int> lags;
-  std::vector<double> xy, th;
+  std::vector<double> xy, th, xy_other, th_other;
 };
 
 /// The plateau of sigma(k): sigma at the doubled lag 2k of the first k
@@ -132,8 +145,12 @@ StandstillNoise MeasureStandstillNoise(const CampaignData& c, const StandstillNo
     if (lag == 1) out.differences = static_cast<int>(dth.size());
     if (static_cast<int>(dth.size()) < o.min_differences) break;
     sf.lags.push_back(lag);
-    sf.xy.push_back(RobustSd(dxy) / std::sqrt(2.0));
-    sf.th.push_back(RobustSd(dth) / std::sqrt(2.0));
+    const double rxy = RobustSd(dxy) / std::sqrt(2.0), rth = RobustSd(dth) / std::sqrt(2.0);
+    const double vxy = Sd(dxy) / std::sqrt(2.0), vth = Sd(dth) / std::sqrt(2.0);
+    sf.xy.push_back(o.robust ? rxy : vxy);
+    sf.th.push_back(o.robust ? rth : vth);
+    sf.xy_other.push_back(rxy);
+    sf.th_other.push_back(rth);
   }
   if (sf.lags.empty()) return out;
   out.measured = true;
@@ -141,6 +158,13 @@ StandstillNoise MeasureStandstillNoise(const CampaignData& c, const StandstillNo
   out.lag1_sigma_theta_rad = sf.th.front();
   Plateau(sf.lags, sf.xy, o.plateau_tolerance, out.sigma_xy_m, out.lag_xy, out.plateau_xy);
   Plateau(sf.lags, sf.th, o.plateau_tolerance, out.sigma_theta_rad, out.lag_theta, out.plateau_theta);
+  auto at = [&](const std::vector<double>& v, int lag) {
+    for (std::size_t i = 0; i < sf.lags.size(); ++i)
+      if (sf.lags[i] == lag) return v[i];
+    return v.back();
+  };
+  out.robust_sigma_xy_m = at(sf.xy_other, out.lag_xy);
+  out.robust_sigma_theta_rad = at(sf.th_other, out.lag_theta);
   out.floored_xy = out.sigma_xy_m < o.floor_xy_m;
   out.floored_theta = out.sigma_theta_rad < o.floor_theta_rad;
   out.sigma_xy_m = std::max(out.sigma_xy_m, o.floor_xy_m);

@@ -15,9 +15,9 @@
 // samples (a capture system's filter): r(1) > 0, so the sample-to-sample
 // difference underestimates sigma by sqrt(1 - r(1)); D rises with k and
 // levels off at 2 sigma^2 once r(k) ~ 0. So sigma(k) = sqrt(D(k) / 2) is
-// measured at lags k = 1, 2, 4, ... (max_lag), each robustly (1.4826 x the
-// median absolute deviation of the differences, so a nudge inside a
-// standstill does not inflate it), and the estimate is sigma(2k) for the
+// measured at lags k = 1, 2, 4, ... (max_lag), each as the sd of the
+// differences (their second moment about their mean), and the estimate is
+// sigma(2k) for the
 // first lag k whose doubling raises it by no more than plateau_tolerance
 // (the plateau; for white noise sigma(2) ~ sigma(1)). Example: AR(1) noise
 // with r(1) = 0.8, r(k) = 0.8^k: sigma(1) = 0.45 sigma, sigma(2) = 0.60,
@@ -27,6 +27,20 @@
 // plateau up to the longest lag) leaves the largest lag's value, reported
 // as `plateau = false`: then sigma is an upper end (a single usable lag is
 // reported the same way: the correlation was not checked).
+//
+// The sd, not a robust scale. The piece model is Gaussian in its second
+// moments: a piece's covariance needs the capture noise's VARIANCE, whatever
+// its shape. A motion capture's pose noise is not normal: a rigid body
+// re-fitted to a changing subset of its markers jumps between a few poses
+// (on the June OptiOdom sessions 0.3-0.6 mm and 4-7 mrad at once, and back
+// a few samples later), on top of a fine jitter. 1.4826 x the median absolute
+// deviation (the estimator before issue 28's gap lane, `robust`) measures the
+// jitter's width and leaves the jumps out: s1 0.051 mm / 0.89 mrad, where
+// the differences' sd gives 0.12 mm / 1.6 mrad, and the standstill pieces
+// then scattered 4 x their predicted sd along-track. The robust value is
+// still measured and reported beside it (robust_sigma_*); a nudge that stays
+// (a step, not a jump and back) raises D(k) at every lag up to the step's
+// distance from the ends, which the plateau rule sees as no plateau.
 //
 // Floor: a physics engine's ground truth (or a noise-free simulation) has
 // standstills without any scatter (sigma 0), and a noise of 0 would make a
@@ -56,6 +70,11 @@ struct StandstillNoiseOptions {
   /// A doubling of the lag that raises sigma by at most this fraction is
   /// the plateau (> 0). Default 0.15.
   double plateau_tolerance = 0.15;
+  /// Measure each lag robustly (1.4826 x the median absolute deviation,
+  /// the width of the noise's core; the estimator before the gap lane)
+  /// instead of by the differences' sd (the variance the piece covariances
+  /// need; see the file comment). Default false.
+  bool robust = false;
   /// Floors of the estimate [m], [rad] (>= 0). Default 1e-5 each.
   double floor_xy_m = 1e-5, floor_theta_rad = 1e-5;
 
@@ -68,6 +87,11 @@ struct StandstillNoise {
   double sigma_xy_m = 0.0, sigma_theta_rad = 0.0;
   /// The sample-to-sample estimate (lag 1), unfloored [m], [rad].
   double lag1_sigma_xy_m = 0.0, lag1_sigma_theta_rad = 0.0;
+  /// The robust scale at the same plateau lag (1.4826 x the MAD of the
+  /// differences / sqrt 2), unfloored [m], [rad]. sigma / robust well above
+  /// 1 (normal noise: 1 within sampling error) means a heavy-tailed capture
+  /// noise (jumps).
+  double robust_sigma_xy_m = 0.0, robust_sigma_theta_rad = 0.0;
   /// Lag of the plateau [samples], per component.
   int lag_xy = 1, lag_theta = 1;
   /// The structure function levelled off (false: still rising at the
