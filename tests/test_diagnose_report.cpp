@@ -227,4 +227,11 @@ TEST_CASE("diagnose --plot/--report: residuals per experiment with band, the lar
   CHECK(html.find("The largest piece residuals") != std::string::npos);
   CHECK(html.find("What to do next") != std::string::npos);
   CHECK(html.find("umbmark simulate") != std::string::npos);
+  // What the explained model leaves: the JSON's remaining_where, tabled with
+  // the same sizes (one decimal) and the G left.
+  const auto& left = j["verdict"]["remaining_where"];
+  REQUIRE_FALSE(left.empty());
+  CHECK(html.find("What is left after the explanation, where") != std::string::npos);
+  CHECK(html.find(fmt::format("G = {:.3g} left", j["verdict"]["remaining_score"].get<double>())) != std::string::npos);
+  CHECK(html.find(fmt::format("<td class=\"num\">{:+.1f}</td>", left[0]["size_se"].get<double>())) != std::string::npos);
 }

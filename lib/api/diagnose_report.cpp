@@ -393,6 +393,28 @@ void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
                             100.0 * Number(v, "negligible_threshold")));
 }
 
+/// What the explained model leaves (verdict.remaining_where): where to look
+/// next when the verdict is not named.
+void RemainingTable(io::HtmlReport& rep, const nlohmann::json& j) {
+  const auto& v = j.at("verdict");
+  const auto& left = v.value("remaining_where", nlohmann::json::array());
+  if (left.empty()) return;
+  rep.Heading("What is left after the explanation, where");
+  rep.Paragraph(fmt::format("The gap statistics of the explained model (the baseline with the explanation's effects, "
+                            "fitted jointly): G = {:.3g} left, where 0 is the model's own noise and {:.3g} the level "
+                            "the gap test calls significant. The largest parts say where the runs still leave the model: "
+                            "plot those pieces (umbmark evaluate --report) before adding effects.",
+                            Number(v, "remaining_score"), Number(j.at("gap"), "null_quantile_1_minus_alpha")));
+  std::vector<std::vector<std::string>> rows;
+  for (std::size_t i = 0; i < std::min<std::size_t>(left.size(), 8); ++i) {
+    const auto& w = left[i];
+    rows.push_back({w.value("experiment_label", std::string("?")), w.value("subset", std::string()),
+                    w.value("statistic", std::string()), w.value("component", std::string()),
+                    fmt::format("{}", w.value("n", 0)), fmt::format("{:+.1f}", Number(w, "size_se"))});
+  }
+  rep.Table({"experiment", "pieces", "statistic", "component", "n", "size [SE]"}, rows, 4);
+}
+
 /// The largest piece residuals, numbered as in the plot.
 void TopPiecesTable(io::HtmlReport& rep, const nlohmann::json& j) {
   const auto top = TopPieceResiduals(j, kTopPieces);
@@ -472,6 +494,7 @@ std::string DiagnoseReportHtml(const nlohmann::json& j, const std::string& manif
   GivenModelTable(rep, j);
   CandidateTable(rep, j);
   ExplanationTable(rep, j);
+  RemainingTable(rep, j);
   TopPiecesTable(rep, j);
   rep.Heading("Plots");
   rep.Figure(DiagnosePlotsSvg(j),
