@@ -89,6 +89,7 @@ void EnableNoiseEffect(sim::EffectKind k, PieceNoiseFitOptions& o) {
     case effects::NoiseTerm::kMotionFloor: o.motion_floor = true; break;
     case effects::NoiseTerm::kRunTime: o.run_time = true; break;
     case effects::NoiseTerm::kWheelNoise: o.fit_wheel_noise = true; break;
+    case effects::NoiseTerm::kFirstStart: o.first_start = true; break;
     case effects::NoiseTerm::kBumps:  // its own mixture fit (FitBumps)
     case effects::NoiseTerm::kNone: break;
   }
@@ -107,6 +108,9 @@ effects::NoiseValues NoiseValuesOf(const NoiseParams& n) {
   v.run_tau2 = n.run_tau2;
   v.kL2 = n.kL2;
   v.kR2 = n.kR2;
+  v.first_start_th2 = n.first_start2;
+  v.first_start_xy2 = n.first_start_xy2;
+  v.turn_start_th2 = n.turn_start2;
   return v;
 }
 
@@ -124,7 +128,11 @@ std::string NoiseEffectName(effects::NoiseTerm term) {
 
 int EffectParameterCount(sim::EffectKind k) {
   if (IsNoiseEffect(k)) return std::max(1, static_cast<int>(effects::Of(k).FromNoise({}).size()));
-  return static_cast<int>(EffectParams(k).size());
+  // A mean effect with a random part (a variance it switches on) counts its
+  // variances too.
+  const int random_part =
+      NoiseTermOf(k) == effects::NoiseTerm::kNone ? 0 : static_cast<int>(effects::Of(k).FromNoise({}).size());
+  return static_cast<int>(EffectParams(k).size()) + random_part;
 }
 
 double Gap(double score, double null_median) { return std::max(0.0, score - null_median); }
@@ -403,8 +411,14 @@ MeanFit FitMeanEffect(const Shared& x, const std::vector<int>& eparams, Candidat
   // variance there, from the fitted kappa.
   NoiseParams start = x.b.noise;
   start.swivel_rev2 = mf.p[kParamSwivel] * mf.p[kParamSwivel];
-  start = HeldWheelNoise(c, x.b, mf.eps, bases, start, x.b.noise_fit, /*bumps=*/false);
-  NoiseParams ne = FitPieceNoise(mf.eps, bases, c.pieces, {}, start, x.b.noise_fit);
+  // A mean effect's random part (a variance it switches on, such as a
+  // heading kick at each run's first start) is fitted with it, in the
+  // folds too.
+  PieceNoiseFitOptions nf = x.b.noise_fit, fold_fit = x.fold_fit;
+  EnableNoiseEffect(cd.effect, nf);
+  EnableNoiseEffect(cd.effect, fold_fit);
+  start = HeldWheelNoise(c, x.b, mf.eps, bases, start, nf, /*bumps=*/false);
+  NoiseParams ne = FitPieceNoise(mf.eps, bases, c.pieces, {}, start, nf);
   const std::vector<Eigen::Matrix3d> We = Whiteners(bases, c.pieces, ne);
   // Parameter standard errors with the refitted noise.
   Eigen::VectorXd r2;
@@ -427,6 +441,13 @@ MeanFit FitMeanEffect(const Shared& x, const std::vector<int>& eparams, Candidat
     cd.param_se[ParamName(eparams[k])] = a >= 0 ? std::sqrt(std::max(0.0, cov(a, a))) : 0.0;
     shown += a >= 0 ? 1 : 0;
   }
+  // Its random part's fitted values (and one parameter each where the
+  // campaign shows it).
+  if (NoiseTermOf(cd.effect) != effects::NoiseTerm::kNone)
+    for (const auto& [name, value] : NoiseEffectParams(cd.effect, ne)) {
+      cd.params[name] = value;
+      shown += value > 0.0 ? 1 : 0;
+    }
   cd.parameters = std::max(1, shown);
   cd.E_d = mf.p[kParamEd];
   cd.E_b = mf.p[kParamEb];
@@ -436,7 +457,7 @@ MeanFit FitMeanEffect(const Shared& x, const std::vector<int>& eparams, Candidat
   cd.gap_by_kind = ga.by_kind;
   const CrossValidation cv = CrossValidate(
       c, bases, x.folds, mf.eps, mf.D, We, [&](const std::vector<double>& e, const std::vector<char>& use) {
-        return FitPieceNoise(e, bases, c.pieces, use, ne, x.fold_fit);
+        return FitPieceNoise(e, bases, c.pieces, use, ne, fold_fit);
       });
   cd.heldout_loglik_gain = cv.loglik - x.cv_ll_base;
   const double gcv = ComputeGap(c, cv.scores, x.options.gap).score;

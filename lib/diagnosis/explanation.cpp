@@ -183,6 +183,9 @@ std::map<std::string, double> ParamsOf(sim::EffectKind e, const SetFit& f) {
   if (IsNoiseEffect(e)) return NoiseEffectParams(e, f.noise);
   std::map<std::string, double> out;
   for (int k : EffectParams(e)) out[ParamName(k)] = f.p[k];  // a parameter not fitted stays 0
+  // A mean effect's random part (a variance it switches on).
+  if (NoiseTermOf(e) != effects::NoiseTerm::kNone)
+    for (const auto& [name, value] : NoiseEffectParams(e, f.noise)) out[name] = value;
   return out;
 }
 

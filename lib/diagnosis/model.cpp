@@ -583,6 +583,19 @@ std::vector<PieceBases> ComputeBases(const CampaignData& campaign, const MeanMod
         B.K = v * v.transpose();
         break;
       }
+    for (std::size_t i = pc.a; i < pc.b && i < r.first_start.size(); ++i)
+      if (r.first_start[i]) {
+        const Eigen::Vector3d v(-motion[j].y, motion[j].x, 1.0);
+        B.P = v * v.transpose();
+        B.P_xy = Eigen::Vector3d(1.0, 1.0, 0.0).asDiagonal();
+        break;
+      }
+    for (std::size_t i = pc.a; i < pc.b && i < r.swivel.size(); ++i)
+      if (r.swivel[i] != 0) {
+        const Eigen::Vector3d v(-motion[j].y, motion[j].x, 1.0);
+        B.P_turn = v * v.transpose();
+        break;
+      }
   }
   return out;
 }

@@ -171,6 +171,19 @@ struct PieceBases {
   /// end pose (x, y: the predicted motion), on a piece in which a straight
   /// or arc motion starts that reverses the one before (DiagRun::reversal).
   Eigen::Matrix3d K = Eigen::Matrix3d::Zero();
+  /// A heading kick of random size at a run's first start
+  /// (effects::NoiseTerm::kFirstStart): first_start2 P, P = v v^T with v as
+  /// for K, on the piece in which the run's first motion (a straight or arc
+  /// one) starts (DiagRun::first_start).
+  Eigen::Matrix3d P = Eigen::Matrix3d::Zero();
+  /// The position slip there: first_start_xy2 P_xy, P_xy = R R^T with R the
+  /// rotation from the robot's frame at the start to the piece's start frame
+  /// (the identity: isotropic along both axes).
+  Eigen::Matrix3d P_xy = Eigen::Matrix3d::Zero();
+  /// The scatter of a heading kick where a straight or arc motion starts
+  /// after a spot turn (effects::NoiseTerm::kFirstStart): turn_start2 P_turn,
+  /// P_turn = v v^T as for K, on the piece holding such a start.
+  Eigen::Matrix3d P_turn = Eigen::Matrix3d::Zero();
   Eigen::Vector3d tau_lever_pos = Eigen::Vector3d::Zero(), tau_lever_neg = Eigen::Vector3d::Zero();
 };
 

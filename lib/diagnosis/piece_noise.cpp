@@ -23,7 +23,8 @@ double NoiseParams::rho() const {
 Eigen::Matrix3d PieceCovariance(const PieceBases& B, const NoiseParams& n) {
   return n.kL2 * B.A_L + n.kR2 * B.A_R + n.c_LR * B.A_LR + n.sxy2 * B.G_xy + n.sth2 * B.G_theta + B.Q +
          n.floor_s2 * B.F + n.stand_xy2 * B.S_xy + n.stand_th2 * B.S_theta + n.run_tau2 * B.T +
-         n.swivel_rev2 * B.K;
+         n.swivel_rev2 * B.K + n.first_start2 * B.P +
+         n.first_start_xy2 * B.P_xy + n.turn_start2 * B.P_turn;
 }
 
 BumpMixture PieceMixture(const PieceBases& B, const NoiseParams& n) {
@@ -93,8 +94,9 @@ bool Used(const std::vector<char>& use, std::size_t j) { return use.empty() || u
 
 
 /// Variance components: 0 kL2, 1 kR2, 2 c, 3 sxy2, 4 sth2, 5 floor_s2,
-/// 6 stand_xy2, 7 stand_th2, 8 run_tau2.
-constexpr int kComponents = 9;
+/// 6 stand_xy2, 7 stand_th2, 8 run_tau2, 9 first_start2, 10 first_start_xy2,
+/// 11 turn_start2.
+constexpr int kComponents = 12;
 using ScoreVec = Eigen::Matrix<double, kComponents, 1>;
 using InfoMat = Eigen::Matrix<double, kComponents, kComponents>;
 
@@ -108,7 +110,10 @@ double& Slot(NoiseParams& n, int m) {
     case 5: return n.floor_s2;
     case 6: return n.stand_xy2;
     case 7: return n.stand_th2;
-    default: return n.run_tau2;
+    case 8: return n.run_tau2;
+    case 9: return n.first_start2;
+    case 10: return n.first_start_xy2;
+    default: return n.turn_start2;
   }
 }
 
@@ -122,7 +127,10 @@ const Eigen::Matrix3d& Basis(const PieceBases& B, int m) {
     case 5: return B.F;
     case 6: return B.S_xy;
     case 7: return B.S_theta;
-    default: return B.T;
+    case 8: return B.T;
+    case 9: return B.P;
+    case 10: return B.P_xy;
+    default: return B.P_turn;
   }
 }
 
@@ -217,6 +225,9 @@ void Clamp(NoiseParams& n, const PieceNoiseFitOptions& o) {
   n.stand_xy2 = std::max(n.stand_xy2, 0.0);
   n.stand_th2 = std::max(n.stand_th2, 0.0);
   n.run_tau2 = std::max(n.run_tau2, 0.0);
+  n.first_start2 = std::max(n.first_start2, 0.0);
+  n.first_start_xy2 = std::max(n.first_start_xy2, 0.0);
+  n.turn_start2 = std::max(n.turn_start2, 0.0);
   const double lim = 0.995 * std::sqrt(n.kL2 * n.kR2);
   n.c_LR = std::clamp(n.c_LR, -lim, lim);
 }
@@ -258,11 +269,17 @@ std::vector<int> ActiveComponents(const std::vector<PieceBases>& bases, const st
     active.push_back(7);
   }
   if (options.run_time) active.push_back(8);
+  if (options.first_start) {
+    active.push_back(9);
+    active.push_back(10);
+    active.push_back(11);
+  }
   n.bump_rate = n.bump_s2 = 0.0;
   if (!options.correlated) n.c_LR = 0.0;
   if (!options.motion_floor) n.floor_s2 = 0.0;
   if (!options.standstill) n.stand_xy2 = n.stand_th2 = 0.0;
   if (!options.run_time) n.run_tau2 = 0.0;
+  if (!options.first_start) n.first_start2 = n.first_start_xy2 = n.turn_start2 = 0.0;
   std::erase_if(active, [&](int m) {
     if (m < 5) return false;
     for (std::size_t j = 0; j < pieces.size(); ++j)
@@ -420,6 +437,7 @@ BumpFitOptions BumpFitOptions::Terms(const PieceNoiseFitOptions& fit) {
   o.motion_floor = fit.motion_floor;
   o.standstill = fit.standstill;
   o.run_time = fit.run_time;
+  o.first_start = fit.first_start;
   return o;
 }
 
@@ -454,6 +472,9 @@ struct BumpSpace {
     add(o.standstill, 6, 1e-14, 1e-4);
     add(o.standstill, 7, 1e-14, 1e-2);
     add(o.run_time, 8, 1e-12, 1.0);  // tau_sd 1 us .. 1 s
+    add(o.first_start, 9, 1e-12, 1.0);    // sd 1 urad .. 1 rad
+    add(o.first_start, 10, 1e-14, 1e-2);  // sd up to 100 mm
+    add(o.first_start, 11, 1e-12, 1.0);   // sd 1 urad .. 1 rad
   }
   NoiseParams Unpack(const std::vector<double>& x) const {
     NoiseParams n = start;
@@ -533,6 +554,7 @@ NoiseParams FitBumps(const std::vector<double>& eps, const std::vector<PieceBase
     gf.motion_floor = options.motion_floor;
     gf.standstill = options.standstill;
     gf.run_time = options.run_time;
+    gf.first_start = options.first_start;
     gf.min_k2 = 1e-14;
     NoiseParams g0 = start;
     g0.bump_rate = g0.bump_s2 = 0.0;

@@ -49,6 +49,13 @@ struct NoiseParams {
   /// a heading variance kappa^2 at those starts [rad^2]. Never estimated
   /// here: the mean fit's kappa sets it (candidates.cpp, explanation.cpp).
   double swivel_rev2 = 0.0;
+  /// A heading kick of random size at a run's first start (a mean effect's
+  /// random part, effects::NoiseTerm::kFirstStart) [rad^2].
+  double first_start2 = 0.0;
+  /// The position slip there, along each axis [m^2].
+  double first_start_xy2 = 0.0;
+  /// The scatter of a heading kick after a spot turn [rad^2].
+  double turn_start2 = 0.0;
 
   double rho() const;
 };
@@ -84,6 +91,9 @@ struct PieceNoiseFitOptions {
   /// Estimate motion_noise_floor's sigma^2, standstill_motion's sigma_xy^2
   /// and sigma_theta^2, run_time_offset's tau_sd^2 (else held at 0).
   bool motion_floor = false, standstill = false, run_time = false;
+  /// Estimate the starts' variances first_start2, first_start_xy2,
+  /// turn_start2 (else held at 0).
+  bool first_start = false;
   int max_iterations = 60;
   /// Step halving on the likelihood (robust from a poor start); without it
   /// plain Fisher steps until the relative change is below `tolerance`
@@ -119,6 +129,9 @@ struct BumpFitOptions {
   /// and sigma_theta^2, run_time_offset's tau_sd^2 jointly with the bumps
   /// (else held at `start`'s). Default false: a candidate fitted alone.
   bool motion_floor = false, standstill = false, run_time = false;
+  /// Estimate first_start2, first_start_xy2, turn_start2 jointly with the
+  /// bumps (else held at `start`'s).
+  bool first_start = false;
   /// The wheel noise of the repeated runs' scatter [m] (0: not measured):
   /// one more start, k at it and the bumps holding the rest of the Gaussian
   /// fit's k^2 (a mean effect the pieces' k takes in cannot reach it).

@@ -145,6 +145,7 @@ void AnnotateIntervals(DiagRun& r, int min_stand_intervals) {
   r.kick.assign(intervals, 0);
   r.swivel.assign(intervals, 0);
   r.reversal.assign(intervals, 0);
+  r.first_start.assign(intervals, 0);
   r.stop_of.assign(intervals, -1);
   r.coast_of.assign(intervals, -1);
   r.stops.clear();
@@ -171,6 +172,7 @@ void AnnotateIntervals(DiagRun& r, int min_stand_intervals) {
     if (k > 0 && m.cls != sim::MotionClass::kTurn && r.motions[k - 1].cls != sim::MotionClass::kTurn &&
         r.motions[k - 1].sign != m.sign)
       r.reversal[m.first_interval] = 1;
+    if (k == 0 && m.cls != sim::MotionClass::kTurn) r.first_start[m.first_interval] = 1;
     if (m.last_interval > m.first_interval) {
       const double t0 = IntervalTravel(r, m.first_interval), t1 = IntervalTravel(r, m.first_interval + 1);
       if (t1 > 0.0) r.window_start[m.first_interval] = static_cast<float>(1.0 - std::min(1.0, t0 / t1));

@@ -102,6 +102,10 @@ struct DiagRun {
   /// that reverses the drive direction of the one before (no spot turn
   /// between), where the swivel kicks with a random sign.
   std::vector<char> reversal;
+  /// 1 at the first interval of the run's first motion when it is a
+  /// straight or arc one (effects::NoiseTerm::kFirstStart: a heading kick
+  /// of random size where the run begins to drive).
+  std::vector<char> first_start;
   /// stop_slide: a motion that ends at a stop (the next motion starts from
   /// standstill, or none follows) with its nominal wheel speeds at the end
   /// [m/s] (over up to three full intervals before its last one) and its

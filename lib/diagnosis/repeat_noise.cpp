@@ -37,6 +37,9 @@ void AddBases(PieceBases& out, const PieceBases& B, double w) {
   out.S_theta += w * B.S_theta;
   out.T += w * B.T;
   out.K += w * B.K;
+  out.P += w * B.P;
+  out.P_xy += w * B.P_xy;
+  out.P_turn += w * B.P_turn;
   out.travel_left_m += w * B.travel_left_m;
   out.travel_right_m += w * B.travel_right_m;
 }
@@ -260,6 +263,7 @@ RepeatWheelFit FitRepeatWheelNoise(const RepeatDesign& design, const RepeatDesig
   if (o.motion_floor) terms.push_back(&PieceBases::F);
   if (o.standstill) terms.insert(terms.end(), {&PieceBases::S_xy, &PieceBases::S_theta});
   if (o.run_time) terms.push_back(&PieceBases::T);
+  if (o.first_start) terms.insert(terms.end(), {&PieceBases::P, &PieceBases::P_xy, &PieceBases::P_turn});
   const Eigen::Index m = static_cast<Eigen::Index>(terms.size());
   Eigen::MatrixXd I = Eigen::MatrixXd::Zero(m, m);
   for (std::size_t j = 0; j < rc.pieces.size(); ++j) {
@@ -296,7 +300,7 @@ RepeatNoise MeasureRepeatNoise(const CampaignData& c, const std::vector<double>&
   }
   PieceNoiseFitOptions o = fit;
   o.fit_wheel_noise = true;
-  o.correlated = o.motion_floor = o.standstill = o.run_time = false;
+  o.correlated = o.motion_floor = o.standstill = o.run_time = o.first_start = false;
   NoiseParams n;  // the wheels and the ground truth only
   n.kL2 = start.kL2;
   n.kR2 = start.kR2;

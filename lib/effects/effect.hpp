@@ -59,6 +59,12 @@ enum class NoiseTerm {
   kMotionFloor,  ///< slip where motions start and stop
   kRunTime,      ///< a clock offset of each run (run blocks)
   kWheelNoise,   ///< the wheel noise k_L, k_R of a given model
+  /// A heading kick and a position slip of random size where a run's first
+  /// motion, a straight or arc one, starts, and the scatter of the heading
+  /// kick where a straight or arc motion starts after a spot turn (a mean
+  /// effect's random parts: the variances enter the pieces that hold such a
+  /// start).
+  kFirstStart,
 };
 
 /// The fitted noise, as the diagnosis' piece noise model has it (variances
@@ -71,6 +77,9 @@ struct NoiseValues {
   double floor_s2 = 0.0;   ///< start / stop slip [m^2]
   double run_tau2 = 0.0;   ///< per-run clock [s^2]
   double kL2 = 0.0, kR2 = 0.0;  ///< wheel noise [m]
+  double first_start_th2 = 0.0;  ///< heading kick at a run's first start [rad^2]
+  double first_start_xy2 = 0.0;  ///< position slip there, per robot axis [m^2]
+  double turn_start_th2 = 0.0;   ///< scatter of the heading kick after a spot turn [rad^2]
 };
 
 /// What an effect is: a property of the robot's motion (mechanism), of the

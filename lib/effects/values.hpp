@@ -68,6 +68,15 @@ struct Effects {
   double slide_arc = 0.0;
   double slide_back = 0.0;
   double swivel_kappa = 0.0;       ///< castor_swivel.kappa [rad]
+  /// castor_swivel.kappa_start [rad]: sd of the heading kick at a run's
+  /// first start (an extension beyond the contract; 0: the contract's).
+  double swivel_kappa_start = 0.0;
+  /// castor_swivel.slip_start [m]: sd of the position slip along each robot
+  /// axis at a run's first start (extension; 0: none).
+  double swivel_slip_start = 0.0;
+  /// castor_swivel.kappa_sd [rad]: sd of the kick after a spot turn around
+  /// its mean kappa (extension; 0: none).
+  double swivel_kappa_sd = 0.0;
   double yaw_delta = 0.0;      ///< gt_yaw_misalignment.delta [rad] (outside)
   double slope_g = 0.0;        ///< floor_slope.g [m/m] (outside)
   double slope_dir = 0.0;      ///< floor_slope.dir [rad] (outside)
