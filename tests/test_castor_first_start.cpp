@@ -55,7 +55,9 @@ double Sd(const std::vector<double>& v) {
   return std::sqrt(s / static_cast<double>(v.size() - 1));
 }
 
-double Mean(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()); }
+double Mean(const std::vector<double>& v) {
+  return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+}
 
 std::string CheckMessage(const std::string& spec) {
   sim::Effects e;
@@ -69,8 +71,10 @@ std::string CheckMessage(const std::string& spec) {
 
 }  // namespace
 
-TEST_CASE("castor_swivel: the first start kicks N(0 kappa_start^2) and slips N(0 slip_start^2) and the turns kicks scatter by kappa_sd",
-          "[effects][issue28]") {
+TEST_CASE(
+    "castor_swivel: the first start kicks N(0 kappa_start^2) and slips N(0 slip_start^2) and the turns kicks scatter "
+    "by kappa_sd",
+    "[effects][issue28]") {
   const double kappa = 0.01, kappa_start = 0.02, slip = 0.003, kappa_sd = 0.004;
   sim::CampaignSimOptions o = Quiet(150);
   o.effects.swivel_kappa = kappa;

@@ -139,8 +139,10 @@ class CastorSwivel final : public Effect {
   }
 
   std::string PracticalFloor(const Params& p, const CampaignScale& c) const override {
-    // Negligible only when the first start's kicks are too.
-    if (Get(p, "kappa_start") >= c.FloorRad() || Get(p, "kappa_sd") >= c.FloorRad() || Get(p, "slip_start") >= c.FloorM()) return {};
+    // Negligible only when its random parts are too.
+    if (Get(p, "kappa_start") >= c.FloorRad() || Get(p, "kappa_sd") >= c.FloorRad() ||
+        Get(p, "slip_start") >= c.FloorM())
+      return {};
     return HeadingJumpFloor(p, c, "kappa");
   }
 
@@ -167,13 +169,12 @@ class CastorSwivel final : public Effect {
   std::string ConcreteChange(const Params& p, const AdviceContext& /*c*/) const override {
     // The first start's part is stated when it is at least 0.5 mrad or 0.5
     // mm (the default practical floor's size).
-    const double start = Get(p, "kappa_start"), slip = Get(p, "slip_start");
+    const double start = Get(p, "kappa_start"), slip = Get(p, "slip_start"), sd = Get(p, "kappa_sd");
     const bool first = start >= 5e-4 || slip >= 5e-4;
     return fmt::format("Swivel castor: after a spot turn the heading jumps by {:.1f} mrad (with the turn's sign) at "
                        "the next start{}{}. A castor with less trail or play, or a short straight creep after turns{}.",
                        1e3 * Get(p, "kappa"),
-                       Get(p, "kappa_sd") >= 5e-4 ? fmt::format(" (scattering by {:.1f} mrad sd)", 1e3 * Get(p, "kappa_sd"))
-                                                  : "",
+                       sd >= 5e-4 ? fmt::format(" (scattering by {:.1f} mrad sd)", 1e3 * sd) : "",
                        first ? fmt::format(", and at each run's first start, where the castor swings from the angle "
                                            "it rested at, by a random {:.1f} mrad and {:.1f} mm (sd)",
                                            1e3 * start, 1e3 * slip)
