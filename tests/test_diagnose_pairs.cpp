@@ -167,21 +167,29 @@ TEST_CASE("diagnose pairs: time offset + 4 cm marker offset are not negligible",
   CHECK(d.verdict == d.verdict_effects.front());
 }
 
+/// A 4.7 cm marker offset, (40, -25) mm, beside a 1.5 % scale error on a
+/// robot with the given E_d, E_b (wheel noise 5e-4 m^1/2).
+namespace {
+Standard MarkerAndScale(double E_d, double E_b, std::uint64_t seed) {
+  Standard s = MakeStandard(0.30, 0.10, 4096, 3.0, 3.0, GroundTruthNoise{2.5e-4, 1.0e-3}, seed);
+  s.sim.truth.E_d = E_d;
+  s.sim.truth.E_b = E_b;
+  s.sim.truth.k_L = 5e-4;
+  s.sim.truth.k_R = 5e-4;
+  s.sim.effects.scale_s = 0.015;
+  s.sim.effects.gt_dx = 0.04;
+  s.sim.effects.gt_dy = -0.025;
+  return s;
+}
+}  // namespace
+
 TEST_CASE("diagnose pairs: the advice's wheelbase is the explained model's, not the baseline's",
           "[diagnose][pairs][advice]") {
   // A 4.7 cm marker offset beside a 1.5 % scale error, both named. The
   // scale error's concrete change gives the wheelbase E_b b with E_b of the
   // explained model (fitted jointly with both effects, AdviceOf), which is
   // the simulated 0.98 within 0.5 %; the text states that value.
-  Standard s = MakeStandard(0.30, 0.10, 4096, 3.0, 3.0, GroundTruthNoise{2.5e-4, 1.0e-3}, 28015);
-  s.sim.truth.E_d = 1.002;
-  s.sim.truth.E_b = 0.98;
-  s.sim.truth.k_L = 5e-4;
-  s.sim.truth.k_R = 5e-4;
-  s.sim.effects.scale_s = 0.015;
-  s.sim.effects.gt_dx = 0.04;
-  s.sim.effects.gt_dy = -0.025;
-  const DiagnoseSummary d = Run(s);
+  const DiagnoseSummary d = Run(MarkerAndScale(1.002, 0.98, 28015));
   INFO(d.verdict_reason);
   REQUIRE(Named(d, "scale_error"));
   REQUIRE(Named(d, "gt_offset"));
@@ -205,13 +213,7 @@ TEST_CASE("diagnose pairs: how many more runs determine E_b is said of the expla
   // within what these runs determine, so the record-more sentence (planning,
   // RecordMoreMessage) states that correction (to its three digits) and says
   // it is not determined, never the baseline's.
-  Standard s = MakeStandard(0.30, 0.10, 4096, 3.0, 3.0, GroundTruthNoise{2.5e-4, 1.0e-3}, 28016);
-  s.sim.truth.k_L = 5e-4;
-  s.sim.truth.k_R = 5e-4;
-  s.sim.effects.scale_s = 0.015;
-  s.sim.effects.gt_dx = 0.04;
-  s.sim.effects.gt_dy = -0.025;
-  const DiagnoseSummary d = Run(s);
+  const DiagnoseSummary d = Run(MarkerAndScale(1.0, 1.0, 28016));
   INFO(d.verdict_reason);
   REQUIRE(Named(d, "gt_offset"));
   INFO("baseline E_b " << d.baseline.E_b << ", explained " << d.explained_E_b);
