@@ -154,7 +154,9 @@ std::string ConcreteChange(const ExplanationStep& step, const CampaignData& c, c
 // The steps follow the verdict. For `unexplained` they start from the data
 // (the largest discrepancy and where it lies), then the campaign's design
 // (what is missing to separate effects), then the symptoms (impossible
-// fits), then the partial explanation.
+// fits), then the partial explanation. Longer than 80 lines (94) on
+// purpose: the steps are one list in the order a user acts on them, and
+// each branch only chooses which sentence comes next.
 std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSummary& s) {
   std::vector<std::string> out;
   if (s.verdict == "none") {

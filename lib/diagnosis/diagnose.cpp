@@ -536,7 +536,7 @@ DiagnoseSummary WithoutFaultyRuns(const CampaignData& rest, const DiagnoseOption
 }
 
 // The diagnosis as its numbered stages, each a call into its own file. It is
-// 111 lines long because each stage's options are filled from DiagnoseOptions here,
+// 112 lines long because each stage's options are filled from DiagnoseOptions here,
 // in place, so that every route of a user's option is visible in one place.
 DiagnoseSummary DiagnoseCampaign(const CampaignData& recorded, const DiagnoseOptions& options, bool scan_faults) {
   DiagnoseSummary out;
