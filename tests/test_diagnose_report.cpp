@@ -227,6 +227,15 @@ TEST_CASE("diagnose --plot/--report: residuals per experiment with band, the lar
   CHECK(html.find("The largest piece residuals") != std::string::npos);
   CHECK(html.find("What to do next") != std::string::npos);
   CHECK(html.find("umbmark simulate") != std::string::npos);
+  // The verdict's reason follows as a sentence; an effect's name keeps its
+  // contract spelling.
+  const std::string reason = j["verdict"]["reason"].get<std::string>();
+  const std::string verdict = j["verdict"]["effect"].get<std::string>();
+  INFO(reason);
+  if (reason.starts_with(verdict)) {
+    CHECK(html.find(". " + reason.substr(0, 40)) != std::string::npos);
+  }
+  CHECK(html.find("Castor_kick") == std::string::npos);
   // What the explained model leaves: the JSON's remaining_where, tabled with
   // the same sizes (one decimal) and the G left.
   const auto& left = j["verdict"]["remaining_where"];

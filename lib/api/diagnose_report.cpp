@@ -234,9 +234,12 @@ std::string PText(double p) {
 
 /// The verdict's reason as a sentence after another: its first letter in
 /// upper case (the reason starts in lower case: it follows "verdict: ..."
-/// in the text report).
+/// in the text report), unless it starts with a name (an effect's, such as
+/// castor_kick, which is written as the contract spells it).
 std::string Sentence(std::string s) {
-  if (!s.empty() && s[0] >= 'a' && s[0] <= 'z') s[0] = static_cast<char>(s[0] - 'a' + 'A');
+  const std::string first = s.substr(0, s.find(' '));
+  if (!s.empty() && s[0] >= 'a' && s[0] <= 'z' && first.find('_') == std::string::npos)
+    s[0] = static_cast<char>(s[0] - 'a' + 'A');
   return s;
 }
 
