@@ -22,6 +22,7 @@
 #include "simulation/campaign_sim.hpp"
 #include "simulation/effects.hpp"
 #include "support/diag_campaign.hpp"
+#include "support/effect_campaign.hpp"
 
 using namespace umbmark;
 using Catch::Matchers::WithinAbs;
@@ -30,23 +31,6 @@ using Catch::Matchers::WithinRel;
 namespace {
 
 constexpr double kSide = 2.0;  // square side [m]
-
-Manifest Campaign() {
-  RobotParams r;
-  r.wheelbase_m = 0.4;
-  r.wheel_diameter_left_m = r.wheel_diameter_right_m = 0.1;
-  return sim::StandardCampaignManifest(r, kSide, kSide, GroundTruthNoise{0.0, 0.0});
-}
-
-/// Noise-free squares: k = 0, no ground-truth noise, wheel travel as distances.
-sim::CampaignSimOptions Quiet(int runs) {
-  sim::CampaignSimOptions o;
-  o.truth.k_L = o.truth.k_R = 0.0;
-  o.square_runs_per_direction = runs;
-  o.back_and_forth_runs = 1;
-  o.ground_truth = GroundTruthNoise{0.0, 0.0};
-  return o;
-}
 
 double Sd(const std::vector<double>& v) {
   const double m = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
@@ -59,16 +43,6 @@ double Mean(const std::vector<double>& v) {
   return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
 }
 
-std::string CheckMessage(const std::string& spec) {
-  sim::Effects e;
-  try {
-    sim::ParseEffectSpec(spec, e);
-  } catch (const InvalidOptions& x) {
-    return x.what();
-  }
-  return {};
-}
-
 }  // namespace
 
 TEST_CASE(
@@ -76,11 +50,11 @@ TEST_CASE(
     "by kappa_sd",
     "[effects][issue28]") {
   const double kappa = 0.01, kappa_start = 0.02, slip = 0.003, kappa_sd = 0.004;
-  sim::CampaignSimOptions o = Quiet(150);
+  sim::CampaignSimOptions o = testing::QuietOptions(150, 1);
   o.effects.swivel_kappa = kappa;
   o.effects.swivel_kappa_start = kappa_start;
   o.effects.swivel_slip_start = slip;
-  const sim::SimulatedCampaign c = sim::SimulateCampaign(Campaign(), o);
+  const sim::SimulatedCampaign c = sim::SimulateCampaign(testing::QuietManifest(0.4, kSide, kSide), o);
   const auto& runs = std::get<TrajectoryData>(c.data[0]).runs;
   REQUIRE(runs.size() == 300);
   std::vector<double> kick, along, left;
@@ -112,10 +86,10 @@ TEST_CASE(
 
   // kappa_sd: each square's three kicks after turns scatter around kappa
   // (kappa_start off: the final heading holds their sum alone).
-  sim::CampaignSimOptions t = Quiet(100);
+  sim::CampaignSimOptions t = testing::QuietOptions(100, 1);
   t.effects.swivel_kappa = kappa;
   t.effects.swivel_kappa_sd = kappa_sd;
-  const sim::SimulatedCampaign ct = sim::SimulateCampaign(Campaign(), t);
+  const sim::SimulatedCampaign ct = sim::SimulateCampaign(testing::QuietManifest(0.4, kSide, kSide), t);
   std::vector<double> sum3;
   for (const auto& run : std::get<TrajectoryData>(ct.data[0]).runs) {
     const double sign = run.direction == "cw" ? -1.0 : 1.0;
@@ -127,12 +101,12 @@ TEST_CASE(
 }
 
 TEST_CASE("castor_swivel: its random parts' ranges are checked", "[effects][issue28]") {
-  CHECK(CheckMessage("castor_swivel:kappa=0.01,kappa_start=-0.01").find("castor_swivel.kappa_start = -0.01 must be in "
+  CHECK(testing::EffectSpecError("castor_swivel:kappa=0.01,kappa_start=-0.01").find("castor_swivel.kappa_start = -0.01 must be in "
                                                                         "[0, 0.5] rad") != std::string::npos);
-  CHECK(CheckMessage("castor_swivel:kappa=0.01,slip_start=0.2").find("castor_swivel.slip_start = 0.2 must be in [0, "
+  CHECK(testing::EffectSpecError("castor_swivel:kappa=0.01,slip_start=0.2").find("castor_swivel.slip_start = 0.2 must be in [0, "
                                                                      "0.1] m") != std::string::npos);
-  CHECK(CheckMessage("castor_swivel:kappa=0.01,kappa_sd=nan").find("must be in") != std::string::npos);
-  CHECK(CheckMessage("castor_swivel:kappa=0.01,kappa_start=0.03,slip_start=0.002,kappa_sd=0.003").empty());
+  CHECK(testing::EffectSpecError("castor_swivel:kappa=0.01,kappa_sd=nan").find("must be in") != std::string::npos);
+  CHECK(testing::EffectSpecError("castor_swivel:kappa=0.01,kappa_start=0.03,slip_start=0.002,kappa_sd=0.003").empty());
 }
 
 TEST_CASE("diagnose: castor_swivel's kappa and its random parts are recovered with wheel noise", "[diagnose][issue28]") {

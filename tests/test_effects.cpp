@@ -11,6 +11,7 @@
 #include "simulation/campaign_sim.hpp"
 #include "simulation/effects.hpp"
 #include "simulation/effects_motion.hpp"
+#include "support/effect_campaign.hpp"
 
 using namespace umbmark;
 using namespace umbmark::sim;
@@ -40,16 +41,6 @@ Manifest Campaign(bool ticks, bool square = true, bool back_and_forth = true) {
       keep.push_back(e);
   m.experiments = keep;
   return m;
-}
-
-/// Noise-free options: k = 0, no ground-truth noise, few runs.
-CampaignSimOptions Quiet(int runs = 2) {
-  CampaignSimOptions o;
-  o.truth.k_L = o.truth.k_R = 0.0;
-  o.square_runs_per_direction = runs;
-  o.back_and_forth_runs = runs;
-  o.ground_truth = GroundTruthNoise{0.0, 0.0};
-  return o;
 }
 
 const TrajectoryData& Traj(const SimulatedCampaign& c, std::size_t e) { return std::get<TrajectoryData>(c.data[e]); }
@@ -109,7 +100,7 @@ TEST_CASE("effects: spec parsing round-trips and rejects bad specs", "[effects]"
 }
 
 TEST_CASE("simulate: nominal robot, no noise: ground truth follows the commanded path", "[effects]") {
-  const CampaignSimOptions o = Quiet();
+  const CampaignSimOptions o = testing::QuietOptions(2, 2);
   const SimulatedCampaign c = SimulateCampaign(Campaign(false), o);
   for (const auto& run : Traj(c, 0).runs) {
     const Pose2 end = Last(run);
@@ -126,7 +117,7 @@ TEST_CASE("simulate: nominal robot, no noise: ground truth follows the commanded
 
 TEST_CASE("simulate: true robot is c_L D_L, c_R D_R, E_b b (contract's E_d, E_b)", "[effects]") {
   const double E_d = 1.003, E_b = 1.015;
-  CampaignSimOptions o = Quiet();
+  CampaignSimOptions o = testing::QuietOptions(2, 2);
   o.truth.E_d = E_d;
   o.truth.E_b = E_b;
   const SimulatedCampaign c = SimulateCampaign(Campaign(false), o);
@@ -154,7 +145,7 @@ TEST_CASE("simulate: true robot is c_L D_L, c_R D_R, E_b b (contract's E_d, E_b)
 }
 
 TEST_CASE("scale_error: legs are (1 + s) longer, back-and-forth returns to the start", "[effects]") {
-  CampaignSimOptions o = Quiet();
+  CampaignSimOptions o = testing::QuietOptions(2, 2);
   o.effects.scale_s = 0.02;
   const SimulatedCampaign c = SimulateCampaign(Campaign(false), o);
   for (const auto& run : Traj(c, 1).runs) {
@@ -172,11 +163,11 @@ TEST_CASE("scale_error: legs are (1 + s) longer, back-and-forth returns to the s
 
 TEST_CASE("turn_scrub: CW and CCW shift alike (as a wheelbase error), straight runs untouched", "[effects]") {
   const double k = 0.04;
-  CampaignSimOptions scrub = Quiet();
+  CampaignSimOptions scrub = testing::QuietOptions(2, 2);
   scrub.effects.scrub_k = k;
-  CampaignSimOptions wheelbase = Quiet();
+  CampaignSimOptions wheelbase = testing::QuietOptions(2, 2);
   wheelbase.truth.E_b = 1.0 / (1.0 - k);
-  CampaignSimOptions plain = Quiet();
+  CampaignSimOptions plain = testing::QuietOptions(2, 2);
   // Distance mode: with encoder ticks the legs' one-tick wheel differences
   // would turn by a slightly different amount under the two wheelbases.
   const SimulatedCampaign a = SimulateCampaign(Campaign(false), scrub);
@@ -205,7 +196,7 @@ TEST_CASE("turn_scrub: CW and CCW shift alike (as a wheelbase error), straight r
 
 TEST_CASE("direction_asymmetry: backward travel is (1 + a) longer", "[effects]") {
   const double a = 0.03;
-  CampaignSimOptions o = Quiet();
+  CampaignSimOptions o = testing::QuietOptions(2, 2);
   o.effects.asymmetry_a = a;
   const SimulatedCampaign c = SimulateCampaign(Campaign(false), o);
   for (const auto& run : Traj(c, 1).runs) {
@@ -230,7 +221,7 @@ TEST_CASE("direction_asymmetry: backward travel is (1 + a) longer", "[effects]")
 
 TEST_CASE("castor_kick: heading jumps at every start from standstill, not at spot turns", "[effects]") {
   const double kappa = 0.01;
-  CampaignSimOptions o = Quiet();
+  CampaignSimOptions o = testing::QuietOptions(2, 2);
   o.effects.castor_kappa = kappa;
   const SimulatedCampaign c = SimulateCampaign(Campaign(false), o);
   for (const auto& run : Traj(c, 1).runs) {
@@ -249,7 +240,7 @@ TEST_CASE("castor_kick: heading jumps at every start from standstill, not at spo
 
 TEST_CASE("parameter_drift: the right diameter grows by r per run, across experiments", "[effects]") {
   const double r = 2e-4;
-  CampaignSimOptions o = Quiet(3);
+  CampaignSimOptions o = testing::QuietOptions(3, 3);
   o.effects.drift_r = r;
   const SimulatedCampaign c = SimulateCampaign(Campaign(false), o);
   // Back-and-forth is experiment 2: its runs are campaign runs 6, 7, 8.
@@ -264,7 +255,7 @@ TEST_CASE("parameter_drift: the right diameter grows by r per run, across experi
 
 TEST_CASE("gt_offset: ground truth reports a point of the robot frame", "[effects]") {
   const double dx = 0.03, dy = -0.02;
-  CampaignSimOptions o = Quiet();
+  CampaignSimOptions o = testing::QuietOptions(2, 2);
   o.effects.gt_dx = dx;
   o.effects.gt_dy = dy;
   const SimulatedCampaign c = SimulateCampaign(Campaign(false, true, false), o);
@@ -282,10 +273,10 @@ TEST_CASE("gt_offset: ground truth reports a point of the robot frame", "[effect
 }
 
 TEST_CASE("time_offset: a sample stamped t shows the pose at t - tau", "[effects]") {
-  CampaignSimOptions o = Quiet();
+  CampaignSimOptions o = testing::QuietOptions(2, 2);
   o.effects.time_tau = 0.1;  // two samples at 20 Hz
   const SimulatedCampaign c = SimulateCampaign(Campaign(false), o);
-  const SimulatedCampaign ref = SimulateCampaign(Campaign(false), Quiet());
+  const SimulatedCampaign ref = SimulateCampaign(Campaign(false), testing::QuietOptions(2, 2));
   for (std::size_t e = 0; e < 2; ++e) {
     const auto& run = Traj(c, e).runs[0];
     const auto& base = Traj(ref, e).runs[0];
@@ -300,7 +291,7 @@ TEST_CASE("time_offset: a sample stamped t shows the pose at t - tau", "[effects
 }
 
 TEST_CASE("bump_outliers: Poisson count per metre, N(0, sigma^2) per bump", "[effects]") {
-  CampaignSimOptions o = Quiet(400);
+  CampaignSimOptions o = testing::QuietOptions(400, 400);
   o.effects.bump_rate = 0.5;
   o.effects.bump_sigma = 0.004;
   o.seed = 7;
@@ -325,7 +316,7 @@ TEST_CASE("correlated_noise: along-track and heading variances follow rho", "[ef
   // Var(heading) = (k_L^2 + k_R^2 - 2 rho k_L k_R) D / b^2 (eq. 4 with
   // correlated wheel errors). 300 runs: sample variances within ~25 %.
   for (double rho : {0.8, -0.6}) {
-    CampaignSimOptions o = Quiet(300);
+    CampaignSimOptions o = testing::QuietOptions(300, 300);
     o.truth.k_L = 0.004;
     o.truth.k_R = 0.006;
     o.effects.noise_rho = rho;
@@ -349,7 +340,7 @@ TEST_CASE("correlated_noise: along-track and heading variances follow rho", "[ef
 }
 
 TEST_CASE("outside effects: gt_yaw_misalignment and floor_slope", "[effects]") {
-  CampaignSimOptions o = Quiet();
+  CampaignSimOptions o = testing::QuietOptions(2, 2);
   o.effects.yaw_delta = 0.02;
   o.effects.slope_g = 0.01;
   o.effects.slope_dir = kPi / 2.0;  // slides towards +y of the start frame
@@ -399,7 +390,7 @@ TEST_CASE("motion segmentation: back-to-back legs, turns and reversals are separ
 }
 
 TEST_CASE("simulate: encoder ticks are whole counts of true rotation; controller stops on the target", "[effects]") {
-  CampaignSimOptions o = Quiet();
+  CampaignSimOptions o = testing::QuietOptions(2, 2);
   o.truth.E_d = 1.01;  // true diameters differ from nominal: counts are the nominal ones
   const SimulatedCampaign c = SimulateCampaign(Campaign(true, false, true), o);
   const RobotParams robot = Robot(true);
@@ -418,7 +409,7 @@ TEST_CASE("castor_kick: no kick between motions back to back (no standstill), on
   // run's first motion starts from standstill; a leg right after a spot
   // turn, or a reversal without a pause, does not.
   const double kappa = 0.01;
-  CampaignSimOptions o = Quiet();
+  CampaignSimOptions o = testing::QuietOptions(2, 2);
   o.effects.castor_kappa = kappa;
   o.pause_s = 0.0;
   const SimulatedCampaign c = SimulateCampaign(Campaign(false), o);
@@ -440,7 +431,7 @@ TEST_CASE("standstill_motion: the pose moves only between a motion's end and the
   // Noise-free robot: every ground-truth change while the encoders are still
   // is the settling, drawn once per standstill (constant over it), with the
   // stated spread over many standstills.
-  CampaignSimOptions o = Quiet(20);
+  CampaignSimOptions o = testing::QuietOptions(20, 20);
   o.effects.stand_sigma_xy = 0.004;
   o.effects.stand_sigma_theta = 0.003;
   const SimulatedCampaign c = SimulateCampaign(Campaign(true), o);
@@ -472,7 +463,7 @@ TEST_CASE("standstill_motion: the pose moves only between a motion's end and the
 }
 
 TEST_CASE("run_time_offset: each run's ground truth lags by its own tau_i", "[effects]") {
-  CampaignSimOptions o = Quiet(10);
+  CampaignSimOptions o = testing::QuietOptions(10, 10);
   o.effects.run_tau_sd = 0.05;
   CampaignSimOptions plain = o;
   plain.effects.run_tau_sd = 0.0;

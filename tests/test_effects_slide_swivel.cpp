@@ -19,6 +19,7 @@
 #include "simulation/campaign_sim.hpp"
 #include "simulation/effects.hpp"
 #include "support/diag_campaign.hpp"
+#include "support/effect_campaign.hpp"
 #include "support/run_cli.hpp"
 
 using namespace umbmark;
@@ -30,23 +31,6 @@ namespace {
 constexpr double kB = 0.4;     // nominal wheelbase [m]
 constexpr double kSide = 2.0;  // square side [m]
 constexpr double kDist = 2.0;  // back-and-forth distance [m]
-
-Manifest Campaign() {
-  RobotParams r;
-  r.wheelbase_m = kB;
-  r.wheel_diameter_left_m = r.wheel_diameter_right_m = 0.1;
-  return sim::StandardCampaignManifest(r, kSide, kDist, GroundTruthNoise{0.0, 0.0});
-}
-
-/// Noise-free: k = 0, no ground-truth noise, wheel travel as distances.
-sim::CampaignSimOptions Quiet(int runs) {
-  sim::CampaignSimOptions o;
-  o.truth.k_L = o.truth.k_R = 0.0;
-  o.square_runs_per_direction = runs;
-  o.back_and_forth_runs = runs;
-  o.ground_truth = GroundTruthNoise{0.0, 0.0};
-  return o;
-}
 
 const TrajectoryData& Traj(const sim::SimulatedCampaign& c, std::size_t e) {
   return std::get<TrajectoryData>(c.data[e]);
@@ -60,16 +44,6 @@ Pose2 AtOrBefore(const TrajectoryRun& r, double t) {
   for (std::size_t i = 0; i < r.size(); ++i)
     if (r.t_s[i] <= t + 1e-9) best = i;
   return r.GroundTruth(best);
-}
-
-std::string CheckMessage(const std::string& spec) {
-  sim::Effects e;
-  try {
-    sim::ParseEffectSpec(spec, e);
-  } catch (const InvalidOptions& x) {
-    return x.what();
-  }
-  return {};
 }
 
 const diag::Candidate* Find(const diag::DiagnoseSummary& s, sim::EffectKind k) {
@@ -121,10 +95,10 @@ diag::DiagnoseOptions Fast() {
 TEST_CASE("stop_slide: the chassis coasts d v^2 after a leg and a w^2 after a spot turn, only at stops",
           "[effects][issue21]") {
   const double d = 0.05, a = 0.02;
-  sim::CampaignSimOptions o = Quiet(2);
+  sim::CampaignSimOptions o = testing::QuietOptions(2, 2);
   o.effects.slide_d = d;
   o.effects.slide_a = a;
-  const sim::SimulatedCampaign c = sim::SimulateCampaign(Campaign(), o);
+  const sim::SimulatedCampaign c = sim::SimulateCampaign(testing::QuietManifest(kB, kSide, kDist), o);
   const double v = o.speed_m_s, w = o.turn_rate_rad_s;
   for (const auto& run : Traj(c, 1).runs) {
     // While the robot drives out, nothing slides (unlike a clock offset).
@@ -152,9 +126,9 @@ TEST_CASE("stop_slide: the chassis coasts d v^2 after a leg and a w^2 after a sp
 
 TEST_CASE("castor_swivel: kicks with the preceding turn's sign, a random sign after a reversal", "[effects][issue21]") {
   const double kappa = 0.01;
-  sim::CampaignSimOptions o = Quiet(10);
+  sim::CampaignSimOptions o = testing::QuietOptions(10, 10);
   o.effects.swivel_kappa = kappa;
-  const sim::SimulatedCampaign c = sim::SimulateCampaign(Campaign(), o);
+  const sim::SimulatedCampaign c = sim::SimulateCampaign(testing::QuietManifest(kB, kSide, kDist), o);
   for (const auto& run : Traj(c, 0).runs) {
     // Legs 2-4 follow a spot turn: three kicks with the turn's sign; the
     // first leg (from the run's start, no turn before it) does not kick.
@@ -178,19 +152,19 @@ TEST_CASE("castor_swivel: kicks with the preceding turn's sign, a random sign af
 }
 
 TEST_CASE("stop_slide, castor_swivel: bad parameters are refused with the allowed range", "[effects][issue21]") {
-  CHECK(CheckMessage("stop_slide:d=-1").find("[0, 1] s^2/m") != std::string::npos);
-  CHECK(CheckMessage("stop_slide:d=0.05,a=2").find("stop_slide.a = 2 must be in [0, 1] s^2/rad") != std::string::npos);
-  CHECK(CheckMessage("stop_slide:d=nan").find("not a finite number; must be in [0, 1] s^2/m") != std::string::npos);
-  CHECK(CheckMessage("castor_swivel:kappa=0.6").find("[-0.5, 0.5] rad") != std::string::npos);
-  CHECK(CheckMessage("castor_swivel:kappa=inf").find("must be in [-0.5, 0.5] rad") != std::string::npos);
-  CHECK(CheckMessage("castor_swivel:kappa=0.5").empty());
-  CHECK(CheckMessage("stop_slide:d=0.06,a=0.01").empty());
+  CHECK(testing::EffectSpecError("stop_slide:d=-1").find("[0, 1] s^2/m") != std::string::npos);
+  CHECK(testing::EffectSpecError("stop_slide:d=0.05,a=2").find("stop_slide.a = 2 must be in [0, 1] s^2/rad") != std::string::npos);
+  CHECK(testing::EffectSpecError("stop_slide:d=nan").find("not a finite number; must be in [0, 1] s^2/m") != std::string::npos);
+  CHECK(testing::EffectSpecError("castor_swivel:kappa=0.6").find("[-0.5, 0.5] rad") != std::string::npos);
+  CHECK(testing::EffectSpecError("castor_swivel:kappa=inf").find("must be in [-0.5, 0.5] rad") != std::string::npos);
+  CHECK(testing::EffectSpecError("castor_swivel:kappa=0.5").empty());
+  CHECK(testing::EffectSpecError("stop_slide:d=0.06,a=0.01").empty());
   // Its shape (beyond the contract; 0 by default).
-  CHECK(CheckMessage("stop_slide:d=0.06,arc=-1").find("stop_slide.arc = -1 must be in [0, 4]") != std::string::npos);
-  CHECK(CheckMessage("stop_slide:d=0.06,arc=nan").find("must be in [0, 4]") != std::string::npos);
-  CHECK(CheckMessage("stop_slide:d=0.06,back=-1").find("stop_slide.back = -1 must be in [-0.9, 4]") !=
+  CHECK(testing::EffectSpecError("stop_slide:d=0.06,arc=-1").find("stop_slide.arc = -1 must be in [0, 4]") != std::string::npos);
+  CHECK(testing::EffectSpecError("stop_slide:d=0.06,arc=nan").find("must be in [0, 4]") != std::string::npos);
+  CHECK(testing::EffectSpecError("stop_slide:d=0.06,back=-1").find("stop_slide.back = -1 must be in [-0.9, 4]") !=
         std::string::npos);
-  CHECK(CheckMessage("stop_slide:d=0.06,a=0.01,arc=2,back=0.4").empty());
+  CHECK(testing::EffectSpecError("stop_slide:d=0.06,a=0.01,arc=2,back=0.4").empty());
 
   using testing::Q;
   const auto dir = testing::TempDir("slide-cli");

@@ -6,9 +6,12 @@
 #include <catch2/catch.hpp>
 
 #include <cstdint>
+#include <string>
 #include <variant>
 
+#include "core/errors.hpp"
 #include "simulation/campaign_sim.hpp"
+#include "simulation/effects.hpp"
 
 namespace umbmark::testing {
 
@@ -30,6 +33,37 @@ inline NoiseFreeCampaign MakeNoiseFreeCampaign(std::uint64_t seed) {
   c.options.truth.k_L = c.options.truth.k_R = 0.0;
   c.manifest = sim::StandardCampaignManifest(c.robot, 1.0, c.leg_m, GroundTruthNoise{});
   return c;
+}
+
+/// Noise-free simulation options: k = 0, no ground-truth noise, so wheel
+/// travel equals distance and an effect's closed form holds exactly.
+inline sim::CampaignSimOptions QuietOptions(int square_runs_per_direction, int back_and_forth_runs) {
+  sim::CampaignSimOptions o;
+  o.truth.k_L = o.truth.k_R = 0.0;
+  o.square_runs_per_direction = square_runs_per_direction;
+  o.back_and_forth_runs = back_and_forth_runs;
+  o.ground_truth = GroundTruthNoise{0.0, 0.0};
+  return o;
+}
+
+/// A square campaign without ground-truth noise: wheelbase `b`, 0.1 m
+/// wheels, squares of `side` and back-and-forth legs of `leg` [m].
+inline Manifest QuietManifest(double b, double side, double leg) {
+  RobotParams r;
+  r.wheelbase_m = b;
+  r.wheel_diameter_left_m = r.wheel_diameter_right_m = 0.1;
+  return sim::StandardCampaignManifest(r, side, leg, GroundTruthNoise{0.0, 0.0});
+}
+
+/// The message an effect specification is refused with ("" when accepted).
+inline std::string EffectSpecError(const std::string& spec) {
+  sim::Effects e;
+  try {
+    sim::ParseEffectSpec(spec, e);
+  } catch (const InvalidOptions& x) {
+    return x.what();
+  }
+  return {};
 }
 
 inline const TrajectoryRun& FirstBackAndForthRun(const sim::SimulatedCampaign& c) {
