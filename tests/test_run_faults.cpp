@@ -150,3 +150,43 @@ TEST_CASE("run faults: the campaign without a run", "[run-faults]") {
   const auto& runs1 = std::visit([](const auto& d) { return d.runs.size(); }, r.files[0]);
   CHECK(runs1 == runs0 - 1);
 }
+
+TEST_CASE("run faults: one run pushed 8 mm while it stands is named as an event and left out", "[run-faults]") {
+  testing::SmallCampaign s = testing::MakeSmallCampaign(57, 5, 10);
+  s.sim.sample_rate_hz = 20.0;
+  sim::SimulatedCampaign sc = sim::SimulateCampaign(s.manifest, s.sim);
+  // Square experiment, third run: from the middle of its third standstill on,
+  // the ground truth is 8 mm further along x (a push while the robot stands).
+  TrajectoryRun& r = std::get<TrajectoryData>(sc.data[0]).runs[2];
+  std::vector<std::size_t> still;
+  for (std::size_t i = 1; i < r.size(); ++i)
+    if (r.ticks_left[i] == r.ticks_left[i - 1] && r.ticks_right[i] == r.ticks_right[i - 1]) still.push_back(i);
+  REQUIRE(still.size() > 40);
+  // A sample in the middle of the standstills, away from their ends.
+  const std::size_t at = still[still.size() / 2];
+  for (std::size_t i = at; i < r.size(); ++i) r.gt_x_m[i] += 0.008;
+  const CampaignData c = BuildCampaign(sc.manifest, sc.data);
+  const RunFaultScan scan = Scan(c);
+  REQUIRE(scan.faults.size() == 1);
+  const RunFault& f = scan.faults.front();
+  INFO(f.what);
+  CHECK(f.experiment == 0);
+  CHECK(f.run_id == r.run);
+  CHECK(f.statistic == "event");
+  CHECK(f.z > scan.threshold_event);
+  CHECK(scan.threshold_event > 3.0);
+}
+
+TEST_CASE("run faults: bumps on every run are no event fault", "[run-faults]") {
+  // bump_outliers (rate 0.8 per metre, sigma 6 mm): every run has pieces far
+  // off, so no run's largest piece stands out of its experiment's.
+  for (std::uint64_t seed : {41, 42, 43}) {
+    testing::SmallCampaign s = testing::MakeSmallCampaign(seed, 5, 10);
+    s.sim.sample_rate_hz = 20.0;
+    s.sim.effects.bump_rate = 0.8;
+    s.sim.effects.bump_sigma = 0.006;
+    const RunFaultScan scan = Scan(testing::BuildSmallCampaign(s));
+    INFO("seed " << seed << ": " << (scan.faults.empty() ? std::string() : scan.faults.front().what));
+    CHECK(scan.faults.empty());
+  }
+}

@@ -6,12 +6,14 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 
 #include <Eigen/Dense>
 #include <fmt/format.h>
 
 #include "simulation/rng.hpp"
+#include "stats/distributions.hpp"
 
 namespace umbmark::diag {
 
@@ -31,8 +33,12 @@ namespace {
 
 /// 1.4826 MAD is the standard deviation of normal data.
 constexpr double kMadToSd = 1.482602218505602;
-/// Statistics tested per run: tau, dx, dy, scatter (the Bonferroni factor).
-constexpr int kStatistics = 4;
+/// Statistics tested per run: tau, dx, dy, scatter, event (the Bonferroni
+/// factor).
+constexpr int kStatistics = 5;
+/// The smallest tail probability an event's normal score is taken from
+/// (a chi^2 beyond about 1400 underflows; the score is then 37 sd).
+constexpr double kMinEventTail = 1e-300;
 
 double Median(std::vector<double> v) {
   if (v.empty()) return 0.0;
@@ -154,6 +160,37 @@ std::vector<RunStatistic> Scatter(const CampaignData& c, const BaselineFit& base
   for (std::size_t r = 0; r < c.runs.size(); ++r)
     if (dof[r] > 0.0 && chi2[r] > 0.0 && std::isfinite(chi2[r]))
       out[r] = {std::log(chi2[r] / dof[r]), std::sqrt(2.0 / dof[r]), true};
+  return out;
+}
+
+/// Each run's largest single piece: its chi^2 under the baseline (the
+/// piece's components' degrees of freedom) as the normal score of the
+/// maximum over the run's n pieces, u = -Phi^-1(P(max > chi^2)) with
+/// P(max > x) = 1 - (1 - Q(x))^n: N(0, 1) for every run when the model
+/// holds, whatever the run's length.
+std::vector<RunStatistic> Events(const CampaignData& c, const BaselineFit& base, std::vector<int>& piece) {
+  const std::size_t runs = c.runs.size();
+  std::vector<double> worst_tail(runs, 1.0);
+  std::vector<int> count(runs, 0);
+  piece.assign(runs, -1);
+  for (std::size_t j = 0; j < c.pieces.size(); ++j) {
+    const std::size_t r = static_cast<std::size_t>(c.pieces[j].run);
+    const int k = c.pieces[j].components;
+    if (k <= 0) continue;
+    count[r] += 1;
+    const double q = ChiSquareSurvival(Whitened(base, base.eps, j).squaredNorm(), k);
+    if (std::isfinite(q) && q < worst_tail[r]) {
+      worst_tail[r] = q;
+      piece[r] = static_cast<int>(j);
+    }
+  }
+  std::vector<RunStatistic> out(runs);
+  for (std::size_t r = 0; r < runs; ++r) {
+    if (piece[r] < 0 || count[r] < 2) continue;
+    const double p_max = -std::expm1(count[r] * std::log1p(-worst_tail[r]));
+    const double u = -NormalQuantile(std::clamp(p_max, kMinEventTail, 1.0 - 1e-16));
+    if (std::isfinite(u)) out[r] = {u, 1.0, true};
+  }
   return out;
 }
 
@@ -283,14 +320,39 @@ RunStatistics ComputeRunStatistics(const CampaignData& c, const MeanModel& model
   out.tau = ClockProfiles(c, model, base, options);
   MarkerFits(c, model, base, out);
   out.scatter = Scatter(c, base);
+  out.event = Events(c, base, out.event_piece);
   return out;
 }
 
 namespace {
 
 /// The flags of run r, with the practical floors applied.
-std::vector<Flag> FlagsOfRun(std::size_t r, const RunStatistics& st, const std::vector<double> z[4],
-                             const double thr[4], const double med[4], const RunFaultOptions& o) {
+/// The event flag of run r (its largest piece), with its practical floor:
+/// the piece moved by min_shift_m, or turned by as much at a wheel.
+std::optional<Flag> EventFlag(std::size_t r, const CampaignData& c, const BaselineFit& base, const RunStatistics& st,
+                              double z, double thr, double median, const RunFaultOptions& o) {
+  const int j = st.event_piece[r];
+  if (j < 0) return std::nullopt;
+  const std::size_t jj = static_cast<std::size_t>(j);
+  const Piece& p = c.pieces[jj];
+  const double ex = base.eps[3 * jj], ey = base.eps[3 * jj + 1], eth = p.components == 3 ? base.eps[3 * jj + 2] : 0.0;
+  const double shift = std::max(std::hypot(ex, ey), std::abs(eth) * 0.5 * c.robot.wheelbase_m);
+  if (shift < o.min_shift_m) return std::nullopt;
+  const DiagRun& run = c.runs[static_cast<std::size_t>(p.run)];
+  const double t0 = p.a < run.t.size() ? run.t[p.a] - run.t.front() : 0.0;
+  const double t1 = p.b < run.t.size() ? run.t[p.b] - run.t.front() : t0;
+  return Flag{"event",
+              fmt::format("one {} piece of it, {:.1f}-{:.1f} s into the run, leaves the model by ({:+.2f}, {:+.2f}) mm "
+                          "(along, left) and {:+.2f} mrad, {:.1f} sd where the largest piece of its experiment's median "
+                          "run is {:.1f} sd: a push, a coasting stop, a wheel slip or a ground-truth glitch at that "
+                          "moment. Look at this run there (or drop the run)",
+                          PieceTypeToString(p.type), t0, t1, 1e3 * ex, 1e3 * ey, 1e3 * eth, st.event[r].value, median),
+              z / thr, z, thr};
+}
+
+std::vector<Flag> FlagsOfRun(std::size_t r, const CampaignData& c, const BaselineFit& base, const RunStatistics& st,
+                             const std::vector<double> z[kStatistics], const double thr[kStatistics],
+                             const double med[kStatistics], const RunFaultOptions& o) {
   // med: the medians of the run's own experiment.
   std::vector<Flag> flags;
   auto over = [&](int k) { return std::isfinite(thr[k]) && std::isfinite(z[k][r]) && std::abs(z[k][r]) > thr[k]; };
@@ -320,8 +382,12 @@ std::vector<Flag> FlagsOfRun(std::size_t r, const RunStatistics& st, const std::
                                    1e3 * med[2]),
                        std::abs(z[k][r]) / thr[k], z[k][r], thr[k]});
   }
-  // A clock or marker that far off scatters the run's residuals too: the
-  // scatter is named only when neither explains the run.
+  // One piece far off (upward only) is named beside a clock or marker: a
+  // run's clock does not make a single piece stand out.
+  if (over(4) && z[4][r] > 0.0)
+    if (std::optional<Flag> f = EventFlag(r, c, base, st, z[4][r], thr[4], med[4], o)) flags.push_back(*f);
+  // A clock, a marker or an event that far off scatters the run's residuals
+  // too: the scatter is named only when none explains the run.
   if (flags.empty() && over(3) && z[3][r] > 0.0) {
     const double ratio = std::exp(st.scatter[r].value - med[3]);
     if (ratio >= o.min_scatter_ratio)
@@ -341,11 +407,11 @@ RunFaultScan FindRunFaults(const CampaignData& c, const MeanModel& model, const 
                            const RunFaultOptions& options) {
   RunFaultScan out;
   const RunStatistics st = ComputeRunStatistics(c, model, base, options);
-  const std::vector<RunStatistic>* stats[4] = {&st.tau, &st.dx, &st.dy, &st.scatter};
-  std::vector<double> z[4], med[4];
-  double thr[4];
+  const std::vector<RunStatistic>* stats[kStatistics] = {&st.tau, &st.dx, &st.dy, &st.scatter, &st.event};
+  std::vector<double> z[kStatistics], med[kStatistics];
+  double thr[kStatistics];
   const double rate = options.alpha / kStatistics;
-  for (int k = 0; k < 4; ++k) {
+  for (int k = 0; k < kStatistics; ++k) {
     const Tested t = Collect(c, *stats[k]);
     z[k] = Deviations(t, c.runs.size());
     med[k] = ExperimentMedians(c, *stats[k]);
@@ -358,21 +424,23 @@ RunFaultScan FindRunFaults(const CampaignData& c, const MeanModel& model, const 
   out.threshold_clock = std::isfinite(thr[0]) ? thr[0] : 0.0;
   out.threshold_marker = std::isfinite(thr[1]) ? thr[1] : 0.0;
   out.threshold_scatter = std::isfinite(thr[3]) ? thr[3] : 0.0;
-  if (!std::isfinite(thr[0]) && !std::isfinite(thr[1]) && !std::isfinite(thr[3])) {
+  out.threshold_event = std::isfinite(thr[4]) ? thr[4] : 0.0;
+  if (!std::isfinite(thr[0]) && !std::isfinite(thr[1]) && !std::isfinite(thr[3]) && !std::isfinite(thr[4])) {
     out.test = fmt::format("not tested: the test needs {} runs or more in experiments of 3 runs or more ({} here)",
                            options.min_runs, out.runs_tested);
     return out;
   }
   auto thr_text = [](double t) { return std::isfinite(t) ? fmt::format("{:.1f}", t) : std::string("(not tested)"); };
   out.test = fmt::format(
-      "each run's own clock offset, marker offset and residual scatter against the same quantity of the other runs of "
-      "its experiment (median per experiment, spread by the MAD pooled over experiments of 3 runs or more): a run is faulty beyond {} (clock), {} (marker), {} (scatter) robust standard "
+      "each run's own clock offset, marker offset, residual scatter and largest single piece against the same "
+      "quantity of the other runs of its experiment (median per experiment, spread by the MAD pooled over experiments "
+      "of 3 runs or more): a run is faulty beyond {} (clock), {} (marker), {} (scatter), {} (event) robust standard "
       "deviations, where normal run-to-run variation over {} runs goes in {:.0f}% of campaigns",
-      thr_text(thr[0]), thr_text(thr[1]), thr_text(thr[3]), out.runs_tested, 100.0 * options.alpha);
+      thr_text(thr[0]), thr_text(thr[1]), thr_text(thr[3]), thr_text(thr[4]), out.runs_tested, 100.0 * options.alpha);
   for (std::size_t r = 0; r < c.runs.size(); ++r) {
     const std::size_t e = static_cast<std::size_t>(c.runs[r].experiment);
-    const double m[4] = {med[0][e], med[1][e], med[2][e], med[3][e]};
-    std::vector<Flag> flags = FlagsOfRun(r, st, z, thr, m, options);
+    const double m[kStatistics] = {med[0][e], med[1][e], med[2][e], med[3][e], med[4][e]};
+    std::vector<Flag> flags = FlagsOfRun(r, c, base, st, z, thr, m, options);
     if (flags.empty()) continue;
     std::sort(flags.begin(), flags.end(), [](const Flag& a, const Flag& b) { return a.excess > b.excess; });
     RunFault f;

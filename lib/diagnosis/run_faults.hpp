@@ -13,6 +13,13 @@
 //            pieces alone, weighted least squares, linear in dx, dy);
 //   scatter  log of its mean chi^2 per residual component under the
 //            baseline (se sqrt(2 / components)).
+//   event    its largest single piece: the piece's chi^2 under the baseline
+//            as the normal score of the largest of the run's n pieces,
+//            u = -Phi^-1(1 - (1 - Q)^n), Q the chi^2 tail (se 1; N(0, 1)
+//            for every run when the model holds). One push, coasting stop,
+//            wheel slip or ground-truth glitch in one run stands out; an
+//            effect acting on many pieces (bumps, a castor's kick at every
+//            run's first start) raises every run's u and none stands out.
 // A per-run effect (run_time_offset: tau_r ~ N(mu, tau_sd^2)) makes the
 // statistic of every run vary from run to run; a fault makes one run stand
 // out of that spread. Runs of different experiments may differ by design (a
@@ -29,13 +36,15 @@
 // removed). A run is faulty when |z_r| exceeds the (1 - alpha / m) quantile
 // of max_r |z_r| over runs whose statistic is independent and normal (a
 // per-run effect's tail), by Monte Carlo with these experiments' sizes (`simulations` draws,
-// seeded), m = 4 statistics (tau, dx, dy, scatter; scatter counts only
-// upward). So a campaign with per-run clocks but no fault names a run in
+// seeded), m = 5 statistics (tau, dx, dy, scatter, event; scatter and event
+// count only upward). So a campaign with per-run clocks but no fault names a run in
 // at most a fraction alpha (default 1 %) of cases, whatever its size, and
 // the threshold is set by that rate, not between observed cases. A fault
 // must also matter in practice: a clock or marker that moves the run's
 // poses by at least `min_shift_m` (the clock at the run's median moving
-// speed), a scatter at least `min_scatter_ratio` times the campaign's.
+// speed), a scatter at least `min_scatter_ratio` times the campaign's, an
+// event that moves the piece by at least `min_shift_m` (or turns it by as
+// much at a wheel: heading x half the wheelbase).
 #pragma once
 
 #include <cstdint>
@@ -84,7 +93,8 @@ struct RunFault {
   int experiment = 0;  ///< 0-based
   std::string run_id;  ///< as in the file
   std::string what;    ///< in words, with the numbers and what to do
-  /// The statistic that stands out most: "clock", "marker" or "scatter".
+  /// The statistic that stands out most: "clock", "marker", "event" or
+  /// "scatter".
   std::string statistic;
   double z = 0.0, threshold = 0.0;
   /// The run's own clock offset [s] or marker offset [m] less the
@@ -96,7 +106,7 @@ struct RunFaultScan {
   std::vector<RunFault> faults;
   /// The threshold on |z| for each statistic (0 where not tested) and the
   /// number of runs tested.
-  double threshold_clock = 0.0, threshold_marker = 0.0, threshold_scatter = 0.0;
+  double threshold_clock = 0.0, threshold_marker = 0.0, threshold_scatter = 0.0, threshold_event = 0.0;
   int runs_tested = 0;
   std::string test;  ///< the test in one sentence, for the report
 };
@@ -120,8 +130,9 @@ double MaxDeviationThreshold(int n, double rate, int simulations, std::uint64_t 
 
 /// Per-run statistics under the baseline `base` (see the file comment).
 struct RunStatistics {
-  std::vector<RunStatistic> tau, dx, dy, scatter;
-  std::vector<double> speed;  ///< each run's median moving speed [m/s] (0: none)
+  std::vector<RunStatistic> tau, dx, dy, scatter, event;
+  std::vector<int> event_piece;  ///< the piece of each run's event (index into CampaignData::pieces; -1: none)
+  std::vector<double> speed;     ///< each run's median moving speed [m/s] (0: none)
 };
 RunStatistics ComputeRunStatistics(const CampaignData& c, const MeanModel& model, const BaselineFit& base,
                                    const RunFaultOptions& options);
