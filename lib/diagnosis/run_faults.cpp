@@ -343,8 +343,8 @@ std::optional<Flag> EventFlag(std::size_t r, const CampaignData& c, const Baseli
   const double t1 = p.b < run.t.size() ? run.t[p.b] - run.t.front() : t0;
   return Flag{"event",
               fmt::format("one {} piece of it, {:.1f}-{:.1f} s into the run, leaves the model by ({:+.2f}, {:+.2f}) mm "
-                          "(along, left) and {:+.2f} mrad, {:.1f} sd where the largest piece of its experiment's median "
-                          "run is {:.1f} sd: a push, a coasting stop, a wheel slip or a ground-truth glitch at that "
+                          "(along, left) and {:+.2f} mrad (its largest-piece score {:.1f} sd, its experiment's median run's "
+                          "{:.1f} sd): a push, a coasting stop, a wheel slip or a ground-truth glitch at that "
                           "moment. Look at this run there (or drop the run)",
                           PieceTypeToString(p.type), t0, t1, 1e3 * ex, 1e3 * ey, 1e3 * eth, st.event[r].value, median),
               z / thr, z, thr};
