@@ -41,9 +41,10 @@
 //     encoders read still for min_still_s, so there nudges and creeps are
 //     motions of their own (min_travel_m does not apply).  A one-wheel creep
 //     of a millimetre that ends 0.1 s before a leg is a forward start from
-//     standstill, and so is the leg (issue 28: with the nudge rule the kicks
-//     went to 29 of the 47 starts the contract names on session s1's
-//     squares, and a 10 mrad kick was diagnosed as 3.1 mrad).
+//     standstill, and so is the leg (issue 28: with the nudge rule session
+//     s1's squares got 29 kicks where the encoders show 54 starts from
+//     standstill, the diagnosis' model marks 46, and a 10 mrad kick came
+//     back as 2.3 mrad).
 #pragma once
 
 #include <algorithm>
