@@ -156,68 +156,6 @@ TEST_CASE("injection into real runs follows the contract's definitions", "[injec
     CHECK(jumps >= 24);  // six squares of four legs (and a few one-wheel starts of a few mm)
     CHECK(off < 1e-6);
   }
-  SECTION("castor_kick: a kick at EVERY start from standstill the encoders show, creeps included (contract)") {
-    // Issue 28: the contract's standstill is the encoders reading still (here
-    // 0.1 s, two 20 Hz intervals); every start after one that is no spot turn
-    // kicks by +-kappa. The squares' one-wheel creeps of a millimetre before a
-    // leg are such starts (the injector used to fold them into the
-    // standstill: 29 kicks where these runs hold 54 starts). Counted here
-    // from the ticks alone.
-    auto tab = recorded;
-    InjectOptions o;
-    o.effects = {ParseEffect("castor_kick:kappa=0.01")};
-    umbmark_bench::InjectTable(tab, o);
-    const auto ticks = [&](std::size_t i, int col) { return std::stod(recorded.rows[i][col]); };
-    const auto t = [&](std::size_t i) { return std::stod(recorded.rows[i][recorded.t]); };
-    const auto moves = [&](std::size_t i) {
-      return ticks(i, recorded.left) != ticks(i - 1, recorded.left) ||
-             ticks(i, recorded.right) != ticks(i - 1, recorded.right);
-    };
-    std::vector<double> expected(n, 0.0);
-    int starts = 0, creeps = 0;
-    for (std::size_t a = 0; a < n;) {
-      std::size_t e = a;
-      while (e < n && recorded.rows[e][recorded.run] == recorded.rows[a][recorded.run]) ++e;
-      // Motions of run [a, e): moving samples joined across still gaps under 0.1 s.
-      for (std::size_t i = a + 1; i < e;) {
-        if (!moves(i)) { ++i; continue; }
-        std::size_t last = i, j = i + 1;
-        while (j < e) {
-          if (moves(j)) { last = j++; continue; }
-          std::size_t k = j;
-          while (k < e && !moves(k)) ++k;
-          // As the injector reads it, to the bit: the imported clock is not
-          // exact (0.0500000000000007), so of the still gaps of exactly two
-          // intervals some reach 0.1 s and some fall short (with a 1e-9 s
-          // tolerance: 64 starts, not 54; docs/diagnosis.md).
-          if (k >= e || t(k - 1) - t(j - 1) >= 0.1) break;
-          j = k;
-        }
-        const double sL = ticks(last, recorded.left) - ticks(i - 1, recorded.left);
-        const double sR = ticks(last, recorded.right) - ticks(i - 1, recorded.right);
-        if (std::abs(sL + sR) > 0.25 * std::abs(sR - sL)) {
-          expected[i] = (sL + sR >= 0.0 ? 1.0 : -1.0) * 0.01;
-          ++starts;
-          creeps += std::max(std::abs(sL), std::abs(sR)) * kPi * 0.084 / 2796.8 < 0.002 ? 1 : 0;
-        }
-        i = last + 1;
-      }
-      a = e;
-    }
-    double worst = 0.0;
-    int kicked = 0;
-    for (std::size_t i = 1; i < n; ++i) {
-      if (recorded.rows[i][recorded.run] != recorded.rows[i - 1][recorded.run]) continue;
-      const double step = (pose(tab, i).th - pose(recorded, i).th) - (pose(tab, i - 1).th - pose(recorded, i - 1).th);
-      worst = std::max(worst, std::abs(step - expected[i]));
-      kicked += std::abs(step) > 0.005 ? 1 : 0;
-    }
-    INFO(starts << " starts from standstill, " << creeps << " of them creeps under 2 mm, " << kicked << " kicked");
-    CHECK(starts == 54);  // 24 legs and 30 creeps or splits
-    CHECK(creeps >= 20);  // measured 24: before, none of these was kicked (29 kicks)
-    CHECK(kicked == starts);
-    CHECK(worst < 1e-6);
-  }
   SECTION("scale_error and turn_scrub: legs longer by s, spot turns short by k of the wheels' travel") {
     umbmark_bench::RecordedRun run;  // run 1 of the squares
     for (std::size_t i = 0; i < n && recorded.rows[i][recorded.run] == recorded.rows[0][recorded.run]; ++i) {
@@ -247,6 +185,75 @@ TEST_CASE("injection into real runs follows the contract's definitions", "[injec
     CHECK(legs == 4);   // a square: four legs of 0.75 m and four spot turns
     CHECK(turns == 4);
   }
+}
+
+TEST_CASE("castor_kick: a kick at EVERY start from standstill the encoders show, creeps included (contract)",
+          "[inject][june]") {
+  const auto recorded = umbmark_bench::ReadTrajectory(ImportedS1()[0].string());  // the six squares
+  const std::size_t n = recorded.rows.size();
+  const auto pose = [](const umbmark_bench::TrajectoryTable& t, std::size_t i) {
+    return Pose2{std::stod(t.rows[i][t.x]), std::stod(t.rows[i][t.y]), std::stod(t.rows[i][t.th])};
+  };
+  // Issue 28: the contract's standstill is the encoders reading still (here
+  // 0.1 s, two 20 Hz intervals); every start after one that is no spot turn
+  // kicks by +-kappa. The squares' one-wheel creeps of a millimetre before a
+  // leg are such starts (the injector used to fold them into the
+  // standstill: 29 kicks where these runs hold 54 starts). Counted here
+  // from the ticks alone.
+  auto tab = recorded;
+  InjectOptions o;
+  o.effects = {ParseEffect("castor_kick:kappa=0.01")};
+  umbmark_bench::InjectTable(tab, o);
+  const auto ticks = [&](std::size_t i, int col) { return std::stod(recorded.rows[i][col]); };
+  const auto t = [&](std::size_t i) { return std::stod(recorded.rows[i][recorded.t]); };
+  const auto moves = [&](std::size_t i) {
+    return ticks(i, recorded.left) != ticks(i - 1, recorded.left) ||
+           ticks(i, recorded.right) != ticks(i - 1, recorded.right);
+  };
+  std::vector<double> expected(n, 0.0);
+  int starts = 0, creeps = 0;
+  for (std::size_t a = 0; a < n;) {
+    std::size_t e = a;
+    while (e < n && recorded.rows[e][recorded.run] == recorded.rows[a][recorded.run]) ++e;
+    // Motions of run [a, e): moving samples joined across still gaps under 0.1 s.
+    for (std::size_t i = a + 1; i < e;) {
+      if (!moves(i)) { ++i; continue; }
+      std::size_t last = i, j = i + 1;
+      while (j < e) {
+        if (moves(j)) { last = j++; continue; }
+        std::size_t k = j;
+        while (k < e && !moves(k)) ++k;
+        // As the injector reads it, to the bit: the imported clock is not
+        // exact (0.0500000000000007), so of the still gaps of exactly two
+        // intervals some reach 0.1 s and some fall short (with a 1e-9 s
+        // tolerance: 64 starts, not 54; docs/diagnosis.md).
+        if (k >= e || t(k - 1) - t(j - 1) >= 0.1) break;
+        j = k;
+      }
+      const double sL = ticks(last, recorded.left) - ticks(i - 1, recorded.left);
+      const double sR = ticks(last, recorded.right) - ticks(i - 1, recorded.right);
+      if (std::abs(sL + sR) > 0.25 * std::abs(sR - sL)) {
+        expected[i] = (sL + sR >= 0.0 ? 1.0 : -1.0) * 0.01;
+        ++starts;
+        creeps += std::max(std::abs(sL), std::abs(sR)) * kPi * 0.084 / 2796.8 < 0.002 ? 1 : 0;
+      }
+      i = last + 1;
+    }
+    a = e;
+  }
+  double worst = 0.0;
+  int kicked = 0;
+  for (std::size_t i = 1; i < n; ++i) {
+    if (recorded.rows[i][recorded.run] != recorded.rows[i - 1][recorded.run]) continue;
+    const double step = (pose(tab, i).th - pose(recorded, i).th) - (pose(tab, i - 1).th - pose(recorded, i - 1).th);
+    worst = std::max(worst, std::abs(step - expected[i]));
+    kicked += std::abs(step) > 0.005 ? 1 : 0;
+  }
+  INFO(starts << " starts from standstill, " << creeps << " of them creeps under 2 mm, " << kicked << " kicked");
+  CHECK(starts == 54);  // 24 legs and 30 creeps or splits
+  CHECK(creeps >= 20);  // measured 24: before, none of these was kicked (29 kicks)
+  CHECK(kicked == starts);
+  CHECK(worst < 1e-6);
 }
 
 TEST_CASE("diagnose names and sizes effects injected into a real session", "[diagnose][inject][june]") {
