@@ -197,6 +197,12 @@ TEST_CASE("advice: record_more is the closed form of classic UMBmark's 1/n covar
   REQUIRE(tiny.check.record_more.size() == 1);
   CHECK(tiny.check.record_more.front().extra_runs_per_direction == 0);
   CHECK(tiny.messages.front().find("keep the recorded value") != std::string::npos);
+  // Its driving time in the unit a person reads: hours past 1.5 h, minutes past 2 min.
+  const double t = tiny.check.record_more.front().time_s;
+  const std::string when = t >= 5400.0 ? fmt::format("even {:.1f} h more of driving", t / 3600.0)
+                           : t >= 120.0 ? fmt::format("even {:.0f} min more of driving", t / 60.0)
+                                        : fmt::format("even {:.0f} s more of driving", t);
+  CHECK(tiny.messages.front().find(when) != std::string::npos);
   // The recorded parameters (no correction): nothing to determine.
   CHECK(AdviseCalibration(in, in.recorded, WheelNoise{1e-3, 1e-3}).check.record_more.empty());
 }

@@ -175,6 +175,14 @@ TEST_CASE("run faults: one run pushed 8 mm while it stands is named as an event 
   CHECK(f.statistic == "event");
   CHECK(f.z > scan.threshold_event);
   CHECK(scan.threshold_event > 3.0);
+  // The diagnosis names it in plain words first and fits without it.
+  DiagnoseOptions o;
+  o.null_simulations = 100;
+  const DiagnoseSummary d = Diagnose(c, o);
+  REQUIRE(d.run_faults.size() == 1);
+  CHECK(d.run_faults.front().statistic == "event");
+  CHECK_THAT(d.summary, Catch::Matchers::Contains("one moment of it is far off the model"));
+  CHECK(d.baseline.runs == static_cast<int>(c.runs.size()) - 1);
 }
 
 TEST_CASE("run faults: bumps on every run are no event fault", "[run-faults]") {

@@ -444,7 +444,8 @@ void RunFaultTable(io::HtmlReport& rep, const nlohmann::json& j) {
     rows.push_back({fmt::format("{}", f.value("experiment", 0)), run.is_string() ? run.get<std::string>() : run.dump(),
                     f.value("what", "")});
   }
-  rep.Table({"experiment", "run", "what is wrong, what to do"}, rows);
+  // No numeric column: the text wraps (a numeric cell does not).
+  rep.Table({"experiment", "run", "what is wrong, what to do"}, rows, 3);
   rep.Paragraph("Test: " + j.value("run_fault_test", std::string()) + ".");
 }
 

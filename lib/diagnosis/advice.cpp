@@ -272,6 +272,7 @@ std::string PlainSummary(const DiagnoseSummary& s) {
       runs.push_back(fmt::format("experiment {} run {} ({})", f.experiment + 1, f.run_id,
                                  f.statistic == "clock"    ? fmt::format("its clock is {:+.0f} ms off", 1e3 * f.tau_s)
                                  : f.statistic == "marker" ? std::string("its marker moved")
+                                 : f.statistic == "event"  ? std::string("one moment of it is far off the model")
                                                            : std::string("its data scatter far more")));
     parts.push_back(fmt::format("{} faulty, not the robot: {}; fix or drop {} (left out below).",
                                 s.run_faults.size() == 1 ? "One recorded run is" : "Some recorded runs are",

@@ -39,6 +39,13 @@ std::string CheckOptions::Check() const {
 
 namespace {
 
+/// A driving time in the unit a person reads it in: s, min or h.
+std::string DrivingTime(double seconds) {
+  if (seconds >= 5400.0) return fmt::format("{:.1f} h", seconds / 3600.0);
+  if (seconds >= 120.0) return fmt::format("{:.0f} min", seconds / 60.0);
+  return fmt::format("{:.0f} s", seconds);
+}
+
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -280,7 +287,7 @@ std::string SmallestAddition(const std::vector<Addition>& candidates, int min_co
   if (!best) return "no addition of up to 20 squares, back-and-forth runs or circles separates them";
   std::string text = best->text;
   text.replace(text.find("{}"), 2, std::to_string(best_n));
-  return fmt::format("{} (about {:.0f} s of driving)", text, best_n * best->time_s);
+  return fmt::format("{} (about {} of driving)", text, DrivingTime(best_n * best->time_s));
 }
 
 }  // namespace
@@ -623,14 +630,14 @@ std::string RecordMoreMessage(const RecordMore& m) {
           : fmt::format("{}'s correction ({:+.3g} %) is known only to +-{:.3g} % (predicted 95 % half-width)",
                         m.quantity, 100.0 * m.correction, 100.0 * m.half_width);
   if (m.extra_runs_per_direction == 0)
-    return head + fmt::format("; even {:.0f} s more of {:.2f} m squares would leave +-{:.3g} %: {}", m.time_s, m.side_m,
-                              100.0 * m.half_width_after,
+    return head + fmt::format("; even {} more of driving {:.2f} m squares would leave +-{:.3g} %: {}",
+                              DrivingTime(m.time_s), m.side_m, 100.0 * m.half_width_after,
                               m.half_width_after >= std::abs(m.correction)
                                   ? "the correction is within the noise, keep the recorded value"
                                   : "it stays uncertain by more than half its size");
-  return head + fmt::format("; record {} more square run(s) of {:.2f} m in each direction (about {:.0f} s of driving) "
+  return head + fmt::format("; record {} more square run(s) of {:.2f} m in each direction (about {} of driving) "
                             "to bring it to +-{:.3g} %, half the correction or less",
-                            m.extra_runs_per_direction, m.side_m, m.time_s, 100.0 * m.half_width_after);
+                            m.extra_runs_per_direction, m.side_m, DrivingTime(m.time_s), 100.0 * m.half_width_after);
 }
 
 }  // namespace umbmark::planning
