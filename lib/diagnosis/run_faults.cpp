@@ -326,7 +326,6 @@ RunStatistics ComputeRunStatistics(const CampaignData& c, const MeanModel& model
 
 namespace {
 
-/// The flags of run r, with the practical floors applied.
 /// The event flag of run r (its largest piece), with its practical floor:
 /// the piece moved by min_shift_m, or turned by as much at a wheel.
 std::optional<Flag> EventFlag(std::size_t r, const CampaignData& c, const BaselineFit& base, const RunStatistics& st,
@@ -350,6 +349,7 @@ std::optional<Flag> EventFlag(std::size_t r, const CampaignData& c, const Baseli
               z / thr, z, thr};
 }
 
+/// The flags of run r, with the practical floors applied.
 std::vector<Flag> FlagsOfRun(std::size_t r, const CampaignData& c, const BaselineFit& base, const RunStatistics& st,
                              const std::vector<double> z[kStatistics], const double thr[kStatistics],
                              const double med[kStatistics], const RunFaultOptions& o) {
