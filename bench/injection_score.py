@@ -119,8 +119,11 @@ def score(out, sessions, injections):
             continue
         bv = base["verdict"]
         base_named = set(bv.get("effects", []))
+        # In the verdict's order: its first is the effect the agreement
+        # check compares (it was sorted by name before session 18, so that
+        # check read the alphabetically first effect).
         rows.append(dict(session=s, injection="base", effect="-", verdict=bv["effect"],
-                         effects=sorted(base_named)))
+                         effects=list(bv.get("effects", []))))
         for line in injections:
             name, effect_text = line.split("|", 1)
             effect, injected = params_of(effect_text.split()[0])

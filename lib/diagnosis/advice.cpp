@@ -149,6 +149,28 @@ effects::AdviceContext AdviceOf(const CampaignData& c, const DiagnoseSummary& s)
 std::string ConcreteChange(const ExplanationStep& step, const CampaignData& c, const DiagnoseSummary& s) {
   return effects::Of(step.effect).ConcreteChange(step.params, AdviceOf(c, s));
 }
+
+/// A named verdict that leaves a significant remainder: what the named
+/// effects close, and where to look for the rest (the explained model's
+/// largest part), so the user does not expect the gap to be gone.
+std::string RemainderStep(const DiagnoseSummary& s, const std::string& fixed) {
+  std::string where;
+  if (!s.remaining_where.empty()) {
+    const WhereItem& w = s.remaining_where.front();
+    const std::string exp = w.experiment >= 0 && w.experiment < static_cast<int>(s.experiment_labels.size())
+                                ? "experiment " + s.experiment_labels[w.experiment] + ", "
+                                : std::string();
+    where = fmt::format(" Look at it where it is largest: {}{}, the {} of the {} component ({:.1f} standard errors "
+                        "off the explained model; umbmark evaluate --report plots those runs).",
+                        exp, w.subset, StatKindToString(w.statistic), w.component, w.z);
+  }
+  return fmt::format("Model or fix {} (fitted values in the explanation table), then diagnose again: about {:.0f}% of "
+                     "the gap should be gone. The rest ({:.0f}% on held-out runs, G = {:.1f} against the null's "
+                     "{:.1f}) is significant and no listed effect describes it.{}",
+                     fixed, 100.0 * (1.0 - s.unexplained_fraction), 100.0 * s.unexplained_fraction,
+                     s.remaining_gap_score, s.null_quantile_alpha, where);
+}
+
 }  // namespace
 
 // The steps follow the verdict. For `unexplained` they start from the data
@@ -187,9 +209,14 @@ std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSu
   }
   if (s.verdict != "unexplained") {
     out.insert(out.end(), changes.begin(), changes.end());
-    out.push_back(fmt::format("Model or fix {} (fitted values in the explanation table), then diagnose again: the gap "
-                              "should be gone.", fmt::join(s.verdict_effects.empty() ? std::vector<std::string>{s.verdict}
-                                                                                     : s.verdict_effects, " and ")));
+    const std::string fixed =
+        fmt::format("{}", fmt::join(s.verdict_effects.empty() ? std::vector<std::string>{s.verdict} : s.verdict_effects,
+                                    " and "));
+    if (!s.remainder_significant)
+      out.push_back(fmt::format("Model or fix {} (fitted values in the explanation table), then diagnose again: the "
+                                "gap should be gone.", fixed));
+    else
+      out.push_back(RemainderStep(s, fixed));
     std::vector<std::string> specs;
     for (const auto& step : s.explanation) {
       // Parameter errors are not simulated effects (their fix is above);
@@ -304,6 +331,10 @@ std::string PlainSummary(const DiagnoseSummary& s) {
     if (!recording.empty())
       parts.push_back(fmt::format("{}: {}.", unexplained ? "Partly, the recording" : "The recording",
                                   fmt::join(recording, "; ")));
+    if (!unexplained && s.remainder_significant)
+      parts.push_back(fmt::format("{} {:.0f}% of the gap; the rest is something no listed effect describes.",
+                                  s.verdict_effects.size() == 1 ? "This explains" : "These explain",
+                                  100.0 * (1.0 - s.unexplained_fraction)));
   }
   if (!s.next_steps.empty()) parts.push_back("What to do first: " + s.next_steps.front());
   return fmt::format("{}", fmt::join(parts, " "));

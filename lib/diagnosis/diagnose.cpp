@@ -191,12 +191,14 @@ std::vector<const ExplanationStep*> ByEarnings(const Explanation& ex) {
 /// The verdict from the explanation (docs/diagnosis.md, "The verdict's
 /// rule"): its effects that are neither negligible nor fitted at impossible
 /// values (advice.hpp UnphysicalFit, e.g. a negative turn scrub: a symptom
-/// of something else, never a cause) are named when the explanation
-/// leaves no significant gap (G at or below the null's 1 - alpha
-/// quantile; or it closes full_shrink of the held-out gap) and,
-/// when the gap score found the gap, closes at least min_heldout_shrink of
-/// it held out, and no impossible fit outranked its first step
-/// (Explanation::symptom_first); `none` when it closes it with negligible
+/// of something else, never a cause) are named when no impossible fit
+/// outranked its first step (Explanation::symptom_first) and either the
+/// explanation closes the larger part (min_heldout_shrink) of the gap the
+/// score found on held-out runs (a significant remainder is reported
+/// beside them: remainder_significant), or it leaves no significant gap
+/// (G at or below the null's 1 - alpha quantile, or full_shrink of the
+/// held-out gap closed; when the score found the gap, at least
+/// min_heldout_shrink of it); `none` when it closes it so with negligible
 /// effects only;
 /// else `unexplained`, listing the effects that close part of it.
 /// `v`: stage 5 (significance, and the reason in terms of single fits).
@@ -230,18 +232,29 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
   // (with hundreds of runs a small one is significant), not another cause.
   const bool closed = !ex.steps.empty() && !ex.symptom_first && (!ex.gap_left || heldout >= options.full_shrink) &&
                       (!v.found_by_score || heldout >= options.min_heldout_shrink);
+  // Named effects that close the larger part of the gap the score found
+  // are the answer's larger part: they are named, and a significant
+  // remainder is reported beside them (remainder_significant), never
+  // hidden; `none` still needs the gap closed (above).
+  const bool mostly = !ex.steps.empty() && !ex.symptom_first && v.found_by_score &&
+                      heldout >= options.min_heldout_shrink;
+  out.remainder_significant = !ex.steps.empty() && ex.gap_left;
   const char* leave = named.size() == 1 ? "leaves" : "leave";
   const std::string left =
       !ex.gap_left ? fmt::format("{} no significant gap (G = {:.1f} <= {:.1f})", leave, gap_after,
                                  out.null_quantile_alpha)
-                   : fmt::format("{} G = {:.1f} > {:.1f}, less than {:.0f}% of the held-out gap (a misfit of "
-                                 "the effects' shape)",
-                                 leave, gap_after, out.null_quantile_alpha, 100.0 * (1.0 - options.full_shrink));
+      : heldout >= options.full_shrink
+          ? fmt::format("{} G = {:.1f} > {:.1f}, less than {:.0f}% of the held-out gap (a misfit of "
+                        "the effects' shape)",
+                        leave, gap_after, out.null_quantile_alpha, 100.0 * (1.0 - options.full_shrink))
+          : fmt::format("{} G = {:.1f} > {:.1f}: a significant remainder, {:.0f}% of the held-out gap, that no "
+                        "listed effect describes (where it lies: below)",
+                        leave, gap_after, out.null_quantile_alpha, 100.0 * (1.0 - heldout));
   if (closed && named.empty() && impossible.empty()) {
     out.verdict = "none";
     out.verdict_reason = fmt::format("the significant gap ({}) is closed by effects too small to matter{}",
                                      v.significance, negligible_text);
-  } else if (closed && !named.empty()) {
+  } else if ((closed || mostly) && !named.empty()) {
     out.verdict = named.front();
     out.verdict_reason = fmt::format(
         "{} {} {:.0f}% of the gap on held-out runs ({:+.1f} nats held out over the baseline) and {}; effects added "
@@ -269,7 +282,13 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
     out.verdict_reason += negligible_text;
   }
   out.verdict_effects = out.verdict == "none" ? std::vector<std::string>{} : named;
-  if (out.verdict == "none") out.unexplained_fraction = 0.0;
+  if (out.verdict == "none") out.unexplained_fraction = 0.0, out.remainder_significant = false;
+  if (out.verdict != "none" && out.verdict != "unexplained" && out.remainder_significant &&
+      heldout < options.full_shrink)
+    out.warnings.push_back(fmt::format(
+        "the verdict's effects close {:.0f}% of the gap on held-out runs; the significant remainder (G = {:.1f} > "
+        "{:.1f}) is something no listed effect describes",
+        100.0 * heldout, gap_after, out.null_quantile_alpha));
   // A weakly identifiable effect the explanation names was told apart by
   // its fits: not "hardly told apart" (stage 5 did not know the names).
   std::erase_if(out.indistinguishable, [&](const std::string& line) {

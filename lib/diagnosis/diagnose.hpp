@@ -34,10 +34,11 @@
 //  5. Verdict (verdict.hpp): `none` when p >= alpha; else the verdict is
 //     the stepwise explanation's (explanation.hpp; docs/diagnosis.md, "The
 //     verdict's rule"): effects added one at a time by held-out evidence,
-//     the first like every other; its practical effects are named when the
-//     residual G is not significant (or below 1 - full_shrink of the
-//     held-out gap) and, when G found the gap, it closes at least
-//     min_heldout_shrink of it held out; else `unexplained`. This stage
+//     the first like every other; its practical effects are named when,
+//     G having found the gap, they close at least min_heldout_shrink of it
+//     held out (a significant remainder is reported beside them), or when
+//     the residual G is not significant (or below 1 - full_shrink of the
+//     held-out gap); else `unexplained`. This stage
 //     ranks the candidates fitted alone and lists the effects the data
 //     cannot tell apart (from the baseline, or from each other).
 //
@@ -80,13 +81,16 @@ struct DiagnoseOptions {
   /// False-alarm rate: the gap is significant when p < alpha. Default 0.01.
   double alpha = 0.01;
   /// The named explanation must close at least this fraction of the gap on
-  /// held-out runs when the gap score found the gap. Default 0.5 ("most of
-  /// it").
+  /// held-out runs when the gap score found the gap; closing it, its
+  /// effects are named, and a significant remainder is reported beside
+  /// them (DiagnoseSummary::remainder_significant). Default 0.5 ("the
+  /// larger part").
   double min_heldout_shrink = 0.5;
-  /// ...and leave no significant gap (G after its last step below the
-  /// null's 1 - alpha quantile) unless its cumulative held-out shrink
-  /// reaches this (a residual under a tenth of the gap is a misfit of the
-  /// named effects' shape, not another cause). Default 0.9.
+  /// A gap closed by negligible effects only is `none` when the explanation
+  /// leaves no significant gap (G after its last step below the null's 1 -
+  /// alpha quantile) or its cumulative held-out shrink reaches this (a
+  /// residual under a tenth of the gap is a misfit of the effects' shape,
+  /// not another cause). Default 0.9.
   double full_shrink = 0.9;
   /// Held-out log-likelihood an effect must gain per parameter. Default 2 nats.
   double complexity_penalty_nats = 2.0;
@@ -227,6 +231,11 @@ struct DiagnoseSummary {
   std::vector<std::string> verdict_effects;
   /// 1 - the explanation's cumulative held-out shrink (0 for `none`).
   double unexplained_fraction = 0.0;
+  /// The gap left after the explanation is still significant (G with its
+  /// effects fitted above the null's 1 - alpha quantile; false for
+  /// `none`). With a named verdict: the named effects close the larger
+  /// part of the gap and a remainder no listed effect describes is left.
+  bool remainder_significant = false;
   double negligible_threshold = 0.25;
   std::vector<std::string> indistinguishable;
   /// With a given model: what to change in the user's simulation, for every
