@@ -228,8 +228,12 @@ std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSu
     }
     if (!specs.empty())
       out.push_back(fmt::format("Check your simulation reproduces the runs: umbmark simulate {} --out DIR {} (the "
-                                "fitted values, SI units), then diagnose DIR/campaign.toml: the verdict should be none.",
-                                c.path, fmt::join(specs, " ")));
+                                "fitted values, SI units), then diagnose DIR/campaign.toml: it should name the same effects at these "
+                                "values (within their standard errors) and leave no significant gap{}.",
+                                c.path, fmt::join(specs, " "),
+                                s.remainder_significant ? "; the simulated runs lack this remainder, which is what "
+                                                          "your simulation will still miss"
+                                                        : ""));
     if (!symptoms.empty())
       out.push_back("Some other candidates fitted impossible values (a symptom, not a cause): " +
                     fmt::format("{}", fmt::join(symptoms, "; ")) + ".");
