@@ -236,8 +236,13 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
   // are the answer's larger part: they are named, and a significant
   // remainder is reported beside them (remainder_significant), never
   // hidden; `none` still needs the gap closed (above).
+  // ...unless what they leave lies mostly (the same level) in the runs'
+  // means and trends: something the same in every run, or drifting, is a
+  // systematic cause no listed effect describes, not the noise
+  // description's misfit (variances, correlations, tails).
+  const bool systematic_left = ex.gap_left && out.remainder_mean_share >= options.min_heldout_shrink;
   const bool mostly = !ex.steps.empty() && !ex.symptom_first && v.found_by_score &&
-                      heldout >= options.min_heldout_shrink;
+                      heldout >= options.min_heldout_shrink && !systematic_left;
   out.remainder_significant = !ex.steps.empty() && ex.gap_left;
   const char* leave = named.size() == 1 ? "leaves" : "leave";
   const std::string left =
@@ -276,9 +281,13 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
           "; {} {} {:.0f}% of the gap on held-out runs but {}, so no combination of the listed "
           "effects explains it",
           fmt::join(named, " + "), named.size() == 1 ? "closes" : "together close", 100.0 * heldout,
-          ex.gap_left ? fmt::format("leave a significant gap (G = {:.1f} > {:.1f})", gap_after,
-                                    out.null_quantile_alpha)
-                      : fmt::format("close less than {:.0f}% of it", 100.0 * options.min_heldout_shrink));
+          !ex.gap_left ? fmt::format("close less than {:.0f}% of it", 100.0 * options.min_heldout_shrink)
+          : heldout >= options.min_heldout_shrink && systematic_left
+              ? fmt::format("leave a significant gap (G = {:.1f} > {:.1f}) that lies mostly in the runs' means "
+                            "({:.0f}% of it in mean and trend statistics: something systematic no listed effect "
+                            "describes)",
+                            gap_after, out.null_quantile_alpha, 100.0 * out.remainder_mean_share)
+              : fmt::format("leave a significant gap (G = {:.1f} > {:.1f})", gap_after, out.null_quantile_alpha));
     out.verdict_reason += negligible_text;
   }
   out.verdict_effects = out.verdict == "none" ? std::vector<std::string>{} : named;
@@ -343,6 +352,9 @@ void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit
       const GapSummary left = ComputeGap(c, PieceScores(eps, ex.bases, c.pieces, ex.noise), options.gap);
       out.remaining_gap_score = left.score;
       out.remaining_where = LocateGap(c, left, options.where_top);
+      const double systematic = left.by_kind[static_cast<int>(StatKind::kMean)] +
+                                left.by_kind[static_cast<int>(StatKind::kTrend)];
+      out.remainder_mean_share = left.score > 0.0 ? systematic / left.score : 0.0;
     }
     NameEffects(ex, options, v, out);
     explained = std::move(ex);

@@ -236,6 +236,13 @@ struct DiagnoseSummary {
   /// `none`). With a named verdict: the named effects close the larger
   /// part of the gap and a remainder no listed effect describes is left.
   bool remainder_significant = false;
+  /// The share of the gap left (G with the explanation's effects fitted)
+  /// in mean and trend statistics: what is the same in every run, or
+  /// drifts over the runs. At min_heldout_shrink or more the remainder is
+  /// a systematic cause no listed effect describes and the verdict is
+  /// `unexplained`; below, it is the noise description's misfit
+  /// (variances, correlations, tails), reported beside the named effects.
+  double remainder_mean_share = 0.0;
   double negligible_threshold = 0.25;
   std::vector<std::string> indistinguishable;
   /// With a given model: what to change in the user's simulation, for every

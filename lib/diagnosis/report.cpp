@@ -457,6 +457,7 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
             {"effects", s.verdict_effects},
             {"unexplained_fraction", Num(s.unexplained_fraction)},
             {"remainder_significant", s.remainder_significant},
+            {"remainder_mean_share", Num(s.remainder_mean_share)},
             {"remaining_score", Num(s.remaining_gap_score)},
             {"remaining_where", WhereJson(s, s.remaining_where)},
             {"reason", s.verdict_reason},
