@@ -176,7 +176,7 @@ std::string RemainderStep(const DiagnoseSummary& s, const std::string& fixed) {
 // The steps follow the verdict. For `unexplained` they start from the data
 // (the largest discrepancy and where it lies), then the campaign's design
 // (what is missing to separate effects), then the symptoms (impossible
-// fits), then the partial explanation. Longer than 80 lines (94) on
+// fits), then the partial explanation. Longer than 80 lines (104) on
 // purpose: the steps are one list in the order a user acts on them, and
 // each branch only chooses which sentence comes next.
 std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSummary& s) {
@@ -228,8 +228,9 @@ std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSu
     }
     if (!specs.empty())
       out.push_back(fmt::format("Check your simulation reproduces the runs: umbmark simulate {} --out DIR {} (the "
-                                "fitted values, SI units), then diagnose DIR/campaign.toml: it should name the same effects at these "
-                                "values (within their standard errors) and leave no significant gap{}.",
+                                "fitted values, SI units), then diagnose DIR/campaign.toml: it should name the same "
+                                "effects at these values (within their standard errors) and leave no significant "
+                                "gap{}.",
                                 c.path, fmt::join(specs, " "),
                                 s.remainder_significant ? "; the simulated runs lack this remainder, which is what "
                                                           "your simulation will still miss"

@@ -188,20 +188,61 @@ std::vector<const ExplanationStep*> ByEarnings(const Explanation& ex) {
   return order;
 }
 
+/// The effects the verdict lists but does not name: negligible ones and
+/// fits at impossible values (symptoms).
+std::string NotNamedText(const std::vector<std::string>& negligible, const std::vector<std::string>& impossible,
+                         double level) {
+  std::string text = negligible.empty()
+                         ? std::string()
+                         : fmt::format("; negligible in practice (size below {:.2g} x the noise of one piece): {}",
+                                       level, fmt::join(negligible, ", "));
+  if (!impossible.empty())
+    text += fmt::format("; fitted at impossible values (a symptom, not named, never a step): {}",
+                        fmt::join(impossible, ", "));
+  return text;
+}
+
+/// What a named explanation leaves: no significant gap, a misfit of its
+/// shape (under 1 - full_shrink of the held-out gap), or a remainder.
+std::string WhatIsLeft(bool gap_left, const char* leave, double heldout, double gap_after, double quantile,
+                       double full_shrink) {
+  if (!gap_left) return fmt::format("{} no significant gap (G = {:.1f} <= {:.1f})", leave, gap_after, quantile);
+  if (heldout >= full_shrink)
+    return fmt::format("{} G = {:.1f} > {:.1f}, less than {:.0f}% of the held-out gap (a misfit of the effects' shape)",
+                       leave, gap_after, quantile, 100.0 * (1.0 - full_shrink));
+  return fmt::format("{} G = {:.1f} > {:.1f}: a significant remainder, {:.0f}% of the held-out gap, that no listed "
+                     "effect describes (where it lies: below)",
+                     leave, gap_after, quantile, 100.0 * (1.0 - heldout));
+}
+
+/// Why the effects of an `unexplained` verdict are not enough.
+std::string WhyNotEnough(bool gap_left, bool systematic, double gap_after, double quantile, double mean_share,
+                         double min_heldout_shrink) {
+  if (!gap_left) return fmt::format("close less than {:.0f}% of it", 100.0 * min_heldout_shrink);
+  if (systematic)
+    return fmt::format("leave a significant gap (G = {:.1f} > {:.1f}) that lies mostly in the runs' means ({:.0f}% "
+                       "of it in mean and trend statistics: something systematic no listed effect describes)",
+                       gap_after, quantile, 100.0 * mean_share);
+  return fmt::format("leave a significant gap (G = {:.1f} > {:.1f})", gap_after, quantile);
+}
+
 /// The verdict from the explanation (docs/diagnosis.md, "The verdict's
 /// rule"): its effects that are neither negligible nor fitted at impossible
 /// values (advice.hpp UnphysicalFit, e.g. a negative turn scrub: a symptom
 /// of something else, never a cause) are named when no impossible fit
 /// outranked its first step (Explanation::symptom_first) and either the
 /// explanation closes the larger part (min_heldout_shrink) of the gap the
-/// score found on held-out runs (a significant remainder is reported
-/// beside them: remainder_significant), or it leaves no significant gap
+/// score found on held-out runs and what it leaves lies mostly outside
+/// the runs' means (a significant remainder is reported beside them:
+/// remainder_significant, remainder_mean_share), or it leaves no significant gap
 /// (G at or below the null's 1 - alpha quantile, or full_shrink of the
 /// held-out gap closed; when the score found the gap, at least
 /// min_heldout_shrink of it); `none` when it closes it so with negligible
 /// effects only;
 /// else `unexplained`, listing the effects that close part of it.
 /// `v`: stage 5 (significance, and the reason in terms of single fits).
+/// Longer than 80 lines (86) on purpose: the three verdicts are one
+/// decision, and each branch only assembles its own sentence.
 void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Verdict& v, DiagnoseSummary& out) {
   std::vector<std::string> named, negligible, impossible, symptoms;
   double gain = 0.0;
@@ -217,15 +258,9 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
   for (const ExplanationStep& s : ex.symptoms) symptoms.push_back(sim::EffectToString(s.effect));
   const double heldout = ex.steps.empty() ? 0.0 : ex.steps.back().cumulative_heldout_shrink;
   out.unexplained_fraction = std::clamp(1.0 - heldout, 0.0, 1.0);
-  std::string negligible_text =
-      negligible.empty() ? std::string()
-                         : fmt::format("; negligible in practice (size below {:.2g} x the noise of one piece): {}",
-                                       options.negligible, fmt::join(negligible, ", "));
   std::vector<std::string> all_impossible = impossible;
   all_impossible.insert(all_impossible.end(), symptoms.begin(), symptoms.end());
-  if (!all_impossible.empty())
-    negligible_text += fmt::format("; fitted at impossible values (a symptom, not named, never a step): {}",
-                                   fmt::join(all_impossible, ", "));
+  const std::string negligible_text = NotNamedText(negligible, all_impossible, options.negligible);
   const double gap_after = ex.steps.empty() ? out.gap_score : ex.steps.back().gap_after;
   // A significant residual is excused when the explanation closes at least
   // full_shrink of the held-out gap: the misfit of the named effects' shape
@@ -235,26 +270,16 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
   // Named effects that close the larger part of the gap the score found
   // are the answer's larger part: they are named, and a significant
   // remainder is reported beside them (remainder_significant), never
-  // hidden; `none` still needs the gap closed (above).
-  // ...unless what they leave lies mostly (the same level) in the runs'
-  // means and trends: something the same in every run, or drifting, is a
-  // systematic cause no listed effect describes, not the noise
-  // description's misfit (variances, correlations, tails).
+  // hidden, unless it lies mostly (the same level) in the runs' means and
+  // trends: something the same in every run, or drifting, is a systematic
+  // cause no listed effect describes, not the noise description's misfit
+  // (variances, correlations, tails). `none` still needs the gap closed.
   const bool systematic_left = ex.gap_left && out.remainder_mean_share >= options.min_heldout_shrink;
   const bool mostly = !ex.steps.empty() && !ex.symptom_first && v.found_by_score &&
                       heldout >= options.min_heldout_shrink && !systematic_left;
   out.remainder_significant = !ex.steps.empty() && ex.gap_left;
-  const char* leave = named.size() == 1 ? "leaves" : "leave";
-  const std::string left =
-      !ex.gap_left ? fmt::format("{} no significant gap (G = {:.1f} <= {:.1f})", leave, gap_after,
-                                 out.null_quantile_alpha)
-      : heldout >= options.full_shrink
-          ? fmt::format("{} G = {:.1f} > {:.1f}, less than {:.0f}% of the held-out gap (a misfit of "
-                        "the effects' shape)",
-                        leave, gap_after, out.null_quantile_alpha, 100.0 * (1.0 - options.full_shrink))
-          : fmt::format("{} G = {:.1f} > {:.1f}: a significant remainder, {:.0f}% of the held-out gap, that no "
-                        "listed effect describes (where it lies: below)",
-                        leave, gap_after, out.null_quantile_alpha, 100.0 * (1.0 - heldout));
+  const std::string left = WhatIsLeft(ex.gap_left, named.size() == 1 ? "leaves" : "leave", heldout, gap_after,
+                                      out.null_quantile_alpha, options.full_shrink);
   if (closed && named.empty() && impossible.empty()) {
     out.verdict = "none";
     out.verdict_reason = fmt::format("the significant gap ({}) is closed by effects too small to matter{}",
@@ -281,17 +306,15 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
           "; {} {} {:.0f}% of the gap on held-out runs but {}, so no combination of the listed "
           "effects explains it",
           fmt::join(named, " + "), named.size() == 1 ? "closes" : "together close", 100.0 * heldout,
-          !ex.gap_left ? fmt::format("close less than {:.0f}% of it", 100.0 * options.min_heldout_shrink)
-          : heldout >= options.min_heldout_shrink && systematic_left
-              ? fmt::format("leave a significant gap (G = {:.1f} > {:.1f}) that lies mostly in the runs' means "
-                            "({:.0f}% of it in mean and trend statistics: something systematic no listed effect "
-                            "describes)",
-                            gap_after, out.null_quantile_alpha, 100.0 * out.remainder_mean_share)
-              : fmt::format("leave a significant gap (G = {:.1f} > {:.1f})", gap_after, out.null_quantile_alpha));
+          WhyNotEnough(ex.gap_left, heldout >= options.min_heldout_shrink && systematic_left, gap_after,
+                       out.null_quantile_alpha, out.remainder_mean_share, options.min_heldout_shrink));
     out.verdict_reason += negligible_text;
   }
   out.verdict_effects = out.verdict == "none" ? std::vector<std::string>{} : named;
-  if (out.verdict == "none") out.unexplained_fraction = 0.0, out.remainder_significant = false;
+  if (out.verdict == "none") {
+    out.unexplained_fraction = 0.0;
+    out.remainder_significant = false;
+  }
   if (out.verdict != "none" && out.verdict != "unexplained" && out.remainder_significant &&
       heldout < options.full_shrink)
     out.warnings.push_back(fmt::format(

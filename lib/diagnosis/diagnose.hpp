@@ -36,7 +36,8 @@
 //     verdict's rule"): effects added one at a time by held-out evidence,
 //     the first like every other; its practical effects are named when,
 //     G having found the gap, they close at least min_heldout_shrink of it
-//     held out (a significant remainder is reported beside them), or when
+//     held out and what they leave lies mostly outside the runs' means
+//     (a significant remainder is reported beside them), or when
 //     the residual G is not significant (or below 1 - full_shrink of the
 //     held-out gap); else `unexplained`. This stage
 //     ranks the candidates fitted alone and lists the effects the data
