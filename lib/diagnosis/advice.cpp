@@ -150,6 +150,16 @@ std::string ConcreteChange(const ExplanationStep& step, const CampaignData& c, c
   return effects::Of(step.effect).ConcreteChange(step.params, AdviceOf(c, s));
 }
 
+/// Where a gap statistic lies, in words: "experiment 2 (free, e2.csv),
+/// circular, standstill"; the subset names "all experiments" itself when
+/// the item pools them.
+std::string WherePlace(const DiagnoseSummary& s, const WhereItem& w) {
+  const std::string exp = w.experiment >= 0 && w.experiment < static_cast<int>(s.experiment_labels.size())
+                              ? "experiment " + s.experiment_labels[w.experiment] + ", "
+                              : std::string(w.subset.starts_with("all experiments") ? "" : "all experiments, ");
+  return exp + w.subset;
+}
+
 /// A named verdict that leaves a significant remainder: what the named
 /// effects close, and where to look for the rest (the explained model's
 /// largest part), so the user does not expect the gap to be gone.
@@ -157,12 +167,9 @@ std::string RemainderStep(const DiagnoseSummary& s, const std::string& fixed) {
   std::string where;
   if (!s.remaining_where.empty()) {
     const WhereItem& w = s.remaining_where.front();
-    const std::string exp = w.experiment >= 0 && w.experiment < static_cast<int>(s.experiment_labels.size())
-                                ? "experiment " + s.experiment_labels[w.experiment] + ", "
-                                : std::string();
-    where = fmt::format(" Look at it where it is largest: {}{}, the {} of the {} component ({:.1f} standard errors "
+    where = fmt::format(" Look at it where it is largest: {}, the {} of the {} component ({:.1f} standard errors "
                         "off the explained model; umbmark evaluate --report plots those runs).",
-                        exp, w.subset, StatKindToString(w.statistic), w.component, w.z);
+                        WherePlace(s, w), StatKindToString(w.statistic), w.component, w.z);
   }
   return fmt::format("Model or fix {} (fitted values in the explanation table), then diagnose again: about {:.0f}% of "
                      "the gap should be gone. The rest ({:.0f}% on held-out runs, G = {:.1f} against the null's "
@@ -171,14 +178,50 @@ std::string RemainderStep(const DiagnoseSummary& s, const std::string& fixed) {
                      s.remaining_gap_score, s.null_quantile_alpha, where);
 }
 
+/// The steps of a named verdict: each named effect's concrete change, what
+/// diagnosing again should show (the gap gone, or only the remainder
+/// left), the simulate command that reproduces the runs, the symptoms.
+void NamedVerdictSteps(const CampaignData& c, const DiagnoseSummary& s, const std::vector<std::string>& changes,
+                       const std::vector<std::string>& symptoms, std::vector<std::string>& out) {
+  out.insert(out.end(), changes.begin(), changes.end());
+  const std::string fixed =
+      fmt::format("{}", fmt::join(s.verdict_effects.empty() ? std::vector<std::string>{s.verdict} : s.verdict_effects,
+                                  " and "));
+  if (!s.remainder_significant)
+    out.push_back(fmt::format("Model or fix {} (fitted values in the explanation table), then diagnose again: the "
+                              "gap should be gone.", fixed));
+  else
+    out.push_back(RemainderStep(s, fixed));
+  std::vector<std::string> specs;
+  for (const auto& step : s.explanation) {
+    // Parameter errors are not simulated effects (their fix is above);
+    // an impossible fit is a symptom, not something to simulate.
+    if (step.negligible || !step.unphysical.empty() || sim::IsParameterError(step.effect)) continue;
+    std::vector<std::string> kv;
+    for (const auto& [k, v] : step.params) kv.push_back(fmt::format("{}={:.4g}", k, v));
+    specs.push_back(fmt::format("--effect {}:{}", sim::EffectToString(step.effect), fmt::join(kv, ",")));
+  }
+  if (!specs.empty())
+    out.push_back(fmt::format("Check your simulation reproduces the runs: umbmark simulate {} --out DIR {} (the "
+                              "fitted values, SI units), then diagnose DIR/campaign.toml: it should name the same "
+                              "effects at these values (within their standard errors) and leave no significant "
+                              "gap{}.",
+                              c.path, fmt::join(specs, " "),
+                              s.remainder_significant ? "; the simulated runs lack this remainder, which is what "
+                                                        "your simulation will still miss"
+                                                      : ""));
+  if (!symptoms.empty())
+    out.push_back("Some other candidates fitted impossible values (a symptom, not a cause): " +
+                  fmt::format("{}", fmt::join(symptoms, "; ")) + ".");
+}
+
 }  // namespace
 
 // The steps follow the verdict. For `unexplained` they start from the data
 // (the largest discrepancy and where it lies), then the campaign's design
 // (what is missing to separate effects), then the symptoms (impossible
-// fits), then the partial explanation. Longer than 80 lines (104) on
-// purpose: the steps are one list in the order a user acts on them, and
-// each branch only chooses which sentence comes next.
+// fits), then the partial explanation; for a named verdict
+// NamedVerdictSteps.
 std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSummary& s) {
   std::vector<std::string> out;
   if (s.verdict == "none") {
@@ -208,36 +251,7 @@ std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSu
     if (std::string change = ConcreteChange(step, c, s); !change.empty()) changes.push_back(std::move(change));
   }
   if (s.verdict != "unexplained") {
-    out.insert(out.end(), changes.begin(), changes.end());
-    const std::string fixed =
-        fmt::format("{}", fmt::join(s.verdict_effects.empty() ? std::vector<std::string>{s.verdict} : s.verdict_effects,
-                                    " and "));
-    if (!s.remainder_significant)
-      out.push_back(fmt::format("Model or fix {} (fitted values in the explanation table), then diagnose again: the "
-                                "gap should be gone.", fixed));
-    else
-      out.push_back(RemainderStep(s, fixed));
-    std::vector<std::string> specs;
-    for (const auto& step : s.explanation) {
-      // Parameter errors are not simulated effects (their fix is above);
-      // an impossible fit is a symptom, not something to simulate.
-      if (step.negligible || !step.unphysical.empty() || sim::IsParameterError(step.effect)) continue;
-      std::vector<std::string> kv;
-      for (const auto& [k, v] : step.params) kv.push_back(fmt::format("{}={:.4g}", k, v));
-      specs.push_back(fmt::format("--effect {}:{}", sim::EffectToString(step.effect), fmt::join(kv, ",")));
-    }
-    if (!specs.empty())
-      out.push_back(fmt::format("Check your simulation reproduces the runs: umbmark simulate {} --out DIR {} (the "
-                                "fitted values, SI units), then diagnose DIR/campaign.toml: it should name the same "
-                                "effects at these values (within their standard errors) and leave no significant "
-                                "gap{}.",
-                                c.path, fmt::join(specs, " "),
-                                s.remainder_significant ? "; the simulated runs lack this remainder, which is what "
-                                                          "your simulation will still miss"
-                                                        : ""));
-    if (!symptoms.empty())
-      out.push_back("Some other candidates fitted impossible values (a symptom, not a cause): " +
-                    fmt::format("{}", fmt::join(symptoms, "; ")) + ".");
+    NamedVerdictSteps(c, s, changes, symptoms, out);
     return out;
   }
   // The listed effects' fixes come first when together they close at least
@@ -249,15 +263,11 @@ std::vector<std::string> AdviseNextSteps(const CampaignData& c, const DiagnoseSu
   if (!s.where.empty()) {
     // What those changes leave is the explained model's largest part.
     const WhereItem& w = fixes_first && !s.remaining_where.empty() ? s.remaining_where.front() : s.where.front();
-    // The subset names "all experiments" itself when the item pools them.
-    const std::string exp = w.experiment >= 0 && w.experiment < static_cast<int>(s.experiment_labels.size())
-                                ? "experiment " + s.experiment_labels[w.experiment] + ", "
-                                : std::string(w.subset.starts_with("all experiments") ? "" : "all experiments, ");
-    out.push_back(fmt::format("{} {}{}: its {} of the {} component is {:.1f} standard errors off the "
+    out.push_back(fmt::format("{} {}: its {} of the {} component is {:.1f} standard errors off the "
                               "model. Plot those runs' odometry against the ground truth (umbmark evaluate --report) "
                               "and check the ground truth there (marker swaps, dropped samples, timing).",
-                              fixes_first ? "Then, for what those changes leave, look at" : "Look first at", exp,
-                              w.subset, StatKindToString(w.statistic), w.component, w.z));
+                              fixes_first ? "Then, for what those changes leave, look at" : "Look first at",
+                              WherePlace(s, w), StatKindToString(w.statistic), w.component, w.z));
   }
   if (!fixes_first) out.insert(out.end(), changes.begin(), changes.end());
   if (!symptoms.empty())

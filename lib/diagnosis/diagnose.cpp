@@ -277,7 +277,10 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
   const bool systematic_left = ex.gap_left && out.remainder_mean_share >= options.min_heldout_shrink;
   const bool mostly = !ex.steps.empty() && !ex.symptom_first && v.found_by_score &&
                       heldout >= options.min_heldout_shrink && !systematic_left;
-  out.remainder_significant = !ex.steps.empty() && ex.gap_left;
+  // One reading of "a remainder" for the reason, the warning, the summary
+  // and the next steps: significant and more than the misfit of the
+  // effects' shape (full_shrink).
+  out.remainder_significant = !ex.steps.empty() && ex.gap_left && heldout < options.full_shrink;
   const std::string left = WhatIsLeft(ex.gap_left, named.size() == 1 ? "leaves" : "leave", heldout, gap_after,
                                       out.null_quantile_alpha, options.full_shrink);
   if (closed && named.empty() && impossible.empty()) {
@@ -315,8 +318,7 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
     out.unexplained_fraction = 0.0;
     out.remainder_significant = false;
   }
-  if (out.verdict != "none" && out.verdict != "unexplained" && out.remainder_significant &&
-      heldout < options.full_shrink)
+  if (out.verdict != "none" && out.verdict != "unexplained" && out.remainder_significant)
     out.warnings.push_back(fmt::format(
         "the verdict's effects close {:.0f}% of the gap on held-out runs; the significant remainder (G = {:.1f} > "
         "{:.1f}) is something no listed effect describes",

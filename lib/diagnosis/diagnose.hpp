@@ -233,9 +233,11 @@ struct DiagnoseSummary {
   /// 1 - the explanation's cumulative held-out shrink (0 for `none`).
   double unexplained_fraction = 0.0;
   /// The gap left after the explanation is still significant (G with its
-  /// effects fitted above the null's 1 - alpha quantile; false for
-  /// `none`). With a named verdict: the named effects close the larger
-  /// part of the gap and a remainder no listed effect describes is left.
+  /// effects fitted above the null's 1 - alpha quantile) and more than the
+  /// misfit of the effects' shape (their held-out shrink below
+  /// full_shrink); false for `none`. With a named verdict: the named
+  /// effects close the larger part of the gap and a remainder no listed
+  /// effect describes is left.
   bool remainder_significant = false;
   /// The share of the gap left (G with the explanation's effects fitted)
   /// in mean and trend statistics: what is the same in every run, or
