@@ -84,6 +84,11 @@ Command SetupDiagnose(CLI::App& parent) {
       ->check(NumberIn(0.01, 1.0));
   app->add_option("--penalty", d.complexity_penalty_nats, "Held-out nats an effect must gain per parameter (default 2)")
       ->check(NonNegative());
+  app->add_option("--decisive", d.decisive_nats,
+                  "Held-out nats an effect must earn given the explanation's other effects, after its penalty, to "
+                  "be named in the verdict (default 4.61 = ln 100: a likelihood ratio of 100, decisive on "
+                  "Jeffreys' scale)")
+      ->check(NonNegative());
   app->add_option("--folds", d.pieces.folds, "Cross-validation folds over runs (default 5)")->check(NumberIn(2, 100));
   app->add_option("--piece-length", d.pieces.max_piece_length_m,
                   "Longest piece of a leg or arc compared with the model [m] (default 1; 0.01 to 1000)")

@@ -214,7 +214,8 @@ TEST_CASE("DART campaigns: the verdict is the explanation, by one rule", "[diagn
   // docs/diagnosis.md, "The verdict's rule", on every committed campaign:
   // every step gains held-out evidence beyond its penalty (2 nats per
   // parameter); the named effects are the explanation's steps that are not
-  // negligible, led by the first; a named verdict leaves no significant gap
+  // negligible and earn decisive evidence given the others (ln 100 nats
+  // after their penalty), led by the first; a named verdict leaves no significant gap
   // or closes at least 90 % of the held-out gap; `unexplained` otherwise.
   for (const std::string cls :
        {"clean", "floor_strips", "marker_offset", "clock_fixed", "eccentric_hubs", "stop_slide", "swivel_castor"}) {
@@ -224,7 +225,9 @@ TEST_CASE("DART campaigns: the verdict is the explanation, by one rule", "[diagn
     std::vector<std::string> practical;
     for (const auto& e : ex) {
       CHECK(e["heldout_gain_nats"].get<double>() > 2.0 * static_cast<double>(e["params"].size()));
-      if (!e["negligible"].get<bool>() && !e.contains("unphysical")) practical.push_back(e["effect"]);
+      CHECK(e["not_decisive"].get<bool>() == (e["earned_given_others_nats"].get<double>() < std::log(100.0)));
+      if (!e["negligible"].get<bool>() && !e["not_decisive"].get<bool>() && !e.contains("unphysical"))
+        practical.push_back(e["effect"]);
     }
     const std::string verdict = j["verdict"]["effect"];
     if (!j["gap"]["significant"].get<bool>()) {

@@ -652,6 +652,48 @@ TEST_CASE("diagnose: two effects at once (castor kick + time offset) are both na
   CHECK(j.at("verdict").contains("unexplained_fraction"));
 }
 
+TEST_CASE("diagnose: an effect whose evidence given the others is not decisive stays a step, not named",
+          "[diagnose][explanation]") {
+  // Both causes earn far more than ln 100 given the other: named. Raising
+  // the level just above what the weaker one earns leaves it a step,
+  // reported as not decisive, and the stronger one the verdict.
+  Small s = MakeSmall(61);
+  s.sim.effects.castor_kappa = 0.008;
+  s.sim.effects.time_tau = 0.04;
+  DiagnoseOptions o = Fast();
+  CHECK_THAT(o.decisive_nats, WithinAbs(std::log(100.0), 1e-12));
+  DiagnoseSummary d = Diagnose(Build(s), o);
+  INFO(d.verdict_reason);
+  REQUIRE(d.explanation.size() >= 2);
+  const ExplanationStep* weakest = nullptr;
+  for (const ExplanationStep& e : d.explanation) {
+    if (e.negligible || !e.unphysical.empty()) continue;
+    CHECK(e.earned_given_others_nats >= o.decisive_nats);
+    CHECK_FALSE(e.not_decisive);
+    if (!weakest || e.earned_given_others_nats < weakest->earned_given_others_nats) weakest = &e;
+  }
+  REQUIRE(weakest != nullptr);
+  const std::string weak_name = sim::EffectToString(weakest->effect);
+  const std::size_t named_before = d.verdict_effects.size();
+  REQUIRE(named_before >= 2);
+  o.decisive_nats = weakest->earned_given_others_nats + 1.0;
+  d = Diagnose(Build(s), o);
+  INFO(d.verdict_reason);
+  CHECK(d.verdict_effects.size() == named_before - 1);
+  CHECK(std::find(d.verdict_effects.begin(), d.verdict_effects.end(), weak_name) == d.verdict_effects.end());
+  CHECK(d.verdict != weak_name);
+  CHECK(d.verdict_reason.find("not decisive given the other effects") != std::string::npos);
+  CHECK(d.verdict_reason.find(weak_name + " (") != std::string::npos);
+  bool flagged = false;
+  for (const ExplanationStep& e : d.explanation) flagged = flagged || (e.effect == weakest->effect && e.not_decisive);
+  CHECK(flagged);
+  const nlohmann::json j = DiagnoseToJson(d);
+  bool json_flagged = false;
+  for (const auto& e : j.at("explanation"))
+    json_flagged = json_flagged || (e.at("effect") == weak_name && e.at("not_decisive").get<bool>());
+  CHECK(json_flagged);
+}
+
 TEST_CASE("diagnose: a significant but sub-millimetre marker offset is negligible, never the verdict",
           "[diagnose][negligible]") {
   // Noise-free ground truth makes a 0.3 mm offset highly significant; next
@@ -770,9 +812,17 @@ TEST_CASE("diagnose: a noise floor's size is the growth of the spread of the pie
   s.sim.effects.floor_sigma = 0.0002;
   const CampaignData tiny = Build(s);
   DiagnoseOptions all = Fast();
-  all.negligible = 0.0;  // significant: named when every size counts
+  all.negligible = 0.0;  // significant, on little evidence (under 2 nats given nothing else)
   d = Diagnose(tiny, all);
   INFO(d.verdict_reason);
+  // Every size counts, but the evidence is not decisive: a step, not named,
+  // and a gap closed so is not `none` either.
+  CHECK(d.verdict == "unexplained");
+  REQUIRE_FALSE(d.explanation.empty());
+  CHECK(d.explanation.front().not_decisive);
+  CHECK(d.explanation.front().earned_given_others_nats < std::log(100.0));
+  all.decisive_nats = 0.0;  // named when every size and every gain counts
+  d = Diagnose(tiny, all);
   CHECK(d.verdict == "motion_noise_floor");
   d = Diagnose(tiny, Fast());
   CHECK(d.verdict == "none");

@@ -365,9 +365,12 @@ void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
   int k = 0;
   for (const auto& e : ex) {
     // An impossible fit is marked as what it is: a symptom, never named.
-    const std::string flag = e.contains("unphysical")         ? " (impossible value: a symptom)"
-                             : e.value("negligible", false) ? " (negligible)"
-                                                            : "";
+    const std::string flag =
+        e.contains("unphysical")         ? std::string(" (impossible value: a symptom)")
+        : e.value("negligible", false)   ? std::string(" (negligible)")
+        : e.value("not_decisive", false) ? fmt::format(" (not decisive: {:+.1f} nats given the others)",
+                                                       Number(e, "earned_given_others_nats"))
+                                         : std::string();
     rows.push_back({fmt::format("{}", ++k), e.value("effect", "?"),
                     ParamsText(e.value("params", nlohmann::json::object()), nlohmann::json::object(), e.value("effect", "")),
                     Percent(Number(e, "cumulative_heldout_shrink")), Percent(Number(e, "cumulative_shrink")),
@@ -391,7 +394,9 @@ void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
                             "below {:.2g} x the noise of one piece (1 m of travel or a spot turn), or, for a noise "
                             "effect, when it widens the pose spread of the pieces it acts on by less than {:.0f}% "
                             "(median per piece type, the type it widens most): then it is reported but never the "
-                            "verdict.",
+                            "verdict. An effect is not decisive when, given the other effects, the held-out runs are "
+                            "less than 100 times more probable with it (after the penalty for its parameters): it "
+                            "stays a step, but the verdict does not name it.",
                             Percent(Number(v, "unexplained_fraction")), Number(v, "negligible_threshold"),
                             100.0 * Number(v, "negligible_threshold")));
 }

@@ -40,6 +40,7 @@ std::string DiagnoseOptions::Check() const {
     return fmt::format("min_heldout_shrink = {} must be in (0, 1]", min_heldout_shrink);
   if (!(complexity_penalty_nats >= 0.0))
     return fmt::format("complexity_penalty_nats = {} must be >= 0", complexity_penalty_nats);
+  if (!(decisive_nats >= 0.0)) return fmt::format("decisive_nats = {} must be >= 0", decisive_nats);
   if (threads < 1) return fmt::format("threads = {} must be >= 1", threads);
   if (!(negligible >= 0.0)) return fmt::format("negligible = {} must be >= 0", negligible);
   if (max_explanation_effects < 1)
@@ -188,14 +189,19 @@ std::vector<const ExplanationStep*> ByEarnings(const Explanation& ex) {
   return order;
 }
 
-/// The effects the verdict lists but does not name: negligible ones and
-/// fits at impossible values (symptoms).
-std::string NotNamedText(const std::vector<std::string>& negligible, const std::vector<std::string>& impossible,
-                         double level) {
+/// The effects the verdict lists but does not name: negligible ones, ones
+/// whose evidence given the others is not decisive (`weak`, with their
+/// nats) and fits at impossible values (symptoms).
+std::string NotNamedText(const std::vector<std::string>& negligible, const std::vector<std::string>& weak,
+                         const std::vector<std::string>& impossible, double level, double decisive) {
   std::string text = negligible.empty()
                          ? std::string()
                          : fmt::format("; negligible in practice (size below {:.2g} x the noise of one piece): {}",
                                        level, fmt::join(negligible, ", "));
+  if (!weak.empty())
+    text += fmt::format("; not decisive given the other effects (a held-out likelihood ratio below {:.0f}, "
+                        "{:.2f} nats, after the penalty for its parameters): {}",
+                        std::exp(decisive), decisive, fmt::join(weak, ", "));
   if (!impossible.empty())
     text += fmt::format("; fitted at impossible values (a symptom, not named, never a step): {}",
                         fmt::join(impossible, ", "));
@@ -215,21 +221,24 @@ std::string WhatIsLeft(bool gap_left, const char* leave, double heldout, double 
                      leave, gap_after, quantile, 100.0 * (1.0 - heldout));
 }
 
-/// Why the effects of an `unexplained` verdict are not enough.
-std::string WhyNotEnough(bool gap_left, bool systematic, double gap_after, double quantile, double mean_share,
-                         double min_heldout_shrink) {
-  if (!gap_left) return fmt::format("close less than {:.0f}% of it", 100.0 * min_heldout_shrink);
+/// Why the effects of an `unexplained` verdict are not enough (`one`: a
+/// single effect, the verbs in the singular).
+std::string WhyNotEnough(bool one, bool gap_left, bool systematic, double gap_after, double quantile,
+                         double mean_share, double min_heldout_shrink) {
+  const char* leave = one ? "leaves" : "leave";
+  if (!gap_left) return fmt::format("{} less than {:.0f}% of it", one ? "closes" : "close", 100.0 * min_heldout_shrink);
   if (systematic)
-    return fmt::format("leave a significant gap (G = {:.1f} > {:.1f}) that lies mostly in the runs' means ({:.0f}% "
+    return fmt::format("{} a significant gap (G = {:.1f} > {:.1f}) that lies mostly in the runs' means ({:.0f}% "
                        "of it in mean and trend statistics: something systematic no listed effect describes)",
-                       gap_after, quantile, 100.0 * mean_share);
-  return fmt::format("leave a significant gap (G = {:.1f} > {:.1f})", gap_after, quantile);
+                       leave, gap_after, quantile, 100.0 * mean_share);
+  return fmt::format("{} a significant gap (G = {:.1f} > {:.1f})", leave, gap_after, quantile);
 }
 
 /// The verdict from the explanation (docs/diagnosis.md, "The verdict's
-/// rule"): its effects that are neither negligible nor fitted at impossible
-/// values (advice.hpp UnphysicalFit, e.g. a negative turn scrub: a symptom
-/// of something else, never a cause) are named when no impossible fit
+/// rule"): its effects that are neither negligible, nor short of decisive
+/// evidence given the others (ExplanationStep::not_decisive), nor fitted
+/// at impossible values (advice.hpp UnphysicalFit, e.g. a negative turn
+/// scrub: a symptom of something else, never a cause) are named when no impossible fit
 /// outranked its first step (Explanation::symptom_first) and either the
 /// explanation closes the larger part (min_heldout_shrink) of the gap the
 /// score found on held-out runs and what it leaves lies mostly outside
@@ -238,13 +247,13 @@ std::string WhyNotEnough(bool gap_left, bool systematic, double gap_after, doubl
 /// (G at or below the null's 1 - alpha quantile, or full_shrink of the
 /// held-out gap closed; when the score found the gap, at least
 /// min_heldout_shrink of it); `none` when it closes it so with negligible
-/// effects only;
+/// effects only (not with effects short of decisive evidence);
 /// else `unexplained`, listing the effects that close part of it.
 /// `v`: stage 5 (significance, and the reason in terms of single fits).
-/// Longer than 80 lines (86) on purpose: the three verdicts are one
+/// Longer than 80 lines (93) on purpose: the three verdicts are one
 /// decision, and each branch only assembles its own sentence.
 void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Verdict& v, DiagnoseSummary& out) {
-  std::vector<std::string> named, negligible, impossible, symptoms;
+  std::vector<std::string> named, negligible, weak, impossible, symptoms;
   double gain = 0.0;
   for (const ExplanationStep* step : ByEarnings(ex)) {
     const ExplanationStep& s = *step;
@@ -252,15 +261,20 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
     gain += s.heldout_gain_nats;
     if (!s.unphysical.empty())
       impossible.push_back(name);
+    else if (s.negligible)
+      negligible.push_back(name);
+    else if (s.not_decisive)
+      weak.push_back(fmt::format("{} ({:+.1f} nats)", name, s.earned_given_others_nats));
     else
-      (s.negligible ? negligible : named).push_back(name);
+      named.push_back(name);
   }
   for (const ExplanationStep& s : ex.symptoms) symptoms.push_back(sim::EffectToString(s.effect));
   const double heldout = ex.steps.empty() ? 0.0 : ex.steps.back().cumulative_heldout_shrink;
   out.unexplained_fraction = std::clamp(1.0 - heldout, 0.0, 1.0);
   std::vector<std::string> all_impossible = impossible;
   all_impossible.insert(all_impossible.end(), symptoms.begin(), symptoms.end());
-  const std::string negligible_text = NotNamedText(negligible, all_impossible, options.negligible);
+  const std::string negligible_text =
+      NotNamedText(negligible, weak, all_impossible, options.negligible, options.decisive_nats);
   const double gap_after = ex.steps.empty() ? out.gap_score : ex.steps.back().gap_after;
   // A significant residual is excused when the explanation closes at least
   // full_shrink of the held-out gap: the misfit of the named effects' shape
@@ -283,7 +297,7 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
   out.remainder_significant = !ex.steps.empty() && ex.gap_left && heldout < options.full_shrink;
   const std::string left = WhatIsLeft(ex.gap_left, named.size() == 1 ? "leaves" : "leave", heldout, gap_after,
                                       out.null_quantile_alpha, options.full_shrink);
-  if (closed && named.empty() && impossible.empty()) {
+  if (closed && named.empty() && weak.empty() && impossible.empty()) {
     out.verdict = "none";
     out.verdict_reason = fmt::format("the significant gap ({}) is closed by effects too small to matter{}",
                                      v.significance, negligible_text);
@@ -309,7 +323,7 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
           "; {} {} {:.0f}% of the gap on held-out runs but {}, so no combination of the listed "
           "effects explains it",
           fmt::join(named, " + "), named.size() == 1 ? "closes" : "together close", 100.0 * heldout,
-          WhyNotEnough(ex.gap_left, heldout >= options.min_heldout_shrink && systematic_left, gap_after,
+          WhyNotEnough(named.size() == 1, ex.gap_left, heldout >= options.min_heldout_shrink && systematic_left, gap_after,
                        out.null_quantile_alpha, out.remainder_mean_share, options.min_heldout_shrink));
     out.verdict_reason += negligible_text;
   }
@@ -362,6 +376,7 @@ void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit
       for (const Candidate& cd : out.candidates)
         if (cd.effect == st.effect) se = cd.param_se;
       st.unphysical = UnphysicalFit(sim::EffectToString(st.effect), st.params, static_cast<int>(c.runs.size()), se);
+      st.not_decisive = st.earned_given_others_nats < options.decisive_nats;
     }
     out.explanation = ex.steps;
     if (!ex.steps.empty()) {

@@ -95,6 +95,12 @@ struct DiagnoseOptions {
   double full_shrink = 0.9;
   /// Held-out log-likelihood an effect must gain per parameter. Default 2 nats.
   double complexity_penalty_nats = 2.0;
+  /// The verdict names an effect of the explanation only when, given the
+  /// others, it earns at least this much held-out log-likelihood after its
+  /// penalty (ExplanationStep::earned_given_others_nats): a held-out
+  /// likelihood ratio of 100, "decisive" on Jeffreys' scale. Below it the
+  /// effect stays a step, reported as not decisive. Default ln 100 = 4.61.
+  double decisive_nats = 4.605170185988092;
   /// Seed of the bootstrap. Default 1.
   std::uint64_t seed = 1;
   /// Threads for the bootstrap and the candidate fits (>= 1). Default 2.

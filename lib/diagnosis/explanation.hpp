@@ -106,6 +106,9 @@ struct ExplanationStep {
   /// the single-effect candidate's standard errors), empty when it is not;
   /// filled by Diagnose. Such a step is a symptom and never named.
   std::string unphysical;
+  /// Given the others it earns less than DiagnoseOptions::decisive_nats:
+  /// a step of the explanation, reported, not named (filled by Diagnose).
+  bool not_decisive = false;
 };
 
 /// Why an effect with these fitted parameters is too small to matter

@@ -62,7 +62,8 @@ nlohmann::json ExplanationJson(const DiagnoseSummary& s) {
                      {"size_mm", Num(e.size_mm)},
                      {"size_mrad", Num(e.size_mrad)},
                      {"relative_size", Num(e.relative_size)},
-                     {"negligible", e.negligible}});
+                     {"negligible", e.negligible},
+                     {"not_decisive", e.not_decisive}});
     if (!e.size_pieces.empty()) steps.back()["size_pieces"] = e.size_pieces;
     if (!e.practical_floor.empty()) steps.back()["practical_floor"] = e.practical_floor;
     // An impossible fit is a symptom, never named (diagnose.cpp NameEffects).
@@ -382,7 +383,9 @@ void ExplanationSection(TextReport& o, const DiagnoseSummary& s) {
                          !e.unphysical.empty() ? std::string(" (impossible value: a symptom)")
                          : !e.practical_floor.empty() ? " (negligible: " + e.practical_floor + ")"
                          : e.negligible                 ? std::string(" (negligible)")
-                                                        : std::string(),
+                         : e.not_decisive ? fmt::format(" (not decisive: {:+.1f} nats given the others)",
+                                                        e.earned_given_others_nats)
+                                          : std::string(),
                          params));
     }
     for (const auto& e : s.symptoms) {
