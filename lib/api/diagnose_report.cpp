@@ -370,6 +370,7 @@ void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
         : e.value("negligible", false)   ? std::string(" (negligible)")
         : e.value("not_decisive", false) ? fmt::format(" (not decisive: {:+.1f} nats given the others)",
                                                        Number(e, "earned_given_others_nats"))
+        : e.contains("outside_range")    ? std::string(" (outside the physical range: not named)")
                                          : std::string();
     rows.push_back({fmt::format("{}", ++k), e.value("effect", "?"),
                     ParamsText(e.value("params", nlohmann::json::object()), nlohmann::json::object(), e.value("effect", "")),

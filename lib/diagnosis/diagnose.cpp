@@ -237,6 +237,7 @@ std::string WhyNotEnough(bool one, bool gap_left, bool systematic, double gap_af
 /// The verdict from the explanation (docs/diagnosis.md, "The verdict's
 /// rule"): its effects that are neither negligible, nor short of decisive
 /// evidence given the others (ExplanationStep::not_decisive), nor fitted
+/// outside their physical range (ExplanationStep::outside_range), nor
 /// at impossible values (advice.hpp UnphysicalFit, e.g. a negative turn
 /// scrub: a symptom of something else, never a cause) are named when no impossible fit
 /// outranked its first step (Explanation::symptom_first) and either the
@@ -250,10 +251,10 @@ std::string WhyNotEnough(bool one, bool gap_left, bool systematic, double gap_af
 /// effects only (not with effects short of decisive evidence);
 /// else `unexplained`, listing the effects that close part of it.
 /// `v`: stage 5 (significance, and the reason in terms of single fits).
-/// Longer than 80 lines (93) on purpose: the three verdicts are one
+/// Longer than 80 lines (99) on purpose: the three verdicts are one
 /// decision, and each branch only assembles its own sentence.
 void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Verdict& v, DiagnoseSummary& out) {
-  std::vector<std::string> named, negligible, weak, impossible, symptoms;
+  std::vector<std::string> named, negligible, weak, outside, impossible, symptoms;
   double gain = 0.0;
   for (const ExplanationStep* step : ByEarnings(ex)) {
     const ExplanationStep& s = *step;
@@ -265,6 +266,8 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
       negligible.push_back(name);
     else if (s.not_decisive)
       weak.push_back(fmt::format("{} ({:+.1f} nats)", name, s.earned_given_others_nats));
+    else if (!s.outside_range.empty())
+      outside.push_back(fmt::format("{} ({})", name, s.outside_range));
     else
       named.push_back(name);
   }
@@ -273,8 +276,12 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
   out.unexplained_fraction = std::clamp(1.0 - heldout, 0.0, 1.0);
   std::vector<std::string> all_impossible = impossible;
   all_impossible.insert(all_impossible.end(), symptoms.begin(), symptoms.end());
-  const std::string negligible_text =
+  std::string negligible_text =
       NotNamedText(negligible, weak, all_impossible, options.negligible, options.decisive_nats);
+  if (!outside.empty())
+    negligible_text += fmt::format("; fitted outside the physical range, though within its standard errors of it "
+                                   "(no cause a robot can have; not named): {}",
+                                   fmt::join(outside, "; "));
   const double gap_after = ex.steps.empty() ? out.gap_score : ex.steps.back().gap_after;
   // A significant residual is excused when the explanation closes at least
   // full_shrink of the held-out gap: the misfit of the named effects' shape
@@ -297,7 +304,7 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
   out.remainder_significant = !ex.steps.empty() && ex.gap_left && heldout < options.full_shrink;
   const std::string left = WhatIsLeft(ex.gap_left, named.size() == 1 ? "leaves" : "leave", heldout, gap_after,
                                       out.null_quantile_alpha, options.full_shrink);
-  if (closed && named.empty() && weak.empty() && impossible.empty()) {
+  if (closed && named.empty() && weak.empty() && outside.empty() && impossible.empty()) {
     out.verdict = "none";
     out.verdict_reason = fmt::format("the significant gap ({}) is closed by effects too small to matter{}",
                                      v.significance, negligible_text);
@@ -376,6 +383,14 @@ void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit
       for (const Candidate& cd : out.candidates)
         if (cd.effect == st.effect) se = cd.param_se;
       st.unphysical = UnphysicalFit(sim::EffectToString(st.effect), st.params, static_cast<int>(c.runs.size()), se);
+      // A value outside the physical range that its standard errors excuse
+      // is no symptom, but no cause a robot can have either: not named.
+      // (Standard errors of 0: the range at the point estimate itself.)
+      std::map<std::string, double> exact;
+      for (const auto& [name, value] : st.params) exact[name] = 0.0;
+      if (st.unphysical.empty())
+        st.outside_range =
+            UnphysicalFit(sim::EffectToString(st.effect), st.params, static_cast<int>(c.runs.size()), exact);
       st.not_decisive = st.earned_given_others_nats < options.decisive_nats;
     }
     out.explanation = ex.steps;

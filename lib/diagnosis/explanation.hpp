@@ -109,6 +109,11 @@ struct ExplanationStep {
   /// Given the others it earns less than DiagnoseOptions::decisive_nats:
   /// a step of the explanation, reported, not named (filled by Diagnose).
   bool not_decisive = false;
+  /// Its fitted value lies outside the effect's physical range, but within
+  /// the tolerance of its standard errors (so not `unphysical`, e.g. a turn
+  /// scrub of k = -0.005, 1.5 SE below 0): a step, never named; why, in
+  /// words (filled by Diagnose), else empty.
+  std::string outside_range;
 };
 
 /// Why an effect with these fitted parameters is too small to matter

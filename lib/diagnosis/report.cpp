@@ -64,6 +64,7 @@ nlohmann::json ExplanationJson(const DiagnoseSummary& s) {
                      {"relative_size", Num(e.relative_size)},
                      {"negligible", e.negligible},
                      {"not_decisive", e.not_decisive}});
+    if (!e.outside_range.empty()) steps.back()["outside_range"] = e.outside_range;
     if (!e.size_pieces.empty()) steps.back()["size_pieces"] = e.size_pieces;
     if (!e.practical_floor.empty()) steps.back()["practical_floor"] = e.practical_floor;
     // An impossible fit is a symptom, never named (diagnose.cpp NameEffects).
@@ -385,7 +386,8 @@ void ExplanationSection(TextReport& o, const DiagnoseSummary& s) {
                          : e.negligible                 ? std::string(" (negligible)")
                          : e.not_decisive ? fmt::format(" (not decisive: {:+.1f} nats given the others)",
                                                         e.earned_given_others_nats)
-                                          : std::string(),
+                         : !e.outside_range.empty() ? std::string(" (outside the physical range: not named)")
+                                                    : std::string(),
                          params));
     }
     for (const auto& e : s.symptoms) {
