@@ -361,6 +361,7 @@ void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
   const auto& ex = j.value("explanation", nlohmann::json::array());
   if (ex.empty()) return;
   rep.Heading("The explanation: effects added one at a time, fitted jointly");
+  const double threshold = Number(j.at("verdict"), "negligible_threshold");
   std::vector<std::vector<std::string>> rows;
   int k = 0;
   for (const auto& e : ex) {
@@ -380,7 +381,12 @@ void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
                     e.contains("size_pieces")
                         ? fmt::format("+{:.0f}% sd of {} pieces{}", 100.0 * Number(e, "relative_size"),
                                       e.value("size_pieces", "?"), flag)
-                        : fmt::format("{:.2f}{}", Number(e, "relative_size"), flag)});
+                        // Three decimals where two would print the threshold itself.
+                        : fmt::format("{:.{}f}{}", Number(e, "relative_size"),
+                                      std::abs(Number(e, "relative_size") - threshold) < 0.005
+                                          ? 3
+                                          : 2,
+                                      flag)});
   }
   rep.Table({"step", "effect", "parameters", "gap closed, held-out", "in-sample", "size over a run",
              "size / noise of one piece"},
