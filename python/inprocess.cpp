@@ -386,6 +386,21 @@ Result DiagnoseInProcess(const py::args& inputs, const py::kwargs& kwargs) {
       {"alpha", [](O& o, K k, H v) { o.diag.alpha = Number(k, v); }},
       {"min_heldout_shrink", [](O& o, K k, H v) { o.diag.min_heldout_shrink = Number(k, v); }},
       {"penalty", [](O& o, K k, H v) { o.diag.complexity_penalty_nats = Number(k, v); }},
+      {"decisive", [](O& o, K k, H v) { o.diag.decisive_nats = Number(k, v); }},
+      {"monotone_shrink", [](O& o, K, H v) { o.diag.keep_heldout_shrink = Truth(v); }},
+      {"no_monotone_shrink", [](O& o, K, H v) { o.diag.keep_heldout_shrink = !Truth(v); }},
+      {"fit_ground_truth_noise",
+       [](O& o, K, H v) {
+         if (Truth(v)) o.diag.baseline_fit.ground_truth = diag::GroundTruthNoiseSource::kFitted;
+       }},
+      {"hold_wheel_noise",
+       [](O& o, K, H v) {
+         if (Truth(v)) o.diag.baseline_fit.wheel = diag::WheelNoiseSource::kRepeats;
+       }},
+      {"fit_wheel_noise",
+       [](O& o, K, H v) {
+         if (Truth(v)) o.diag.baseline_fit.wheel = diag::WheelNoiseSource::kFitted;
+       }},
       {"folds", [](O& o, K k, H v) { o.diag.pieces.folds = WholeNumber(k, v); }},
       {"piece_length", [](O& o, K k, H v) { o.diag.pieces.max_piece_length_m = Number(k, v); }},
       {"no_likelihood_tests", [](O& o, K, H v) { o.diag.likelihood_tests = !Truth(v); }},
@@ -403,6 +418,10 @@ Result DiagnoseInProcess(const py::args& inputs, const py::kwargs& kwargs) {
   };
   auto o = Options<O>("diagnose", [&](O& opts) {
     opts.manifest = OneInput(inputs, "MANIFEST");
+    // As the command line: --hold-wheel-noise excludes --fit-wheel-noise.
+    const auto given = [&](const char* key) { return kwargs.contains(key) && Truth(kwargs[key]); };
+    if (given("hold_wheel_noise") && given("fit_wheel_noise"))
+      throw InvalidOptions("--hold-wheel-noise excludes --fit-wheel-noise");
     ApplyKeywords(opts, kwargs, setters, "diagnose", {"fail_unexplained"});
   });
   std::optional<api::DiagnoseResult> r;

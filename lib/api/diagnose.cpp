@@ -108,7 +108,8 @@ std::string DiagnoseOptions::Check() const {
   for (const std::string& e :
        {In("--null-sims", diag.null_simulations, 20, 1000000), In("--alpha", diag.alpha, 1e-6, 0.5),
         In("--min-heldout-shrink", diag.min_heldout_shrink, 0.01, 1.0),
-        NonNegative("--penalty", diag.complexity_penalty_nats), In("--folds", diag.pieces.folds, 2, 100),
+        NonNegative("--penalty", diag.complexity_penalty_nats), NonNegative("--decisive", diag.decisive_nats),
+        In("--folds", diag.pieces.folds, 2, 100),
         In("--piece-length", diag.pieces.max_piece_length_m, 0.01, 1000.0), NonNegative("--negligible", diag.negligible),
         In("--max-effects", diag.max_explanation_effects, 1, 12), In("--threads", diag.threads, 1, 256),
         NonNegative("--where", diag.where_top)}) {

@@ -108,6 +108,25 @@ def test_diagnose_equals_cli():
     assert r.verdict["effect"] == cli["verdict"]["effect"]
 
 
+def test_diagnose_in_process_takes_every_verdict_option():
+    # The in-process diagnose takes the command's long options, the verdict's
+    # and the baseline's included (a decisive level no effect reaches: the
+    # explanation's steps are all `not_decisive` and none is named).
+    kwargs = dict(null_sims=20, seed=3, threads=1, decisive=1e9, monotone_shrink=True, hold_wheel_noise=True)
+    r = umbmark.diagnose(EXAMPLES / "diagnose.toml", **kwargs)
+    cli = cli_json("diagnose", EXAMPLES / "diagnose.toml", "--null-sims", "20", "--seed", "3", "--threads", "1",
+                   "--decisive", "1e9", "--monotone-shrink", "--hold-wheel-noise")
+    assert_same(r.to_dict(), cli)
+    steps = cli["explanation"]
+    assert steps and all(s["not_decisive"] for s in steps) and cli["verdict"]["effects"] == []
+    for flag in ("fit_ground_truth_noise", "fit_wheel_noise", "no_monotone_shrink"):
+        umbmark.diagnose(EXAMPLES / "diagnose.toml", null_sims=20, seed=3, threads=1, **{flag: True})
+    with pytest.raises(umbmark.UsageError, match="--hold-wheel-noise excludes --fit-wheel-noise"):
+        umbmark.diagnose(EXAMPLES / "diagnose.toml", hold_wheel_noise=True, fit_wheel_noise=True)
+    with pytest.raises(umbmark.UsageError, match="--decisive"):
+        umbmark.diagnose(EXAMPLES / "diagnose.toml", decisive=-1)
+
+
 def test_evaluate_equals_cli():
     r = umbmark.evaluate(EXAMPLES / "square_ticks.csv", robot=ROBOT)
     cli = cli_json("evaluate", EXAMPLES / "square_ticks.csv", "--robot", ROBOT)
