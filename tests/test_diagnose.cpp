@@ -673,10 +673,13 @@ TEST_CASE("diagnose: an effect whose evidence given the others is not decisive s
     if (!weakest || e.earned_given_others_nats < weakest->earned_given_others_nats) weakest = &e;
   }
   REQUIRE(weakest != nullptr);
-  const std::string weak_name = sim::EffectToString(weakest->effect);
+  // Copied: `d` is replaced below.
+  const sim::EffectKind weak_effect = weakest->effect;
+  const std::string weak_name = sim::EffectToString(weak_effect);
   const std::size_t named_before = d.verdict_effects.size();
   REQUIRE(named_before >= 2);
   o.decisive_nats = weakest->earned_given_others_nats + 1.0;
+  weakest = nullptr;
   d = Diagnose(Build(s), o);
   INFO(d.verdict_reason);
   CHECK(d.verdict_effects.size() == named_before - 1);
@@ -685,7 +688,7 @@ TEST_CASE("diagnose: an effect whose evidence given the others is not decisive s
   CHECK(d.verdict_reason.find("not decisive given the other effects") != std::string::npos);
   CHECK(d.verdict_reason.find(weak_name + " (") != std::string::npos);
   bool flagged = false;
-  for (const ExplanationStep& e : d.explanation) flagged = flagged || (e.effect == weakest->effect && e.not_decisive);
+  for (const ExplanationStep& e : d.explanation) flagged = flagged || (e.effect == weak_effect && e.not_decisive);
   CHECK(flagged);
   const nlohmann::json j = DiagnoseToJson(d);
   bool json_flagged = false;
