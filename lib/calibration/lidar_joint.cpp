@@ -390,7 +390,7 @@ LinearStart LinearCalibration(const std::vector<WheelTravelSample>& wheels, cons
 // Rounds of: weights from the current variance components, Gauss-Newton,
 // variance components and outliers from the residuals; then the sandwich
 // covariance at the final parameters. One function so the round structure
-// reads in one place (110 lines with its lambdas).
+// reads in one place (108 lines with its lambdas).
 LidarJointFit FitLidarJoint(const std::vector<WheelTravelSample>& wheels, const std::vector<ScanPair>& pairs,
                             const LidarJointParams& start, const LidarJointOptions& o) {
   if (const std::string err = o.Validate(); !err.empty()) throw InvalidOptions(err);

@@ -191,9 +191,11 @@ std::vector<const ExplanationStep*> ByEarnings(const Explanation& ex) {
 
 /// The effects the verdict lists but does not name: negligible ones, ones
 /// whose evidence given the others is not decisive (`weak`, with their
-/// nats) and fits at impossible values (symptoms).
+/// nats), ones fitted outside their physical range within its tolerance
+/// (`outside`, with why) and fits at impossible values (symptoms).
 std::string NotNamedText(const std::vector<std::string>& negligible, const std::vector<std::string>& weak,
-                         const std::vector<std::string>& impossible, double level, double decisive) {
+                         const std::vector<std::string>& outside, const std::vector<std::string>& impossible,
+                         double level, double decisive) {
   std::string text = negligible.empty()
                          ? std::string()
                          : fmt::format("; negligible in practice (size below {:.2g} x the noise of one piece): {}",
@@ -202,6 +204,10 @@ std::string NotNamedText(const std::vector<std::string>& negligible, const std::
     text += fmt::format("; not decisive given the other effects (a held-out likelihood ratio below {:.0f}, "
                         "{:.2f} nats, after the penalty for its parameters): {}",
                         std::exp(decisive), decisive, fmt::join(weak, ", "));
+  if (!outside.empty())
+    text += fmt::format("; fitted outside the physical range, though within its standard errors of it (no cause a "
+                        "robot can have; not named): {}",
+                        fmt::join(outside, "; "));
   if (!impossible.empty())
     text += fmt::format("; fitted at impossible values (a symptom, not named, never a step): {}",
                         fmt::join(impossible, ", "));
@@ -251,7 +257,7 @@ std::string WhyNotEnough(bool one, bool gap_left, bool systematic, double gap_af
 /// effects only (not with effects short of decisive evidence);
 /// else `unexplained`, listing the effects that close part of it.
 /// `v`: stage 5 (significance, and the reason in terms of single fits).
-/// Longer than 80 lines (99) on purpose: the three verdicts are one
+/// Longer than 80 lines (95) on purpose: the three verdicts are one
 /// decision, and each branch only assembles its own sentence.
 void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Verdict& v, DiagnoseSummary& out) {
   std::vector<std::string> named, negligible, weak, outside, impossible, symptoms;
@@ -276,12 +282,8 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
   out.unexplained_fraction = std::clamp(1.0 - heldout, 0.0, 1.0);
   std::vector<std::string> all_impossible = impossible;
   all_impossible.insert(all_impossible.end(), symptoms.begin(), symptoms.end());
-  std::string negligible_text =
-      NotNamedText(negligible, weak, all_impossible, options.negligible, options.decisive_nats);
-  if (!outside.empty())
-    negligible_text += fmt::format("; fitted outside the physical range, though within its standard errors of it "
-                                   "(no cause a robot can have; not named): {}",
-                                   fmt::join(outside, "; "));
+  const std::string not_named =
+      NotNamedText(negligible, weak, outside, all_impossible, options.negligible, options.decisive_nats);
   const double gap_after = ex.steps.empty() ? out.gap_score : ex.steps.back().gap_after;
   // A significant residual is excused when the explanation closes at least
   // full_shrink of the held-out gap: the misfit of the named effects' shape
@@ -307,14 +309,14 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
   if (closed && named.empty() && weak.empty() && outside.empty() && impossible.empty()) {
     out.verdict = "none";
     out.verdict_reason = fmt::format("the significant gap ({}) is closed by effects too small to matter{}",
-                                     v.significance, negligible_text);
+                                     v.significance, not_named);
   } else if ((closed || mostly) && !named.empty()) {
     out.verdict = named.front();
     out.verdict_reason = fmt::format(
         "{} {} {:.0f}% of the gap on held-out runs ({:+.1f} nats held out over the baseline) and {}; effects added "
         "one at a time by held-out evidence, fitted jointly; the gap: {}{}",
         fmt::join(named, " + "), named.size() == 1 ? "closes" : "together close", 100.0 * heldout, gain, left,
-        v.significance, negligible_text);
+        v.significance, not_named);
   } else {
     out.verdict = "unexplained";
     out.verdict_reason = v.reason;
@@ -332,7 +334,7 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
           fmt::join(named, " + "), named.size() == 1 ? "closes" : "together close", 100.0 * heldout,
           WhyNotEnough(named.size() == 1, ex.gap_left, heldout >= options.min_heldout_shrink && systematic_left, gap_after,
                        out.null_quantile_alpha, out.remainder_mean_share, options.min_heldout_shrink));
-    out.verdict_reason += negligible_text;
+    out.verdict_reason += not_named;
   }
   out.verdict_effects = out.verdict == "none" ? std::vector<std::string>{} : named;
   if (out.verdict == "none") {

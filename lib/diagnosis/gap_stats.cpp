@@ -102,7 +102,7 @@ std::vector<Scores> PieceScores(const std::vector<double>& eps, const std::vecto
 // subset's accumulator (means, variances, tails, cross-products, run means),
 // and the second turns the same accumulators into the standardized
 // departures G sums; split, the two halves would hand the accumulators back
-// and forth (108 lines, lambdas counted).
+// and forth (106 lines, lambdas counted).
 GapSummary ComputeGap(const CampaignData& campaign, const std::vector<Scores>& scores, const GapOptions& options,
                       const std::vector<char>* use) {
   const std::size_t S = campaign.subsets.size();
