@@ -307,6 +307,22 @@ TEST_CASE("diagnose names and sizes effects injected into a real session", "[dia
     CHECK(j["run_faults"].empty());
     for (const auto& n : j["notes"]) CHECK(n.get<std::string>().find("left out of every fit") == std::string::npos);
   }
+  SECTION("without injection the per-run clock is fitted at 0, and its check says there is nothing to check") {
+    // It used to read "on all pieces 0.0 ms: the moving samples carry the
+    // evidence" (docs/diagnosis.md, the per-run clock checked where it is
+    // fitted).
+    bool seen = false;
+    for (const auto& c : base["candidates"])
+      if (c["effect"] == "run_time_offset") {
+        seen = true;
+        CHECK(c["params"]["tau_sd"].get<double>() == 0.0);
+        const std::string text = c["clock_check"]["evidence"].get<std::string>();
+        INFO(text);
+        CHECK(text.rfind("fitted at 0 on all pieces, so there is no per-run clock to check", 0) == 0);
+        CHECK(text.find("carry the evidence") == std::string::npos);
+      }
+    CHECK(seen);
+  }
   SECTION("castor_kick and castor_swivel kappa = 10 mrad: sized within 25 %") {
     // Issue 28: with the kicks at the contract's starts (creeps included),
     // s1 sizes them 11.9 and 9.95 mrad; with the creeps folded into the

@@ -370,6 +370,16 @@ void CheckRunTimeOffset(const Shared& x, const std::vector<PieceBases>& bases, c
   // Half the full fit's spread, or significant there on its own (chi^2_1 at
   // 0.1 %: 2 x 5.4 nats).
   k.supported = k.pieces > 0 && (k.value >= 0.5 * full || gain > 5.4);
+  // Fitted at 0 on all pieces, the candidate has nothing the check could
+  // support (NullNoiseFit credits it with nothing); "the moving samples
+  // carry the evidence" read as if they did.
+  if (full == 0.0) {
+    k.text = fmt::format(
+        "fitted at 0 on all pieces, so there is no per-run clock to check (on the moving samples alone, the ends of "
+        "{} pieces that do not end at a stop: tau_sd = {:.1f} ms, {:+.1f} nats there)",
+        k.pieces, 1e3 * k.value, gain);
+    return;
+  }
   k.text = fmt::format(
       "the per-run clock offsets on the moving samples alone (the ends of {} pieces that do not end at a stop) "
       "have tau_sd = {:.1f} ms ({:+.1f} nats there), on all pieces {:.1f} ms: {}",
