@@ -488,6 +488,21 @@ int ChooseStep(const std::vector<sim::EffectKind>& remaining, const std::vector<
   return -1;
 }
 
+/// The baseline's wheel noise once the explanation's mean effects are
+/// fitted (Explanation::mean_wheel_noise_measured): k_L^2, k_R^2 refitted
+/// as the baseline fits them to the residuals of the explanation's mean
+/// part `mean` (none when it is the baseline's `base_mean`, or the wheel
+/// noise is given or held from repeated runs).
+void MeasureMeanWheelNoise(const CampaignData& c, const BaselineFit& b, const MeanPart& base_mean,
+                           const MeanPart& mean, Explanation& ex) {
+  if (!b.noise_fit.fit_wheel_noise || b.wheel_noise_source == "repeats" || &mean == &base_mean) return;
+  const NoiseParams left =
+      FitPieceNoise(mean.mf.eps, mean.scrub ? mean.scrub_bases : b.bases, c.pieces, {}, b.noise, b.noise_fit);
+  ex.mean_wheel_noise_measured = true;
+  ex.mean_wheel_noise_k_L = std::sqrt(left.kL2);
+  ex.mean_wheel_noise_k_R = std::sqrt(left.kR2);
+}
+
 /// Candidates worth trying: every identifiable one, also those that lost
 /// held-out evidence alone. Alone, an effect is judged under the
 /// baseline's Gaussian noise; when the noise is not Gaussian (bumps) a
@@ -677,6 +692,8 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
     add(remaining[static_cast<std::size_t>(best)], trial[static_cast<std::size_t>(best)]);
   }
   BackwardCheck(c, model, b, folds, candidates, means, options, base, add, chosen, current, ex);
+  means.Prepare({chosen});
+  MeasureMeanWheelNoise(c, b, means.Get({}), means.Get(chosen), ex);
   progress.Finish();
   ex.gap_left = current.gap_after > null_quantile;
   SizeSteps(c, model, b, means.Get(chosen), current, options.negligible, ex);

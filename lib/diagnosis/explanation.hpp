@@ -146,6 +146,14 @@ struct Explanation {
   ParamVector p{};
   NoiseParams noise;
   std::vector<PieceBases> bases;
+  /// The baseline's wheel noise refitted to the residuals of the
+  /// explanation's mean part (its mean effects fitted, no noise effect
+  /// beside them) [m^1/2], when the baseline fits its wheel noise and the
+  /// explanation has a mean effect: what the baseline's k would be had it
+  /// not taken those effects in (docs/diagnosis.md, "What the baseline's
+  /// wheel noise took in").
+  bool mean_wheel_noise_measured = false;
+  double mean_wheel_noise_k_L = 0.0, mean_wheel_noise_k_R = 0.0;
 };
 
 /// The rule that admits a step (docs/diagnosis.md, "The verdict's rule"):
