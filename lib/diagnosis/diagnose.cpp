@@ -355,6 +355,26 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
   });
 }
 
+/// Which wheel noise is right, the baseline's (bl, br) or the one with the
+/// mean effects fitted (kl, kr): what the repeated runs' scatter (a mean
+/// effect drops out of it) can say at the level of their check
+/// (RepeatDisagreement: two standard errors), or the design that would.
+std::string RepeatsAdvice(const RepeatNoise& r, double bl, double br, double kl, double kr) {
+  if (!r.measured)
+    return "Repeated runs of one path (their scatter about their own mean, where a mean effect drops out) would "
+           "measure the wheel noise apart from the pieces (diagnose --hold-wheel-noise)";
+  const bool apart = std::abs(bl - kl) > 2.0 * r.sd_k_L || std::abs(br - kr) > 2.0 * r.sd_k_R;
+  const bool nearer_fit = std::abs(r.k_L - kl) + std::abs(r.k_R - kr) < std::abs(r.k_L - bl) + std::abs(r.k_R - br);
+  return fmt::format(
+      "The repeated runs' scatter gives k_L = {:.3g} +- {:.2g}, k_R = {:.3g} +- {:.2g} ({} contrasts): {}", r.k_L,
+      r.sd_k_L, r.k_R, r.sd_k_R, r.contrasts,
+      !apart ? "the two differ by less than two of its standard errors, so it cannot tell them apart; more repeated "
+               "runs of one path would"
+      : nearer_fit ? "nearer the wheel noise with the mean effects fitted; diagnose with --hold-wheel-noise to hold k "
+                     "there"
+                   : "nearer the baseline's, so the mean effects may not be all the difference");
+}
+
 /// What the baseline's wheel noise took in (docs/diagnosis.md): a note
 /// when a k of the baseline is more than 1.5 x (the level of the repeated
 /// runs' check, RepeatDisagreement) the k its pieces show once the
@@ -375,11 +395,11 @@ std::string WheelNoiseTookIn(const Explanation& ex, const DiagnoseSummary& out) 
       "the baseline's wheel noise (k_L = {:.3g}, k_R = {:.3g} m^1/2) is {:.2g} x / {:.2g} x what its pieces show once "
       "{} {} fitted (k_L = {:.3g}, k_R = {:.3g}): fitted with E_d, E_b, it took part of {} in, so the gap score G, "
       "measured against the baseline, understates what {} ({:.0f}% of it on held-out runs); the held-out "
-      "evidence (nats) is the measure to read for {}. With repeated runs, diagnose with --hold-wheel-noise",
+      "evidence (nats) is the measure to read for {}. {}",
       bl, br, bl / std::max(kl, 1e-12), br / std::max(kr, 1e-12), fmt::join(mean, " + "),
       mean.size() == 1 ? "is" : "are", kl, kr, mean.size() == 1 ? "it" : "them",
       mean.size() == 1 ? "it closes" : "they close", 100.0 * ex.steps.back().cumulative_heldout_shrink,
-      mean.size() == 1 ? "it" : "them");
+      mean.size() == 1 ? "it" : "them", RepeatsAdvice(out.baseline.repeat, bl, br, kl, kr));
 }
 
 /// Stage 6: the stepwise explanation, which effects the verdict names, and
