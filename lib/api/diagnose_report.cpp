@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "diagnosis/advice.hpp"
+#include "diagnosis/explanation.hpp"
 #include "report/html_report.hpp"
 #include "report/svg_plot.hpp"
 
@@ -381,12 +382,8 @@ void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
                     e.contains("size_pieces")
                         ? fmt::format("+{:.0f}% sd of {} pieces{}", 100.0 * Number(e, "relative_size"),
                                       e.value("size_pieces", "?"), flag)
-                        // Three decimals where two would print the threshold itself.
                         : fmt::format("{:.{}f}{}", Number(e, "relative_size"),
-                                      std::abs(Number(e, "relative_size") - threshold) < 0.005
-                                          ? 3
-                                          : 2,
-                                      flag)});
+                                      diag::RelativeSizeDecimals(Number(e, "relative_size"), threshold), flag)});
   }
   rep.Table({"step", "effect", "parameters", "gap closed, held-out", "in-sample", "size over a run",
              "size / noise of one piece"},

@@ -384,7 +384,7 @@ std::string RepeatsAdvice(const RepeatNoise& r, double bl, double br, double kl,
 /// the June session s5 a +1.5 % scale error doubled k_L and left G where it
 /// was, and the held-out shrink of the fitted scale error read -28 %.
 std::string WheelNoiseTookIn(const Explanation& ex, const DiagnoseSummary& out) {
-  if (!ex.mean_wheel_noise_measured || ex.steps.empty()) return {};
+  if (!ex.mean_wheel_noise_measured) return {};  // measured only with a mean step
   const double kl = ex.mean_wheel_noise_k_L, kr = ex.mean_wheel_noise_k_R;
   const double bl = out.baseline.k_L, br = out.baseline.k_R;
   if (!(bl > 1.5 * kl) && !(br > 1.5 * kr)) return {};
@@ -672,7 +672,7 @@ DiagnoseSummary WithoutFaultyRuns(const CampaignData& rest, const DiagnoseOption
 }
 
 // The diagnosis as its numbered stages, each a call into its own file. It is
-// 112 lines long because each stage's options are filled from DiagnoseOptions here,
+// 111 lines long because each stage's options are filled from DiagnoseOptions here,
 // in place, so that every route of a user's option is visible in one place.
 DiagnoseSummary DiagnoseCampaign(const CampaignData& recorded, const DiagnoseOptions& options, bool scan_faults) {
   DiagnoseSummary out;

@@ -116,6 +116,13 @@ struct ExplanationStep {
   std::string outside_range;
 };
 
+/// Decimals to print a relative size with next to the negligible
+/// threshold: three where two would print the threshold itself (x 0.249
+/// beside "negligible" below 0.25), else two. Text and HTML reports.
+inline int RelativeSizeDecimals(double relative_size, double threshold) {
+  return relative_size - threshold < 0.005 && threshold - relative_size < 0.005 ? 3 : 2;
+}
+
 /// Why an effect with these fitted parameters is too small to matter
 /// whatever the noise (see the file comment), or empty: the effect's own
 /// floor (Effect::PracticalFloor), a pose size at the campaign's speeds and

@@ -376,9 +376,8 @@ void ExplanationSection(TextReport& o, const DiagnoseSummary& s) {
       // A noise effect's size is the growth of the spread of one piece type
       // (explanation.hpp), printed as such.
       const std::string rel = e.size_pieces.empty()
-                                  // Three decimals where two would print the threshold itself.
                                   ? fmt::format("x {:<5.{}f}", e.relative_size,
-                                                std::abs(e.relative_size - s.negligible_threshold) < 0.005 ? 3 : 2)
+                                                RelativeSizeDecimals(e.relative_size, s.negligible_threshold))
                                   : fmt::format("+{:.0f}% sd of {} pieces", 100.0 * e.relative_size, e.size_pieces);
       o.line(fmt::format("    {:>4} {:<22} {:>17.0f}% {:>8.0f}%   {:>7.2f} / {:>6.2f}, {}{}  {}", ++k,
                          sim::EffectToString(e.effect), 100.0 * e.cumulative_shrink, 100.0 * e.cumulative_heldout_shrink,
