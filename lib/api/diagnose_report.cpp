@@ -394,14 +394,22 @@ void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
                                          y.value("effect", "")),
                               y.value("why", "")));
   const auto& v = j.at("verdict");
-  rep.Paragraph(fmt::format("{} of the gap stays unexplained on held-out runs. An effect is negligible when its size is "
+  const std::string reference = v.value("shrink_reference", std::string("baseline"));
+  const std::string against =
+      reference == "baseline"
+          ? std::string()
+          : fmt::format(" (measured against the baseline's mean seen with the wheel noise left once the mean effects "
+                        "are fitted; {} against the baseline itself, whose fitted wheel noise took part of them in: see "
+                        "the notes)",
+                        Percent(1.0 - Number(v, "heldout_shrink_against_baseline")));
+  rep.Paragraph(fmt::format("{} of the gap stays unexplained on held-out runs{}. An effect is negligible when its size is "
                             "below {:.2g} x the noise of one piece (1 m of travel or a spot turn), or, for a noise "
                             "effect, when it widens the pose spread of the pieces it acts on by less than {:.0f}% "
                             "(median per piece type, the type it widens most): then it is reported but never the "
                             "verdict. An effect is not decisive when, given the other effects, the held-out runs are "
                             "less than 100 times more probable with it (after the penalty for its parameters): it "
                             "stays a step, but the verdict does not name it.",
-                            Percent(Number(v, "unexplained_fraction")), Number(v, "negligible_threshold"),
+                            Percent(Number(v, "unexplained_fraction")), against, Number(v, "negligible_threshold"),
                             100.0 * Number(v, "negligible_threshold")));
 }
 

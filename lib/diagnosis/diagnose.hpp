@@ -238,10 +238,22 @@ struct DiagnoseSummary {
   std::vector<std::string> verdict_effects;
   /// 1 - the explanation's cumulative held-out shrink (0 for `none`).
   double unexplained_fraction = 0.0;
+  /// What the explanation's shrinks are measured against
+  /// (docs/diagnosis.md, "The shrink's reference"): "baseline", or
+  /// "mean_effects_wheel_noise" (the baseline's mean seen with the wheel
+  /// noise left once the explanation's mean effects are fitted) where the
+  /// baseline does not see the larger part of the gap closed and that
+  /// reference sees more. JSON verdict.shrink_reference.
+  std::string shrink_reference = "baseline";
+  /// The explanation's held-out shrink against the baseline itself (equal
+  /// to 1 - unexplained_fraction with the baseline as reference). JSON
+  /// verdict.heldout_shrink_against_baseline.
+  double heldout_shrink_against_baseline = 0.0;
   /// The gap left after the explanation is still significant (G with its
   /// effects fitted above the null's 1 - alpha quantile) and more than the
   /// misfit of the effects' shape (their held-out shrink below
-  /// full_shrink); false for `none`. With a named verdict: the named
+  /// full_shrink, against the shrinks' reference and against the baseline
+  /// both); false for `none`. With a named verdict: the named
   /// effects close the larger part of the gap and a remainder no listed
   /// effect describes is left.
   bool remainder_significant = false;

@@ -70,6 +70,10 @@ struct ExplanationOptions {
   /// with the effect unmodelled, is too wide), and the rule dropped them;
   /// the likelihood is the criterion, the shrink is reported as it comes.
   bool keep_heldout_shrink = false;
+  /// The larger part of the gap (DiagnoseOptions::min_heldout_shrink): below
+  /// it against the baseline, the shrinks are measured against the shrinks'
+  /// reference when that sees more (Explanation::reference_held). Default 0.5.
+  double min_heldout_shrink = 0.5;
   /// Progress in effect sets fitted, of at most max_effects x the candidates
   /// (core/progress.hpp); reaches the total when the search stops early.
   /// Default: none.
@@ -85,6 +89,7 @@ struct ExplanationStep {
   double gap_after = 0.0;                  ///< G with every effect so far
   double cumulative_shrink = 0.0;          ///< in-sample
   double cumulative_heldout_shrink = 0.0;  ///< on held-out runs
+  double heldout_gap_after = 0.0;          ///< G on held-out runs with every effect so far
   double heldout_gain_nats = 0.0;          ///< over the previous step, held out
   /// Held-out log-likelihood the final explanation loses without this
   /// effect (the others refitted), less its parameters' penalty: what it
@@ -161,6 +166,20 @@ struct Explanation {
   /// wheel noise took in").
   bool mean_wheel_noise_measured = false;
   double mean_wheel_noise_k_L = 0.0, mean_wheel_noise_k_R = 0.0;
+  /// The last step's cumulative held-out shrink measured against the
+  /// baseline itself. Where the baseline does not see the larger part of
+  /// the gap closed (ExplanationOptions::min_heldout_shrink) and the
+  /// shrinks' reference sees more (docs/diagnosis.md, "The shrink's
+  /// reference": the baseline's mean seen with the wheel noise above) the
+  /// steps' shrinks are measured against the reference; the
+  /// remainder's excuse (DiagnoseOptions::full_shrink) takes the smaller of
+  /// the two, so a reference the baseline could not see never makes a
+  /// remainder look small. Equal to the last step's shrink without a
+  /// reference; 0 without a step.
+  double baseline_heldout_shrink = 0.0;
+  /// The steps' shrinks are measured against the shrinks' reference, not
+  /// the baseline (see baseline_heldout_shrink).
+  bool reference_held = false;
 };
 
 /// The rule that admits a step (docs/diagnosis.md, "The verdict's rule"):
@@ -170,7 +189,9 @@ struct Explanation {
 /// admissible trials the largest held-out gain wins, at the first step as
 /// at every other. So every step adds held-out evidence; the cumulative
 /// held-out shrink is reported as it comes (the likelihood is the
-/// criterion).
+/// criterion), against the shrink's reference (Explanation::
+/// mean_wheel_noise_measured): one G for every step, so a step that never
+/// lowers the held-out G never lowers its shrink either.
 ///
 /// `known`: mean fits already made (FitCandidates' mean_fits: the same
 /// fits, so not repeated). The first step is chosen by the same rule as

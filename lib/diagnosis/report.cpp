@@ -396,10 +396,17 @@ void ExplanationSection(TextReport& o, const DiagnoseSummary& s) {
       for (const auto& [n, v] : e.params) params += FormatParam(n, v, sim::EffectToString(e.effect)) + "  ";
       o.line(fmt::format("    symptom, not a step: {} {}-- {}", sim::EffectToString(e.effect), params, e.unphysical));
     }
-    o.line(fmt::format("    unexplained on held-out runs: {:.0f}%; negligible = size below {:.2g} x the noise of one "
+    const std::string against =
+        s.shrink_reference == "baseline"
+            ? std::string()
+            : fmt::format(" (shrinks against the baseline's mean seen with the wheel noise left once the mean effects "
+                          "are fitted; {:.0f}% against the baseline itself: see the note)",
+                          100.0 * (1.0 - s.heldout_shrink_against_baseline));
+    o.line(fmt::format("    unexplained on held-out runs: {:.0f}%{}; negligible = size below {:.2g} x the noise of one "
                        "piece (<= 1 m of travel or a spot turn); for a noise effect, widening the pose spread of the "
                        "pieces it acts on by less than {:.0f}% (median per piece type, the type it widens most)",
-                       100.0 * s.unexplained_fraction, s.negligible_threshold, 100.0 * s.negligible_threshold));
+                       100.0 * s.unexplained_fraction, against, s.negligible_threshold,
+                       100.0 * s.negligible_threshold));
   }
   o.line("");
 }
@@ -462,6 +469,8 @@ nlohmann::json DiagnoseToJson(const DiagnoseSummary& s) {
            {{"effect", s.verdict},
             {"effects", s.verdict_effects},
             {"unexplained_fraction", Num(s.unexplained_fraction)},
+            {"shrink_reference", s.shrink_reference},
+            {"heldout_shrink_against_baseline", Num(s.heldout_shrink_against_baseline)},
             {"remainder_significant", s.remainder_significant},
             {"remainder_mean_share", Num(s.remainder_mean_share)},
             {"remaining_score", Num(s.remaining_gap_score)},
