@@ -171,10 +171,19 @@ std::string RemainderStep(const DiagnoseSummary& s, const std::string& fixed) {
                         "off the explained model; umbmark evaluate --report plots those runs).",
                         WherePlace(s, w), StatKindToString(w.statistic), w.component, w.z);
   }
+  // Against the shrinks' reference (docs/diagnosis.md, "The shrink's
+  // reference") the share is not what the next diagnosis's own baseline
+  // will show: say which G to expect.
+  const std::string reference =
+      s.shrink_reference == "baseline"
+          ? std::string()
+          : fmt::format(" (of the gap its mean shows with the wheel noise the effects leave; the next diagnosis fits "
+                        "its own wheel noise, so expect its gap score near G = {:.1f}, not {:.1f})",
+                        s.remaining_gap_score, s.gap_score);
   return fmt::format("Model or fix {} (fitted values in the explanation table), then diagnose again: about {:.0f}% of "
-                     "the gap should be gone. The rest ({:.0f}% on held-out runs, G = {:.1f} against the null's "
+                     "the gap should be gone{}. The rest ({:.0f}% on held-out runs, G = {:.1f} against the null's "
                      "{:.1f}) is significant and no listed effect describes it.{}",
-                     fixed, 100.0 * (1.0 - s.unexplained_fraction), 100.0 * s.unexplained_fraction,
+                     fixed, 100.0 * (1.0 - s.unexplained_fraction), reference, 100.0 * s.unexplained_fraction,
                      s.remaining_gap_score, s.null_quantile_alpha, where);
 }
 
