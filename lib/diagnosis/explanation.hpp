@@ -189,9 +189,9 @@ struct Explanation {
 /// admissible trials the largest held-out gain wins, at the first step as
 /// at every other. So every step adds held-out evidence; the cumulative
 /// held-out shrink is reported as it comes (the likelihood is the
-/// criterion), against the shrink's reference (Explanation::
-/// mean_wheel_noise_measured): one G for every step, so a step that never
-/// lowers the held-out G never lowers its shrink either.
+/// criterion), against one reference for every step (the baseline, or
+/// where Explanation::reference_held the shrinks' reference), so a step
+/// that never lowers the held-out G never lowers its shrink either.
 ///
 /// `known`: mean fits already made (FitCandidates' mean_fits: the same
 /// fits, so not repeated). The first step is chosen by the same rule as
