@@ -394,14 +394,9 @@ void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
                                          y.value("effect", "")),
                               y.value("why", "")));
   const auto& v = j.at("verdict");
-  const std::string reference = v.value("shrink_reference", std::string("baseline"));
   const std::string against =
-      reference == "baseline"
-          ? std::string()
-          : fmt::format(" (measured against the baseline's mean seen with the wheel noise left once the mean effects "
-                        "are fitted; {} against the baseline itself, whose fitted wheel noise took part of them in: see "
-                        "the notes)",
-                        Percent(1.0 - Number(v, "heldout_shrink_against_baseline")));
+      diag::ShrinkReferenceClause(v.value("shrink_reference", std::string("baseline")),
+                                  v.value("heldout_shrink_against_baseline", 0.0));
   rep.Paragraph(fmt::format("{} of the gap stays unexplained on held-out runs{}. An effect is negligible when its size is "
                             "below {:.2g} x the noise of one piece (1 m of travel or a spot turn), or, for a noise "
                             "effect, when it widens the pose spread of the pieces it acts on by less than {:.0f}% "

@@ -160,6 +160,18 @@ std::string WherePlace(const DiagnoseSummary& s, const WhereItem& w) {
   return exp + w.subset;
 }
 
+}  // namespace
+
+std::string ShrinkReferenceClause(const std::string& reference, double against_baseline) {
+  if (reference == "baseline") return {};
+  return fmt::format(" (measured against the baseline's mean seen with the wheel noise left once the mean effects are "
+                     "fitted; {:.0f}% against the baseline itself, whose fitted wheel noise took part of them in: see "
+                     "the notes)",
+                     100.0 * (1.0 - against_baseline));
+}
+
+namespace {
+
 /// A named verdict that leaves a significant remainder: what the named
 /// effects close, and where to look for the rest (the explained model's
 /// largest part), so the user does not expect the gap to be gone.

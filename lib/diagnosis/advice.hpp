@@ -44,6 +44,13 @@ std::string FormatPValue(double p);
 std::string EvidenceInWords(double heldout_gain_nats, double evidence_nats, double heldout_shrink,
                             bool noise_effect = false);
 
+/// What the explanation's shrinks are measured against, as a clause for
+/// the line that gives the unexplained share (text and HTML reports): empty
+/// for `reference` "baseline", else the reference (docs/diagnosis.md, "The
+/// shrink's reference") and the share left against the baseline itself
+/// (`against_baseline`: DiagnoseSummary::heldout_shrink_against_baseline).
+std::string ShrinkReferenceClause(const std::string& reference, double against_baseline);
+
 /// What to do next, in order: for `none`, use the model; for a named
 /// verdict, model the effects; for `unexplained`, the largest discrepancy
 /// to look at, the experiments the campaign lacks to tell effects apart,

@@ -525,17 +525,18 @@ void MeasureAgainstMeanWheelNoise(const CampaignData& c, const MeanModel& model,
   ex.mean_wheel_noise_measured = true;
   ex.mean_wheel_noise_k_L = std::sqrt(left.kL2);
   ex.mean_wheel_noise_k_R = std::sqrt(left.kR2);
+  // One reference for the whole explanation (so its steps stay monotone):
+  // the baseline unless it does not see the larger part of the gap closed
+  // and the reference sees more; where it does, the reference is not fitted.
+  if (ex.baseline_heldout_shrink >= min_heldout_shrink) return;
   BaselineFit held = b;
   held.noise.kL2 = left.kL2;
   held.noise.kR2 = left.kR2;
   held.noise_fit.fit_wheel_noise = false;
   const SetFit ref = FitSet(c, model, held, folds, {}, base_mean, gap);
   const double before = Gap(ref.gap_after, null_median), cv_before = Gap(ref.heldout_gap, null_median);
-  // One reference for the whole explanation (so its steps stay monotone):
-  // the baseline unless it does not see the larger part of the gap closed
-  // and the reference sees more.
   const double last = Shrink(Gap(ex.steps.back().heldout_gap_after, null_median), cv_before);
-  if (ex.baseline_heldout_shrink >= min_heldout_shrink || !(last > ex.baseline_heldout_shrink)) return;
+  if (!(last > ex.baseline_heldout_shrink)) return;
   ex.reference_held = true;
   for (std::vector<ExplanationStep>* list : {&ex.steps, &ex.symptoms})
     for (ExplanationStep& s : *list) {

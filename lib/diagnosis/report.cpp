@@ -396,12 +396,7 @@ void ExplanationSection(TextReport& o, const DiagnoseSummary& s) {
       for (const auto& [n, v] : e.params) params += FormatParam(n, v, sim::EffectToString(e.effect)) + "  ";
       o.line(fmt::format("    symptom, not a step: {} {}-- {}", sim::EffectToString(e.effect), params, e.unphysical));
     }
-    const std::string against =
-        s.shrink_reference == "baseline"
-            ? std::string()
-            : fmt::format(" (shrinks against the baseline's mean seen with the wheel noise left once the mean effects "
-                          "are fitted; {:.0f}% against the baseline itself: see the note)",
-                          100.0 * (1.0 - s.heldout_shrink_against_baseline));
+    const std::string against = ShrinkReferenceClause(s.shrink_reference, s.heldout_shrink_against_baseline);
     o.line(fmt::format("    unexplained on held-out runs: {:.0f}%{}; negligible = size below {:.2g} x the noise of one "
                        "piece (<= 1 m of travel or a spot turn); for a noise effect, widening the pose spread of the "
                        "pieces it acts on by less than {:.0f}% (median per piece type, the type it widens most)",
