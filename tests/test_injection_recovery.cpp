@@ -352,6 +352,28 @@ TEST_CASE("diagnose names and sizes effects injected into a real session", "[dia
   }
 }
 
+TEST_CASE("a clock common to all runs comes before the spread of the runs' clocks about it (real s1)",
+          "[diagnose][inject][june]") {
+  // Session 22 (docs/diagnosis.md, "The mean before the spread about it"):
+  // with +80 ms injected into every run of s1 (the harness' seed), the
+  // per-run clock (zero-mean by the contract, tau_sd = 110 ms) took the
+  // common offset as spread and was the verdict; time_offset, tried after
+  // it, lost 27 nats held out and was never named. run_time_offset is now
+  // tried only once time_offset is chosen or may not be a step.
+  const auto clock = DiagnoseS1({"time_offset:tau=0.08"}, 101);
+  INFO(clock["verdict"].dump());
+  CHECK(clock["verdict"]["effect"] == "time_offset");
+  CHECK_FALSE(Named(clock, "run_time_offset"));
+  REQUIRE_FALSE(clock["explanation"].empty());
+  CHECK(clock["explanation"][0]["effect"] == "time_offset");
+  CHECK_THAT(clock["explanation"][0]["params"]["tau"].get<double>(), Catch::Matchers::WithinAbs(0.08, 0.02));
+  // A per-run clock alone (tau_sd = 120 ms, no common one) is still named as
+  // the spread it is.
+  const auto spread = DiagnoseS1({"run_time_offset:tau_sd=0.12"}, 103);
+  INFO(spread["verdict"].dump());
+  CHECK(spread["verdict"]["effect"] == "run_time_offset");
+}
+
 TEST_CASE("a fit outside its physical range, within its standard errors, is a step but never named (real s5)",
           "[diagnose][inject][june]") {
   // Session s5 (Ivanjko paths and circles; harness tuning) with a +1.5 %

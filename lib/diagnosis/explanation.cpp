@@ -6,6 +6,8 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <optional>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -452,8 +454,10 @@ std::string SymptomOf(sim::EffectKind e, const SetFit& f, const std::vector<Cand
 
 /// The next step among `trial` (the chosen set plus remaining[i]) by the
 /// rule of explanation.hpp: the admissible trial with the most held-out
-/// evidence, or -1. Symptoms met on the way (better evidence than the
-/// step) go into ex.symptoms and out of `pool`.
+/// evidence, a spread (Descriptor::spread_of) only while its fixed effect
+/// may not be the step, or -1. Symptoms met on the way (better evidence
+/// than the step, or a spread's fixed effect judged ahead of it) go into
+/// ex.symptoms and out of `pool`.
 int ChooseStep(const std::vector<sim::EffectKind>& remaining, const std::vector<SetFit>& trial, const SetFit& current,
                double null_median, double gap_cv_before, const std::vector<Candidate>& candidates, int runs,
                const ExplanationOptions& options, std::vector<sim::EffectKind>& pool, Explanation& ex) {
@@ -466,8 +470,9 @@ int ChooseStep(const std::vector<sim::EffectKind>& remaining, const std::vector<
   }
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return evidence[a] > evidence[b]; });
   const double shrink_now = Shrink(Gap(current.heldout_gap, null_median), gap_cv_before);
-  for (std::size_t i : order) {
-    if (!(evidence[i] > 0.0)) break;
+  // Whether remaining[i] may be the step (a symptom goes into ex.symptoms
+  // and out of `pool`).
+  const auto admit = [&](std::size_t i) {
     if (std::string why = SymptomOf(remaining[i], trial[i], candidates, runs); !why.empty()) {
       ExplanationStep s;
       s.effect = remaining[i];
@@ -479,12 +484,27 @@ int ChooseStep(const std::vector<sim::EffectKind>& remaining, const std::vector<
       s.heldout_gap_after = trial[i].heldout_gap;
       ex.symptoms.push_back(std::move(s));
       pool.erase(std::remove(pool.begin(), pool.end(), remaining[i]), pool.end());
-      continue;
+      return false;
     }
     // With keep_heldout_shrink, a step never lowers the cumulative held-out shrink.
-    if (options.keep_heldout_shrink && Shrink(Gap(trial[i].heldout_gap, null_median), gap_cv_before) < shrink_now)
-      continue;
-    return static_cast<int>(i);
+    return !(options.keep_heldout_shrink && Shrink(Gap(trial[i].heldout_gap, null_median), gap_cv_before) < shrink_now);
+  };
+  // A spread waits while its fixed effect may be the step
+  // (Descriptor::spread_of): that one is judged first.
+  std::vector<int> may(remaining.size(), -1);  // -1 not judged yet, 0 no, 1 yes
+  const auto ok = [&](std::size_t i) {
+    if (may[i] < 0) may[i] = admit(i) ? 1 : 0;
+    return may[i] == 1;
+  };
+  const auto waits = [&](std::size_t i) {
+    const auto of = effects::Of(remaining[i]).Describe().spread_of;
+    const auto at = of ? static_cast<std::size_t>(std::find(remaining.begin(), remaining.end(), *of) - remaining.begin())
+                       : remaining.size();
+    return at < remaining.size() && evidence[at] > 0.0 && ok(at);
+  };
+  for (std::size_t i : order) {
+    if (!(evidence[i] > 0.0)) break;
+    if (!waits(i) && ok(i)) return static_cast<int>(i);
   }
   return -1;
 }
@@ -600,6 +620,52 @@ std::vector<const Candidate*> ByEvidence(const std::vector<Candidate>& candidate
   return out;
 }
 
+/// The first step by the rule of every step (explanation.hpp), with each
+/// candidate's evidence from stage 3 (the baseline plus that effect,
+/// cross-validated over the same folds), so {e} is fitted here once, not
+/// per candidate: in that order, the first the rule admits under its fit
+/// here is the step; a spread (Descriptor::spread_of) only when its fixed
+/// effect, judged first, may not be. None when no candidate may be.
+std::optional<std::pair<sim::EffectKind, SetFit>> FirstStep(
+    const CampaignData& c, const MeanModel& model, const BaselineFit& b, const Folds& folds, MeanPartCache& means,
+    const std::vector<Candidate>& candidates, const SetFit& base, double null_median, double gap_cv_before, int runs,
+    const ExplanationOptions& options, std::vector<sim::EffectKind>& pool, Explanation& ex, ProgressCounter& progress) {
+  std::map<sim::EffectKind, std::pair<bool, SetFit>> alone;  // may it be the step, its fit
+  const auto judge = [&](sim::EffectKind e) -> const std::pair<bool, SetFit>& {
+    if (const auto it = alone.find(e); it != alone.end()) return it->second;
+    const std::vector<sim::EffectKind> set{e};
+    means.Prepare({set});
+    std::vector<SetFit> trial{FitSet(c, model, b, folds, set, means.Get(set), options.gap)};
+    progress.Add();
+    const bool may = ChooseStep(set, trial, base, null_median, gap_cv_before, candidates, runs, options, pool, ex) == 0;
+    return alone.emplace(e, std::make_pair(may, std::move(trial.front()))).first->second;
+  };
+  const std::vector<const Candidate*> order = ByEvidence(candidates, pool);
+  for (const Candidate* cd : order) {
+    const auto of = effects::Of(cd->effect).Describe().spread_of;
+    if (of && std::any_of(order.begin(), order.end(), [&](const Candidate* k) { return k->effect == *of; }) &&
+        judge(*of).first)
+      continue;  // the spread waits for its fixed effect
+    if (const auto& [may, fit] = judge(cd->effect); may) return std::make_pair(cd->effect, fit);
+  }
+  return std::nullopt;
+}
+
+/// Explanation::symptom_first: a symptom (an impossible fit, not a noise
+/// effect at zero) has more held-out evidence alone (stage 3) than every
+/// candidate in `pool` that may be a step. (A spread is tried after its
+/// fixed effect, so a symptom met before the first step may have less.)
+bool SymptomFirst(const std::vector<Candidate>& candidates, const std::vector<sim::EffectKind>& pool,
+                  const std::vector<ExplanationStep>& symptoms) {
+  double best_step = -std::numeric_limits<double>::infinity();
+  for (const Candidate* cd : ByEvidence(candidates, pool)) best_step = std::max(best_step, cd->evidence);
+  return std::any_of(symptoms.begin(), symptoms.end(), [&](const ExplanationStep& y) {
+    const auto cd = std::find_if(candidates.begin(), candidates.end(), [&](const Candidate& k) { return k.effect == y.effect; });
+    return NullNoiseFit(sim::EffectToString(y.effect), y.params).empty() &&  // impossible, not zero
+           cd != candidates.end() && cd->evidence > best_step;
+  });
+}
+
 /// The backward check (LeastEarning) after the forward selection: while an
 /// effect no longer earns its held-out evidence given the others (a later
 /// step took over what it imitated), it is left out and the others are
@@ -620,8 +686,14 @@ void BackwardCheck(const CampaignData& c, const MeanModel& model, const Baseline
     keep.erase(keep.begin() + k);
     // The first step again by the rule of the first step; the others in
     // their order.
-    if (const auto lead = ByEvidence(candidates, keep); !lead.empty()) {
-      const auto at = std::find(keep.begin(), keep.end(), lead.front()->effect);
+    // (A spread is not first while its fixed effect stays.)
+    const auto lead = ByEvidence(candidates, keep);
+    const auto first = std::find_if(lead.begin(), lead.end(), [&](const Candidate* cd) {
+      const auto of = effects::Of(cd->effect).Describe().spread_of;
+      return !(of && Contains(keep, *of));
+    });
+    if (first != lead.end()) {
+      const auto at = std::find(keep.begin(), keep.end(), (*first)->effect);
       std::rotate(keep.begin(), at, at + 1);
     }
     chosen.clear();
@@ -684,24 +756,11 @@ Explanation Explain(const CampaignData& c, const MeanModel& model, const Baselin
                            static_cast<double>(options.max_effects) * static_cast<double>(std::max<std::size_t>(candidates.size(), 1)));
   const int runs = static_cast<int>(c.runs.size());
   std::vector<sim::EffectKind> pool = Pool(candidates);
-  // The first step by the rule of every step, with each candidate's
-  // evidence from stage 3 (the baseline plus that effect, cross-validated
-  // over the same folds), so {e} is fitted here once, not per candidate:
-  // the first the rule admits under its fit here is the step (else the
-  // loop below tries them all).
-  for (const Candidate* cd : ByEvidence(candidates, pool)) {
-    const std::vector<sim::EffectKind> set{cd->effect};
-    means.Prepare({set});
-    std::vector<SetFit> trial{FitSet(c, model, b, folds, set, means.Get(set), options.gap)};
-    progress.Add();
-    if (ChooseStep(set, trial, current, null_median, gap_cv_before, candidates, runs, options, pool, ex) == 0) {
-      add(cd->effect, trial.front());
-      break;
-    }
-  }
-  ex.symptom_first = std::any_of(ex.symptoms.begin(), ex.symptoms.end(), [](const ExplanationStep& y) {
-    return NullNoiseFit(sim::EffectToString(y.effect), y.params).empty();  // impossible, not zero
-  });
+  // The first step (FirstStep; if none, the loop below tries them all).
+  if (auto first = FirstStep(c, model, b, folds, means, candidates, base, null_median, gap_cv_before, runs, options,
+                             pool, ex, progress))
+    add(first->first, first->second);
+  ex.symptom_first = SymptomFirst(candidates, pool, ex.symptoms);
   ex.stop_reason = "the largest explanation considered";
   while (static_cast<int>(chosen.size()) < options.max_effects) {
     // Called on a significant gap (verdict.hpp, maybe found by the LR tests

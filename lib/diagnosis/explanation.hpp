@@ -182,6 +182,13 @@ struct Explanation {
   bool reference_held = false;
 };
 
+/// A random effect that is the spread about a fixed effect's value
+/// (effects::Descriptor::spread_of: run_time_offset about time_offset) is
+/// tried only once that effect is chosen or may not be a step: a zero-mean
+/// per-run clock takes a clock common to all runs as spread (June session
+/// s1 with +80 ms: tau_sd = 110 ms, and time_offset beside it then lost 27
+/// nats held out). docs/diagnosis.md, "The mean before the spread about it".
+///
 /// The rule that admits a step (docs/diagnosis.md, "The verdict's rule"):
 /// it gains more than the penalty per parameter in held-out log-likelihood
 /// and is no symptom (see Explanation::symptoms); with keep_heldout_shrink

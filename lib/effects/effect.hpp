@@ -204,6 +204,11 @@ struct Descriptor {
   std::vector<int> mean_terms{};
   /// The noise component it switches on (a random effect; kNone else).
   NoiseTerm noise_term = NoiseTerm::kNone;
+  /// A random effect that is the spread about a fixed effect's value (the
+  /// runs' own clocks about the common one): the explanation tries it only
+  /// after that effect, when that one may be a step (the mean before the
+  /// variance about it; docs/diagnosis.md, "The verdict's rule").
+  std::optional<EffectKind> spread_of{};
   /// The id of its own random stream in the simulator (StreamSeed of the
   /// seed and the run; RandomSource of StartRun). Part of every simulated
   /// campaign's bits: never change one. 0: 0x10000 + order.

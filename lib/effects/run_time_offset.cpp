@@ -20,7 +20,8 @@ class RunTimeOffset final : public Effect {
                 .definition =
                     "in run i the ground truth stamped t shows the true pose at t - tau_i, tau_i ~ N(0, tau_sd^2) per run",
                 .parameters = {{"tau_sd", &Effects::run_tau_sd, "s"}},
-                .noise_term = NoiseTerm::kRunTime}) {}
+                .noise_term = NoiseTerm::kRunTime,
+                .spread_of = EffectKind::kTimeOffset}) {}
   Params FromNoise(const NoiseValues& n) const override { return {{"tau_sd", std::sqrt(n.run_tau2)}}; }
 
   // As time_offset, with the spread of the runs' clocks.
