@@ -452,6 +452,10 @@ std::string SymptomOf(sim::EffectKind e, const SetFit& f, const std::vector<Cand
   return NullNoiseFit(name, params);
 }
 
+/// The fixed effect a spread waits for (Descriptor::spread_of), if `e` is
+/// one.
+std::optional<sim::EffectKind> MeanOf(sim::EffectKind e) { return effects::Of(e).Describe().spread_of; }
+
 /// The next step among `trial` (the chosen set plus remaining[i]) by the
 /// rule of explanation.hpp: the admissible trial with the most held-out
 /// evidence, a spread (Descriptor::spread_of) only while its fixed effect
@@ -497,7 +501,7 @@ int ChooseStep(const std::vector<sim::EffectKind>& remaining, const std::vector<
     return may[i] == 1;
   };
   const auto waits = [&](std::size_t i) {
-    const auto of = effects::Of(remaining[i]).Describe().spread_of;
+    const auto of = MeanOf(remaining[i]);
     const auto at = of ? static_cast<std::size_t>(std::find(remaining.begin(), remaining.end(), *of) - remaining.begin())
                        : remaining.size();
     return at < remaining.size() && evidence[at] > 0.0 && ok(at);
@@ -642,7 +646,7 @@ std::optional<std::pair<sim::EffectKind, SetFit>> FirstStep(
   };
   const std::vector<const Candidate*> order = ByEvidence(candidates, pool);
   for (const Candidate* cd : order) {
-    const auto of = effects::Of(cd->effect).Describe().spread_of;
+    const auto of = MeanOf(cd->effect);
     if (of && std::any_of(order.begin(), order.end(), [&](const Candidate* k) { return k->effect == *of; }) &&
         judge(*of).first)
       continue;  // the spread waits for its fixed effect
@@ -689,7 +693,7 @@ void BackwardCheck(const CampaignData& c, const MeanModel& model, const Baseline
     // (A spread is not first while its fixed effect stays.)
     const auto lead = ByEvidence(candidates, keep);
     const auto first = std::find_if(lead.begin(), lead.end(), [&](const Candidate* cd) {
-      const auto of = effects::Of(cd->effect).Describe().spread_of;
+      const auto of = MeanOf(cd->effect);
       return !(of && Contains(keep, *of));
     });
     if (first != lead.end()) {
