@@ -194,8 +194,8 @@ std::vector<const ExplanationStep*> ByEarnings(const Explanation& ex) {
 /// nats), ones fitted outside their physical range within its tolerance
 /// (`outside`, with why) and fits at impossible values (symptoms).
 std::string NotNamedText(const std::vector<std::string>& negligible, const std::vector<std::string>& weak,
-                         const std::vector<std::string>& outside, const std::vector<std::string>& impossible,
-                         double level, double decisive) {
+                         const std::vector<std::string>& outside, const std::vector<std::string>& spreads,
+                         const std::vector<std::string>& impossible, double level, double decisive) {
   std::string text = negligible.empty()
                          ? std::string()
                          : fmt::format("; negligible in practice (size below {:.2g} x the noise of one piece): {}",
@@ -208,6 +208,10 @@ std::string NotNamedText(const std::vector<std::string>& negligible, const std::
     text += fmt::format("; fitted outside the physical range, though within its standard errors of it (no cause a "
                         "robot can have; not named): {}",
                         fmt::join(outside, "; "));
+  if (!spreads.empty())
+    text += fmt::format("; the named mechanisms' scatter about their one value (a spread no larger than the mean it "
+                        "varies about, where it lies; not named): {}",
+                        fmt::join(spreads, "; "));
   if (!impossible.empty())
     text += fmt::format("; fitted at impossible values (a symptom, not named, never a step): {}",
                         fmt::join(impossible, ", "));
@@ -268,7 +272,7 @@ std::string WhyNotEnough(bool one, bool gap_left, bool systematic, double gap_af
 /// Longer than 80 lines (101) on purpose: the three verdicts are one
 /// decision, and each branch only assembles its own sentence.
 void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Verdict& v, DiagnoseSummary& out) {
-  std::vector<std::string> named, negligible, weak, outside, impossible, symptoms;
+  std::vector<std::string> named, negligible, weak, outside, spreads, impossible, symptoms;
   double gain = 0.0;
   for (const ExplanationStep* step : ByEarnings(ex)) {
     const ExplanationStep& s = *step;
@@ -282,6 +286,8 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
       weak.push_back(fmt::format("{} ({:+.1f} nats)", name, s.earned_given_others_nats));
     else if (!s.outside_range.empty())
       outside.push_back(fmt::format("{} ({})", name, s.outside_range));
+    else if (!s.spread_of_named.empty())
+      spreads.push_back(fmt::format("{} (the spread of {} about its value)", name, s.spread_of_named));
     else
       named.push_back(name);
   }
@@ -291,7 +297,7 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
   std::vector<std::string> all_impossible = impossible;
   all_impossible.insert(all_impossible.end(), symptoms.begin(), symptoms.end());
   const std::string not_named =
-      NotNamedText(negligible, weak, outside, all_impossible, options.negligible, options.decisive_nats);
+      NotNamedText(negligible, weak, outside, spreads, all_impossible, options.negligible, options.decisive_nats);
   const double gap_after = ex.steps.empty() ? out.gap_score : ex.steps.back().gap_after;
   // A significant residual is excused when the explanation closes at least
   // full_shrink of the held-out gap: the misfit of the named effects' shape
@@ -320,7 +326,7 @@ void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Ve
   out.remainder_significant = !ex.steps.empty() && ex.gap_left && excused < options.full_shrink;
   const std::string left = WhatIsLeft(ex.gap_left, named.size() == 1 ? "leaves" : "leave", heldout, excused,
                                       gap_after, out.null_quantile_alpha, options.full_shrink);
-  if (closed && named.empty() && weak.empty() && outside.empty() && impossible.empty()) {
+  if (closed && named.empty() && weak.empty() && outside.empty() && spreads.empty() && impossible.empty()) {
     out.verdict = "none";
     out.verdict_reason = fmt::format("the significant gap ({}) is closed by effects too small to matter{}",
                                      v.significance, not_named);
@@ -463,6 +469,7 @@ void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit
             UnphysicalFit(sim::EffectToString(st.effect), st.params, static_cast<int>(c.runs.size()), exact);
       st.not_decisive = st.earned_given_others_nats < options.decisive_nats;
     }
+    MarkSpreads(c, model, base, ex);
     out.explanation = ex.steps;
     if (!ex.steps.empty()) {
       out.explained_E_d = ex.p[kParamEd];

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "core/angles.hpp"
 #include "diagnosis/campaign_scale.hpp"
@@ -723,6 +724,81 @@ void BackwardCheck(const CampaignData& c, const MeanModel& model, const Baseline
 // share the chosen set, the current fit and the cache of mean parts; its
 // pieces with state of their own (set fits, sizing, weights, the
 // reference) are the helpers above.
+namespace {
+
+/// Named by the verdict's filters (diagnose.cpp NameEffects), before
+/// MarkSpreads.
+bool PassesFilters(const ExplanationStep& s) {
+  return s.unphysical.empty() && !s.negligible && !s.not_decisive && s.outside_range.empty();
+}
+
+/// Piece covariance with and without noise term `term` (bumps are not in
+/// PieceCovariance: their variance per metre of each wheel's travel is
+/// added, as in SizeWheelNoiseLike).
+std::pair<Eigen::Matrix3d, Eigen::Matrix3d> WithAndWithout(const PieceBases& B, const NoiseParams& n,
+                                                           effects::NoiseTerm term) {
+  const Eigen::Matrix3d with = PieceCovariance(B, n);
+  NoiseParams without = n;
+  switch (term) {
+    case effects::NoiseTerm::kStandstill: without.stand_xy2 = without.stand_th2 = 0.0; break;
+    case effects::NoiseTerm::kMotionFloor: without.floor_s2 = 0.0; break;
+    case effects::NoiseTerm::kCorrelated: without.c_LR = 0.0; break;
+    case effects::NoiseTerm::kBumps: {
+      const effects::NoiseValues v = NoiseValuesOf(n);
+      return {with + v.bumps_per_m * v.bump_var * (B.A_L + B.A_R), with};
+    }
+    default: return {with, with};
+  }
+  return {with, PieceCovariance(B, without)};
+}
+
+/// The share of the variance noise term `term` adds (each piece's part
+/// relative to its variance without it) that lies on pieces where the
+/// mean moves by `moved - still` at least as far as the term's own sd, in
+/// the component (position or heading) the term widens most there.
+double ShareWithinReach(const CampaignData& c, const Explanation& ex, effects::NoiseTerm term,
+                        const std::vector<Pose2>& moved, const std::vector<Pose2>& still) {
+  double all = 0.0, reach = 0.0;
+  for (std::size_t j = 0; j < c.pieces.size(); ++j) {
+    if (c.pieces[j].components != 3) continue;
+    const auto [A, B0] = WithAndWithout(ex.bases[j], ex.noise, term);
+    const double vp0 = B0(0, 0) + B0(1, 1), vh0 = B0(2, 2);
+    const double dvp = std::abs(A(0, 0) + A(1, 1) - vp0), dvh = std::abs(A(2, 2) - vh0);
+    if (!(dvp > 0.0 || dvh > 0.0)) continue;
+    const double wp = dvp / std::max(vp0, 1e-300), wh = dvh / std::max(vh0, 1e-300);
+    const double dp = std::hypot(moved[j].x - still[j].x, moved[j].y - still[j].y);
+    const double dh = std::abs(WrapAngle(moved[j].theta - still[j].theta));
+    const bool within = wp >= wh ? dp >= std::sqrt(dvp) : dh >= std::sqrt(dvh);
+    all += std::max(wp, wh);
+    if (within) reach += std::max(wp, wh);
+  }
+  return all > 0.0 ? reach / all : 0.0;
+}
+
+}  // namespace
+
+void MarkSpreads(const CampaignData& c, const MeanModel& model, const BaselineFit& b, Explanation& ex) {
+  if (ex.bases.size() != c.pieces.size()) return;
+  std::vector<std::string> mechanisms;
+  ParamVector without = ex.p;
+  for (const ExplanationStep& s : ex.steps) {
+    if (!PassesFilters(s) || effects::Of(s.effect).Class() != effects::EffectClass::kMechanism) continue;
+    mechanisms.push_back(sim::EffectToString(s.effect));
+    for (int k : EffectParams(s.effect)) without[k] = b.p[k];
+  }
+  if (mechanisms.empty()) return;
+  const std::vector<Pose2> moved = model.PredictedPieceMotion(ex.p), still = model.PredictedPieceMotion(without);
+  if (moved.size() != c.pieces.size() || still.size() != c.pieces.size()) return;
+  // The larger part (0.5, the verdict's level everywhere) of the spread
+  // within the mechanisms' reach: a scatter smaller than the mean it
+  // varies about (docs/diagnosis.md, "A noise effect within the
+  // mechanisms' reach").
+  for (ExplanationStep& s : ex.steps)
+    if (PassesFilters(s) && effects::Of(s.effect).PureNoise() &&
+        ShareWithinReach(c, ex, NoiseTermOf(s.effect), moved, still) >= 0.5)
+      s.spread_of_named = fmt::format("{}", fmt::join(mechanisms, " + "));
+}
+
 Explanation Explain(const CampaignData& c, const MeanModel& model, const BaselineFit& b, const Folds& folds,
                     const std::vector<Candidate>& candidates, const std::map<std::vector<int>, MeanFit>& known,
                     double gap_score, double null_median, double null_quantile, const ExplanationOptions& options) {

@@ -119,6 +119,12 @@ struct ExplanationStep {
   /// scrub of k = -0.005, 1.5 SE below 0): a step, never named; why, in
   /// words (filled by Diagnose), else empty.
   std::string outside_range;
+  /// A named noise effect (class noise) whose spread lies, for the larger
+  /// part, on pieces where the named mechanisms move the predicted mean at
+  /// least as far as its own sd there: the mechanisms' scatter about their
+  /// one value, not a cause of its own (MarkSpreads); their names
+  /// ("turn_scrub"), else empty. Such a step is reported, never named.
+  std::string spread_of_named;
 };
 
 /// Decimals to print a relative size with next to the negligible
@@ -181,6 +187,16 @@ struct Explanation {
   /// the baseline (see baseline_heldout_shrink).
   bool reference_held = false;
 };
+
+/// Marks the named noise steps of `ex` that are the named mechanisms'
+/// spread (ExplanationStep::spread_of_named; docs/diagnosis.md, "A noise
+/// effect within the mechanisms' reach"). A contract mechanism has one
+/// value, a real one varies from event to event (a physics engine's turn
+/// scrub k = 0.0151 with sd 0.0007 per spot turn), and that scatter is
+/// taken by a noise effect. Call once the verdict's filters (negligible,
+/// not_decisive, unphysical, outside_range) are set on ex.steps; `b` gives
+/// the values a mechanism's parameters take without it.
+void MarkSpreads(const CampaignData& c, const MeanModel& model, const BaselineFit& b, Explanation& ex);
 
 /// A random effect that is the spread about a fixed effect's value
 /// (effects::Descriptor::spread_of: run_time_offset about time_offset) is

@@ -65,6 +65,7 @@ nlohmann::json ExplanationJson(const DiagnoseSummary& s) {
                      {"negligible", e.negligible},
                      {"not_decisive", e.not_decisive}});
     if (!e.outside_range.empty()) steps.back()["outside_range"] = e.outside_range;
+    if (!e.spread_of_named.empty()) steps.back()["spread_of_named"] = e.spread_of_named;
     if (!e.size_pieces.empty()) steps.back()["size_pieces"] = e.size_pieces;
     if (!e.practical_floor.empty()) steps.back()["practical_floor"] = e.practical_floor;
     // An impossible fit is a symptom, never named (diagnose.cpp NameEffects).
@@ -388,7 +389,9 @@ void ExplanationSection(TextReport& o, const DiagnoseSummary& s) {
                          : e.not_decisive ? fmt::format(" (not decisive: {:+.1f} nats given the others)",
                                                         e.earned_given_others_nats)
                          : !e.outside_range.empty() ? std::string(" (outside the physical range: not named)")
-                                                    : std::string(),
+                         : !e.spread_of_named.empty()
+                             ? fmt::format(" (the spread of {} about its value: not named)", e.spread_of_named)
+                             : std::string(),
                          params));
     }
     for (const auto& e : s.symptoms) {
