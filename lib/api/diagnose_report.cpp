@@ -373,17 +373,20 @@ void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
         : e.value("not_decisive", false) ? fmt::format(" (not decisive: {:+.1f} nats given the others)",
                                                        Number(e, "earned_given_others_nats"))
         : e.contains("outside_range")    ? std::string(" (outside the physical range: not named)")
-                                         : std::string();
-    rows.push_back({fmt::format("{}", ++k), e.value("effect", "?"),
+        : e.contains("spread_of_named")
+            ? fmt::format(" ({}'s spread: not named)", e.value("spread_of_named", "?"))
+            : std::string();
+    // The flag goes with the effect's name (a text column, which wraps).
+    rows.push_back({fmt::format("{}", ++k), e.value("effect", std::string("?")) + flag,
                     ParamsText(e.value("params", nlohmann::json::object()), nlohmann::json::object(), e.value("effect", "")),
                     Percent(Number(e, "cumulative_heldout_shrink")), Percent(Number(e, "cumulative_shrink")),
                     fmt::format("{:.2f} mm / {:.2f} mrad", Number(e, "size_mm"), Number(e, "size_mrad")),
                     // A noise effect's size: the growth of one piece type's spread.
                     e.contains("size_pieces")
-                        ? fmt::format("+{:.0f}% sd of {} pieces{}", 100.0 * Number(e, "relative_size"),
-                                      e.value("size_pieces", "?"), flag)
-                        : fmt::format("{:.{}f}{}", Number(e, "relative_size"),
-                                      diag::RelativeSizeDecimals(Number(e, "relative_size"), threshold), flag)});
+                        ? fmt::format("+{:.0f}% sd of {} pieces", 100.0 * Number(e, "relative_size"),
+                                      e.value("size_pieces", "?"))
+                        : fmt::format("{:.{}f}", Number(e, "relative_size"),
+                                      diag::RelativeSizeDecimals(Number(e, "relative_size"), threshold))});
   }
   rep.Table({"step", "effect", "parameters", "gap closed, held-out", "in-sample", "size over a run",
              "size / noise of one piece"},
@@ -403,7 +406,10 @@ void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
                             "(median per piece type, the type it widens most): then it is reported but never the "
                             "verdict. An effect is not decisive when, given the other effects, the held-out runs are "
                             "less than 100 times more probable with it (after the penalty for its parameters): it "
-                            "stays a step, but the verdict does not name it.",
+                            "stays a step, but the verdict does not name it. A noise effect is a mechanism's spread "
+                            "when the larger part of its scatter lies where that mechanism moves the mean at least as "
+                            "far: the mechanism varies from event to event about its value, and the verdict names "
+                            "the mechanism alone.",
                             Percent(Number(v, "unexplained_fraction")), against, Number(v, "negligible_threshold"),
                             100.0 * Number(v, "negligible_threshold")));
 }

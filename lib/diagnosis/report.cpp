@@ -390,7 +390,7 @@ void ExplanationSection(TextReport& o, const DiagnoseSummary& s) {
                                                         e.earned_given_others_nats)
                          : !e.outside_range.empty() ? std::string(" (outside the physical range: not named)")
                          : !e.spread_of_named.empty()
-                             ? fmt::format(" (the spread of {} about its value: not named)", e.spread_of_named)
+                             ? fmt::format(" ({}'s spread: not named)", e.spread_of_named)
                              : std::string(),
                          params));
     }
