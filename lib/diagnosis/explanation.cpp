@@ -766,7 +766,7 @@ double ShareWithinReach(const CampaignData& c, const Explanation& ex, const std:
                         effects::NoiseTerm term, const std::vector<effects::NoiseTerm>& own,
                         const std::vector<Pose2>& moved, const std::vector<Pose2>& still) {
   const NoiseParams without = WithoutTerm(ex.noise, term);
-  double all = 0.0, reach = 0.0;
+  double all = 0.0, reach = 0.0, all_added = 0.0, reach_added = 0.0;
   for (std::size_t j = 0; j < c.pieces.size(); ++j) {
     if (c.pieces[j].components != 3) continue;
     const PieceBases& B = ex.bases[j];
@@ -775,22 +775,26 @@ double ShareWithinReach(const CampaignData& c, const Explanation& ex, const std:
     const double dvp = std::abs(A(0, 0) + A(1, 1) - vp0), dvh = std::abs(A(2, 2) - vh0);
     if (!(dvp > 0.0 || dvh > 0.0)) continue;
     const double gain = PieceLogLik(&eps[3 * j], 3, B, ex.noise) - PieceLogLik(&eps[3 * j], 3, B, without);
-    if (!(gain > 0.0)) continue;
     double rp = 0.0, rh = 0.0;  // the mechanisms' own random parts' variance here
     for (effects::NoiseTerm t : own) {
       const Eigen::Matrix3d M = A - TotalCovariance(B, WithoutTerm(ex.noise, t));
       rp += std::max(M(0, 0) + M(1, 1), 0.0);
       rh += std::max(M(2, 2), 0.0);
     }
-    const bool position = dvp / std::max(vp0, 1e-300) >= dvh / std::max(vh0, 1e-300);
+    const double wp = dvp / std::max(vp0, 1e-300), wh = dvh / std::max(vh0, 1e-300);
+    const bool position = wp >= wh;
     const double dp = std::hypot(moved[j].x - still[j].x, moved[j].y - still[j].y);
     const double dh = std::abs(WrapAngle(moved[j].theta - still[j].theta));
     const bool within = position ? std::max(dp, std::sqrt(rp)) >= std::sqrt(dvp)
                                  : std::max(dh, std::sqrt(rh)) >= std::sqrt(dvh);
+    const double added = std::max(wp, wh);
+    all_added += added;
+    if (within) reach_added += added;
+    if (!(gain > 0.0)) continue;
     all += gain;
     if (within) reach += gain;
   }
-  return all > 0.0 ? reach / all : 0.0;
+  return std::max(all > 0.0 ? reach / all : 0.0, all_added > 0.0 ? reach_added / all_added : 0.0);
 }
 
 }  // namespace
