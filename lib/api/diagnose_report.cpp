@@ -407,9 +407,9 @@ void ExplanationTable(io::HtmlReport& rep, const nlohmann::json& j) {
                             "verdict. An effect is not decisive when, given the other effects, the held-out runs are "
                             "less than 100 times more probable with it (after the penalty for its parameters): it "
                             "stays a step, but the verdict does not name it. A noise effect is a mechanism's spread "
-                            "when the larger part of its scatter lies where that mechanism moves the mean at least as "
-                            "far: the mechanism varies from event to event about its value, and the verdict names "
-                            "the mechanism alone.",
+                            "when the larger part of its scatter lies where that mechanism moves the mean, or scatters "
+                            "by itself, at least as far: the mechanism varies from event to event about its value, "
+                            "and the verdict names the mechanism alone.",
                             Percent(Number(v, "unexplained_fraction")), against, Number(v, "negligible_threshold"),
                             100.0 * Number(v, "negligible_threshold")));
 }

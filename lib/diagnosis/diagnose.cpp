@@ -255,7 +255,8 @@ std::string WhyNotEnough(bool one, bool gap_left, bool systematic, double gap_af
 /// The verdict from the explanation (docs/diagnosis.md, "The verdict's
 /// rule"): its effects that are neither negligible, nor short of decisive
 /// evidence given the others (ExplanationStep::not_decisive), nor fitted
-/// outside their physical range (ExplanationStep::outside_range), nor
+/// outside their physical range (ExplanationStep::outside_range), nor a
+/// named mechanism's spread (ExplanationStep::spread_of_named), nor
 /// at impossible values (advice.hpp UnphysicalFit, e.g. a negative turn
 /// scrub: a symptom of something else, never a cause) are named when no impossible fit
 /// outranked its first step (Explanation::symptom_first) and either the
@@ -269,7 +270,7 @@ std::string WhyNotEnough(bool one, bool gap_left, bool systematic, double gap_af
 /// effects only (not with effects short of decisive evidence);
 /// else `unexplained`, listing the effects that close part of it.
 /// `v`: stage 5 (significance, and the reason in terms of single fits).
-/// Longer than 80 lines (101) on purpose: the three verdicts are one
+/// Longer than 80 lines (103) on purpose: the three verdicts are one
 /// decision, and each branch only assembles its own sentence.
 void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Verdict& v, DiagnoseSummary& out) {
   std::vector<std::string> named, negligible, weak, outside, spreads, impossible, symptoms;

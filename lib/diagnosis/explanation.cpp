@@ -756,12 +756,16 @@ Eigen::Matrix3d TotalCovariance(const PieceBases& B, const NoiseParams& n) {
   return PieceCovariance(B, n) + v.bumps_per_m * v.bump_var * (B.A_L + B.A_R);
 }
 
-/// The share of noise term `term`'s evidence (each piece's log-likelihood
-/// at the explained noise minus without the term, where positive) that
-/// lies on pieces within the named mechanisms' reach: where their mean
-/// moves (`moved - still`), or their own random parts (`own`: their noise
-/// terms) add, at least the term's own sd, in the component (position or
-/// heading) the term widens most there.
+/// The share of noise term `term` that lies on pieces within the named
+/// mechanisms' reach: where their mean moves (`moved - still`), or their
+/// own random parts (`own`: their noise terms) add, at least the term's
+/// own sd, in the component (position or heading) the term widens most
+/// there. The larger of two shares: of the variance it adds (each piece's
+/// relative to the piece's variance without it) and of its evidence (each
+/// piece's log-likelihood at the explained noise minus without the term,
+/// where positive). A Gaussian term earns where it adds; a mixture of rare
+/// bumps adds on every straight and earns on the few pieces with a large
+/// residual (a swivel castor's first starts).
 double ShareWithinReach(const CampaignData& c, const Explanation& ex, const std::vector<double>& eps,
                         effects::NoiseTerm term, const std::vector<effects::NoiseTerm>& own,
                         const std::vector<Pose2>& moved, const std::vector<Pose2>& still) {
@@ -816,8 +820,8 @@ void MarkSpreads(const CampaignData& c, const MeanModel& model, const BaselineFi
   std::vector<double> eps;
   model.Residuals(ex.p, eps);
   if (eps.size() != 3 * c.pieces.size()) return;
-  // The larger part (0.5, the verdict's level everywhere) of its evidence
-  // within the mechanisms' reach: a scatter no larger than the mean it
+  // The larger part (0.5, the verdict's level everywhere) of it within
+  // the mechanisms' reach: a scatter no larger than the mean it
   // varies about, or than the mechanism's own scatter, where it lies
   // (docs/diagnosis.md, "A noise effect within the mechanisms' reach").
   for (ExplanationStep& s : ex.steps)

@@ -119,11 +119,12 @@ struct ExplanationStep {
   /// scrub of k = -0.005, 1.5 SE below 0): a step, never named; why, in
   /// words (filled by Diagnose), else empty.
   std::string outside_range;
-  /// A named noise effect (class noise) whose spread lies, for the larger
-  /// part, on pieces where the named mechanisms move the predicted mean at
-  /// least as far as its own sd there: the mechanisms' scatter about their
-  /// one value, not a cause of its own (MarkSpreads); their names
-  /// ("turn_scrub"), else empty. Such a step is reported, never named.
+  /// A named noise effect (class noise) whose added variance or evidence
+  /// lies, for the larger part, on pieces where the named mechanisms move
+  /// the predicted mean, or their own random parts add, at least its own
+  /// sd there: the mechanisms' scatter about their one value, not a cause
+  /// of its own (MarkSpreads); their names ("turn_scrub"), else empty.
+  /// Such a step is reported, never named.
   std::string spread_of_named;
 };
 
@@ -192,8 +193,8 @@ struct Explanation {
 /// spread (ExplanationStep::spread_of_named; docs/diagnosis.md, "A noise
 /// effect within the mechanisms' reach"). A contract mechanism has one
 /// value, a real one varies from event to event (a physics engine's turn
-/// scrub k = 0.0151 with sd 0.0007 per spot turn), and that scatter is
-/// taken by a noise effect. Call once the verdict's filters (negligible,
+/// scrub k = 0.0151 with sd 0.0007 per spot turn; a swivel castor's first
+/// kick 6 +- 45 mrad), and that scatter is taken by a noise effect. Call once the verdict's filters (negligible,
 /// not_decisive, unphysical, outside_range) are set on ex.steps; `b` gives
 /// the values a mechanism's parameters take without it.
 void MarkSpreads(const CampaignData& c, const MeanModel& model, const BaselineFit& b, Explanation& ex);
