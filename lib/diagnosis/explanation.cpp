@@ -719,11 +719,6 @@ void BackwardCheck(const CampaignData& c, const MeanModel& model, const Baseline
 
 }  // namespace
 
-// Longer than 80 lines on purpose: one greedy forward selection, then the
-// backward check (BackwardCheck) and the shrinks' reference, whose steps
-// share the chosen set, the current fit and the cache of mean parts; its
-// pieces with state of their own (set fits, sizing, weights, the
-// reference) are the helpers above.
 namespace {
 
 /// Named by the verdict's filters (diagnose.cpp NameEffects), before
@@ -830,6 +825,11 @@ void MarkSpreads(const CampaignData& c, const MeanModel& model, const BaselineFi
       s.spread_of_named = fmt::format("{}", fmt::join(mechanisms, " + "));
 }
 
+// Longer than 80 lines on purpose: one greedy forward selection, then the
+// backward check (BackwardCheck) and the shrinks' reference, whose steps
+// share the chosen set, the current fit and the cache of mean parts; its
+// pieces with state of their own (set fits, sizing, weights, the
+// reference) are the helpers above.
 Explanation Explain(const CampaignData& c, const MeanModel& model, const BaselineFit& b, const Folds& folds,
                     const std::vector<Candidate>& candidates, const std::map<std::vector<int>, MeanFit>& known,
                     double gap_score, double null_median, double null_quantile, const ExplanationOptions& options) {

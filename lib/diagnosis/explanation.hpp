@@ -194,9 +194,10 @@ struct Explanation {
 /// effect within the mechanisms' reach"). A contract mechanism has one
 /// value, a real one varies from event to event (a physics engine's turn
 /// scrub k = 0.0151 with sd 0.0007 per spot turn; a swivel castor's first
-/// kick 6 +- 45 mrad), and that scatter is taken by a noise effect. Call once the verdict's filters (negligible,
-/// not_decisive, unphysical, outside_range) are set on ex.steps; `b` gives
-/// the values a mechanism's parameters take without it.
+/// kick 6 +- 45 mrad), and that scatter is taken by a noise effect. Call
+/// once the verdict's filters (negligible, not_decisive, unphysical,
+/// outside_range) are set on ex.steps; `b` gives the values a mechanism's
+/// parameters take without it.
 void MarkSpreads(const CampaignData& c, const MeanModel& model, const BaselineFit& b, Explanation& ex);
 
 /// A random effect that is the spread about a fixed effect's value
