@@ -210,7 +210,7 @@ std::string NotNamedText(const std::vector<std::string>& negligible, const std::
                         fmt::join(outside, "; "));
   if (!spreads.empty())
     text += fmt::format("; the named mechanisms' scatter about their one value (a spread no larger than the mean it "
-                        "varies about, where it lies; not named): {}",
+                        "varies about, or than the mechanism's own scatter, where it lies; not named): {}",
                         fmt::join(spreads, "; "));
   if (!impossible.empty())
     text += fmt::format("; fitted at impossible values (a symptom, not named, never a step): {}",
