@@ -270,7 +270,7 @@ std::string WhyNotEnough(bool one, bool gap_left, bool systematic, double gap_af
 /// effects only (not with effects short of decisive evidence);
 /// else `unexplained`, listing the effects that close part of it.
 /// `v`: stage 5 (significance, and the reason in terms of single fits).
-/// Longer than 80 lines (103) on purpose: the three verdicts are one
+/// Longer than 80 lines (about 100) on purpose: the three verdicts are one
 /// decision, and each branch only assembles its own sentence.
 void NameEffects(const Explanation& ex, const DiagnoseOptions& options, const Verdict& v, DiagnoseSummary& out) {
   std::vector<std::string> named, negligible, weak, outside, spreads, impossible, symptoms;

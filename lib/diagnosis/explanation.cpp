@@ -202,6 +202,30 @@ double Median(std::vector<double> v) {
   return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
 }
 
+/// `n` without noise term `term` (a mechanism's own random parts for
+/// kFirstStart: castor_swivel's kick scatter and first start).
+NoiseParams WithoutTerm(NoiseParams n, effects::NoiseTerm term) {
+  switch (term) {
+    case effects::NoiseTerm::kStandstill: n.stand_xy2 = n.stand_th2 = 0.0; break;
+    case effects::NoiseTerm::kMotionFloor: n.floor_s2 = 0.0; break;
+    case effects::NoiseTerm::kCorrelated: n.c_LR = 0.0; break;
+    case effects::NoiseTerm::kBumps: n.bump_rate = n.bump_s2 = 0.0; break;
+    case effects::NoiseTerm::kFirstStart:
+      n.swivel_rev2 = n.first_start2 = n.first_start_xy2 = n.turn_start2 = 0.0;
+      break;
+    default: break;
+  }
+  return n;
+}
+
+/// Piece covariance under `n`, the bumps' variance per metre of each
+/// wheel's travel included (PieceCovariance leaves them out; as in
+/// SizeWheelNoiseLike).
+Eigen::Matrix3d TotalCovariance(const PieceBases& B, const NoiseParams& n) {
+  const effects::NoiseValues v = NoiseValuesOf(n);
+  return PieceCovariance(B, n) + v.bumps_per_m * v.bump_var * (B.A_L + B.A_R);
+}
+
 /// The scatter of one piece's relative motion under the explained model
 /// (the last step's noise, Gaussian part): RMS over the pieces (those with
 /// heading) of the predicted position and heading sd. Not the baseline's:
@@ -255,8 +279,7 @@ bool SizeWheelNoiseLike(const BaselineFit& base, const std::vector<PieceBases>& 
   if (term == effects::NoiseTerm::kCorrelated) {
     const double ratio = kbar2 > 0.0 ? f.noise.c_LR / kbar2 : 0.0;
     s.relative_size = std::abs(std::sqrt(std::max(0.0, 1.0 + ratio)) - 1.0);
-    NoiseParams without = f.noise;
-    without.c_LR = 0.0;
+    const NoiseParams without = WithoutTerm(f.noise, term);
     MedianSdChange(
         bases.size(), [&](std::size_t j) -> Eigen::Matrix3d { return PieceCovariance(bases[j], f.noise); },
         [&](std::size_t j) -> Eigen::Matrix3d { return PieceCovariance(bases[j], without); }, s);
@@ -267,8 +290,7 @@ bool SizeWheelNoiseLike(const BaselineFit& base, const std::vector<PieceBases>& 
     const double b2 = v.bumps_per_m * v.bump_var;
     s.relative_size = kbar2 > 0.0 ? std::sqrt(1.0 + b2 / kbar2) - 1.0 : 1.0;
     MedianSdChange(
-        bases.size(),
-        [&](std::size_t j) -> Eigen::Matrix3d { return PieceCovariance(bases[j], f.noise) + b2 * (bases[j].A_L + bases[j].A_R); },
+        bases.size(), [&](std::size_t j) -> Eigen::Matrix3d { return TotalCovariance(bases[j], f.noise); },
         [&](std::size_t j) -> Eigen::Matrix3d { return PieceCovariance(bases[j], f.noise); }, s);
     return true;
   }
@@ -302,9 +324,7 @@ void SizeVarianceComponent(const CampaignData& c, const std::vector<PieceBases>&
   // heading sd (the larger counts), and its own sd there [mm, mrad]; the
   // type where that median is largest counts (types with fewer than
   // kMinPiecesPerType such pieces only when no type has that many).
-  NoiseParams without = f.noise;
-  if (NoiseTermOf(e) == effects::NoiseTerm::kStandstill) without.stand_xy2 = without.stand_th2 = 0.0;
-  if (NoiseTermOf(e) == effects::NoiseTerm::kMotionFloor) without.floor_s2 = 0.0;
+  const NoiseParams without = WithoutTerm(f.noise, NoiseTermOf(e));
   struct Spread {
     std::vector<double> rel, pos, head;
   };
@@ -725,30 +745,6 @@ namespace {
 /// MarkSpreads.
 bool PassesFilters(const ExplanationStep& s) {
   return s.unphysical.empty() && !s.negligible && !s.not_decisive && s.outside_range.empty();
-}
-
-/// `n` without noise term `term` (a mechanism's own random parts for
-/// kFirstStart: castor_swivel's kick scatter and first start).
-NoiseParams WithoutTerm(NoiseParams n, effects::NoiseTerm term) {
-  switch (term) {
-    case effects::NoiseTerm::kStandstill: n.stand_xy2 = n.stand_th2 = 0.0; break;
-    case effects::NoiseTerm::kMotionFloor: n.floor_s2 = 0.0; break;
-    case effects::NoiseTerm::kCorrelated: n.c_LR = 0.0; break;
-    case effects::NoiseTerm::kBumps: n.bump_rate = n.bump_s2 = 0.0; break;
-    case effects::NoiseTerm::kFirstStart:
-      n.swivel_rev2 = n.first_start2 = n.first_start_xy2 = n.turn_start2 = 0.0;
-      break;
-    default: break;
-  }
-  return n;
-}
-
-/// Piece covariance under `n`, the bumps' variance per metre of each
-/// wheel's travel included (PieceCovariance leaves them out; as in
-/// SizeWheelNoiseLike).
-Eigen::Matrix3d TotalCovariance(const PieceBases& B, const NoiseParams& n) {
-  const effects::NoiseValues v = NoiseValuesOf(n);
-  return PieceCovariance(B, n) + v.bumps_per_m * v.bump_var * (B.A_L + B.A_R);
 }
 
 /// The share of noise term `term` that lies on pieces within the named

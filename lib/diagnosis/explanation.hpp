@@ -123,7 +123,7 @@ struct ExplanationStep {
   /// lies, for the larger part, on pieces where the named mechanisms move
   /// the predicted mean, or their own random parts add, at least its own
   /// sd there: the mechanisms' scatter about their one value, not a cause
-  /// of its own (MarkSpreads); their names ("turn_scrub"), else empty.
+  /// of its own (MarkSpreads); their names, joined by " + ", else empty.
   /// Such a step is reported, never named.
   std::string spread_of_named;
 };
