@@ -20,6 +20,7 @@
 #include "diagnosis/cross_validation.hpp"
 #include "diagnosis/design_check.hpp"
 #include "diagnosis/explanation.hpp"
+#include "diagnosis/mechanism_spread.hpp"
 #include "diagnosis/mean_fit.hpp"
 #include "diagnosis/null_distribution.hpp"
 #include "diagnosis/return_check.hpp"

@@ -10,7 +10,6 @@
 #include <utility>
 
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 
 #include "core/angles.hpp"
 #include "diagnosis/campaign_scale.hpp"
@@ -200,30 +199,6 @@ double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t m = v.size() / 2;
   return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
-}
-
-/// `n` without noise term `term` (a mechanism's own random parts for
-/// kFirstStart: castor_swivel's kick scatter and first start).
-NoiseParams WithoutTerm(NoiseParams n, effects::NoiseTerm term) {
-  switch (term) {
-    case effects::NoiseTerm::kStandstill: n.stand_xy2 = n.stand_th2 = 0.0; break;
-    case effects::NoiseTerm::kMotionFloor: n.floor_s2 = 0.0; break;
-    case effects::NoiseTerm::kCorrelated: n.c_LR = 0.0; break;
-    case effects::NoiseTerm::kBumps: n.bump_rate = n.bump_s2 = 0.0; break;
-    case effects::NoiseTerm::kFirstStart:
-      n.swivel_rev2 = n.first_start2 = n.first_start_xy2 = n.turn_start2 = 0.0;
-      break;
-    default: break;
-  }
-  return n;
-}
-
-/// Piece covariance under `n`, the bumps' variance per metre of each
-/// wheel's travel included (PieceCovariance leaves them out; as in
-/// SizeWheelNoiseLike).
-Eigen::Matrix3d TotalCovariance(const PieceBases& B, const NoiseParams& n) {
-  const effects::NoiseValues v = NoiseValuesOf(n);
-  return PieceCovariance(B, n) + v.bumps_per_m * v.bump_var * (B.A_L + B.A_R);
 }
 
 /// The scatter of one piece's relative motion under the explained model
@@ -738,88 +713,6 @@ void BackwardCheck(const CampaignData& c, const MeanModel& model, const Baseline
 }
 
 }  // namespace
-
-namespace {
-
-/// Named by the verdict's filters (diagnose.cpp NameEffects), before
-/// MarkSpreads.
-bool PassesFilters(const ExplanationStep& s) {
-  return s.unphysical.empty() && !s.negligible && !s.not_decisive && s.outside_range.empty();
-}
-
-/// The share of noise term `term` that lies on pieces within the named
-/// mechanisms' reach: where their mean moves (`moved - still`), or their
-/// own random parts (`own`: their noise terms) add, at least the term's
-/// own sd, in the component (position or heading) the term widens most
-/// there. The larger of two shares: of the variance it adds (each piece's
-/// relative to the piece's variance without it) and of its evidence (each
-/// piece's log-likelihood at the explained noise minus without the term,
-/// where positive). A Gaussian term earns where it adds; a mixture of rare
-/// bumps adds on every straight and earns on the few pieces with a large
-/// residual (a swivel castor's first starts).
-double ShareWithinReach(const CampaignData& c, const Explanation& ex, const std::vector<double>& eps,
-                        effects::NoiseTerm term, const std::vector<effects::NoiseTerm>& own,
-                        const std::vector<Pose2>& moved, const std::vector<Pose2>& still) {
-  const NoiseParams without = WithoutTerm(ex.noise, term);
-  double all = 0.0, reach = 0.0, all_added = 0.0, reach_added = 0.0;
-  for (std::size_t j = 0; j < c.pieces.size(); ++j) {
-    if (c.pieces[j].components != 3) continue;
-    const PieceBases& B = ex.bases[j];
-    const Eigen::Matrix3d A = TotalCovariance(B, ex.noise), B0 = TotalCovariance(B, without);
-    const double vp0 = B0(0, 0) + B0(1, 1), vh0 = B0(2, 2);
-    const double dvp = std::abs(A(0, 0) + A(1, 1) - vp0), dvh = std::abs(A(2, 2) - vh0);
-    if (!(dvp > 0.0 || dvh > 0.0)) continue;
-    const double gain = PieceLogLik(&eps[3 * j], 3, B, ex.noise) - PieceLogLik(&eps[3 * j], 3, B, without);
-    double rp = 0.0, rh = 0.0;  // the mechanisms' own random parts' variance here
-    for (effects::NoiseTerm t : own) {
-      const Eigen::Matrix3d M = A - TotalCovariance(B, WithoutTerm(ex.noise, t));
-      rp += std::max(M(0, 0) + M(1, 1), 0.0);
-      rh += std::max(M(2, 2), 0.0);
-    }
-    const double wp = dvp / std::max(vp0, 1e-300), wh = dvh / std::max(vh0, 1e-300);
-    const bool position = wp >= wh;
-    const double dp = std::hypot(moved[j].x - still[j].x, moved[j].y - still[j].y);
-    const double dh = std::abs(WrapAngle(moved[j].theta - still[j].theta));
-    const bool within = position ? std::max(dp, std::sqrt(rp)) >= std::sqrt(dvp)
-                                 : std::max(dh, std::sqrt(rh)) >= std::sqrt(dvh);
-    const double added = std::max(wp, wh);
-    all_added += added;
-    if (within) reach_added += added;
-    if (!(gain > 0.0)) continue;
-    all += gain;
-    if (within) reach += gain;
-  }
-  return std::max(all > 0.0 ? reach / all : 0.0, all_added > 0.0 ? reach_added / all_added : 0.0);
-}
-
-}  // namespace
-
-void MarkSpreads(const CampaignData& c, const MeanModel& model, const BaselineFit& b, Explanation& ex) {
-  if (ex.bases.size() != c.pieces.size()) return;
-  std::vector<std::string> mechanisms;
-  std::vector<effects::NoiseTerm> own;  // the mechanisms' own random parts
-  ParamVector without = ex.p;
-  for (const ExplanationStep& s : ex.steps) {
-    if (!PassesFilters(s) || effects::Of(s.effect).Class() != effects::EffectClass::kMechanism) continue;
-    mechanisms.push_back(sim::EffectToString(s.effect));
-    for (int k : EffectParams(s.effect)) without[k] = b.p[k];
-    if (NoiseTermOf(s.effect) != effects::NoiseTerm::kNone) own.push_back(NoiseTermOf(s.effect));
-  }
-  if (mechanisms.empty()) return;
-  const std::vector<Pose2> moved = model.PredictedPieceMotion(ex.p), still = model.PredictedPieceMotion(without);
-  if (moved.size() != c.pieces.size() || still.size() != c.pieces.size()) return;
-  std::vector<double> eps;
-  model.Residuals(ex.p, eps);
-  if (eps.size() != 3 * c.pieces.size()) return;
-  // The larger part (0.5, the verdict's level everywhere) of it within
-  // the mechanisms' reach: a scatter no larger than the mean it
-  // varies about, or than the mechanism's own scatter, where it lies
-  // (docs/diagnosis.md, "A noise effect within the mechanisms' reach").
-  for (ExplanationStep& s : ex.steps)
-    if (PassesFilters(s) && effects::Of(s.effect).PureNoise() &&
-        ShareWithinReach(c, ex, eps, NoiseTermOf(s.effect), own, moved, still) >= 0.5)
-      s.spread_of_named = fmt::format("{}", fmt::join(mechanisms, " + "));
-}
 
 // Longer than 80 lines on purpose: one greedy forward selection, then the
 // backward check (BackwardCheck) and the shrinks' reference, whose steps

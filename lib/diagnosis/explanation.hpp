@@ -123,7 +123,7 @@ struct ExplanationStep {
   /// lies, for the larger part, on pieces where the named mechanisms move
   /// the predicted mean, or their own random parts add, at least its own
   /// sd there: the mechanisms' scatter about their one value, not a cause
-  /// of its own (MarkSpreads); their names, joined by " + ", else empty.
+  /// of its own (mechanism_spread.hpp MarkSpreads); their names, joined by " + ", else empty.
   /// Such a step is reported, never named.
   std::string spread_of_named;
 };
@@ -188,17 +188,6 @@ struct Explanation {
   /// the baseline (see baseline_heldout_shrink).
   bool reference_held = false;
 };
-
-/// Marks the named noise steps of `ex` that are the named mechanisms'
-/// spread (ExplanationStep::spread_of_named; docs/diagnosis.md, "A noise
-/// effect within the mechanisms' reach"). A contract mechanism has one
-/// value, a real one varies from event to event (a physics engine's turn
-/// scrub k = 0.0151 with sd 0.0007 per spot turn; a swivel castor's first
-/// kick 6 +- 45 mrad), and that scatter is taken by a noise effect. Call
-/// once the verdict's filters (negligible, not_decisive, unphysical,
-/// outside_range) are set on ex.steps; `b` gives the values a mechanism's
-/// parameters take without it.
-void MarkSpreads(const CampaignData& c, const MeanModel& model, const BaselineFit& b, Explanation& ex);
 
 /// A random effect that is the spread about a fixed effect's value
 /// (effects::Descriptor::spread_of: run_time_offset about time_offset) is

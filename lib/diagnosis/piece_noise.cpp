@@ -27,6 +27,24 @@ Eigen::Matrix3d PieceCovariance(const PieceBases& B, const NoiseParams& n) {
          n.first_start_xy2 * B.P_xy + n.turn_start2 * B.P_turn;
 }
 
+Eigen::Matrix3d TotalCovariance(const PieceBases& B, const NoiseParams& n) {
+  return PieceCovariance(B, n) + n.bump_rate * n.bump_s2 * (B.A_L + B.A_R);
+}
+
+NoiseParams WithoutTerm(NoiseParams n, effects::NoiseTerm term) {
+  switch (term) {
+    case effects::NoiseTerm::kStandstill: n.stand_xy2 = n.stand_th2 = 0.0; break;
+    case effects::NoiseTerm::kMotionFloor: n.floor_s2 = 0.0; break;
+    case effects::NoiseTerm::kCorrelated: n.c_LR = 0.0; break;
+    case effects::NoiseTerm::kBumps: n.bump_rate = n.bump_s2 = 0.0; break;
+    case effects::NoiseTerm::kFirstStart:
+      n.swivel_rev2 = n.first_start2 = n.first_start_xy2 = n.turn_start2 = 0.0;
+      break;
+    default: break;
+  }
+  return n;
+}
+
 BumpMixture PieceMixture(const PieceBases& B, const NoiseParams& n) {
   BumpMixture m;
   m.cov[0] = PieceCovariance(B, n);

@@ -31,6 +31,7 @@
 #include <Eigen/Core>
 
 #include "diagnosis/model.hpp"
+#include "effects/effect.hpp"
 
 namespace umbmark::diag {
 
@@ -62,6 +63,15 @@ struct NoiseParams {
 
 /// Covariance of piece j (Gaussian part: no bumps).
 Eigen::Matrix3d PieceCovariance(const PieceBases& B, const NoiseParams& n);
+
+/// Piece covariance with the bumps' variance per metre of each wheel's
+/// travel added (rate x sigma_b^2, as k^2 in eq. 4).
+Eigen::Matrix3d TotalCovariance(const PieceBases& B, const NoiseParams& n);
+
+/// `n` without the variance term `term` (kFirstStart: castor_swivel's kick
+/// scatter and first start; kRunTime and kNone: unchanged), to measure what
+/// one noise effect adds.
+NoiseParams WithoutTerm(NoiseParams n, effects::NoiseTerm term);
 
 /// Largest bump rate FitBumps fits [per metre of wheel travel]: a fit at
 /// this bound is the Gaussian limit of bumps (many small ones: wheel noise).
