@@ -101,6 +101,26 @@ TEST_CASE("DART campaigns: fitted sizes match the engine's", "[diagnose][dart]")
   }
 }
 
+TEST_CASE("DART campaigns: the explained model's E_b is the engine's where the baseline's is not", "[diagnose][dart]") {
+  // The baseline fits E_d, E_b with no effect and takes part of the cause in
+  // (the marker: 0.9979 for the engine's 0.9791); the explained model fits
+  // them with the named effects (verdict.explained_model). Reference: the
+  // engine's true wheelbase over the nominal (truth.md).
+  for (const std::string cls : {"marker_offset", "stop_slide", "turn_scrub_scatter"}) {
+    const auto& j = Diagnose(cls);
+    const double E_b = TruthNumber(cls, R"(\(E_b ([0-9.]+)\))");
+    const auto& e = j["verdict"]["explained_model"];
+    INFO(cls << ": " << j["verdict"].dump());
+    REQUIRE(e.is_object());
+    CHECK_THAT(e["E_b"].get<double>(), WithinAbs(E_b, 1e-3));
+    CHECK(std::abs(j["baseline"]["E_b"].get<double>() - E_b) > 3e-3);
+    // The robot it describes: wheelbase E_b b on the manifest's b.
+    const double b = TruthNumber(cls, R"(wheelbase [0-9.]+ m vs ([0-9.]+))");
+    CHECK_THAT(e["wheelbase_m"].get<double>(), WithinAbs(e["E_b"].get<double>() * b, 1e-9));
+  }
+  CHECK(Diagnose("clean")["verdict"]["explained_model"].is_null());
+}
+
 TEST_CASE("DART campaigns: sliding stops are named stop_slide, never a clock", "[diagnose][dart]") {
   const auto& j = Diagnose("stop_slide");
   INFO(j["verdict"].dump());

@@ -28,6 +28,7 @@
 #include "diagnosis/verdict.hpp"
 #include "diagnosis/where.hpp"
 #include "effects/registry.hpp"
+#include "model/true_robot.hpp"
 #include "planning/advice.hpp"
 
 namespace umbmark::diag {
@@ -476,6 +477,11 @@ void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit
     if (!ex.steps.empty()) {
       out.explained_E_d = ex.p[kParamEd];
       out.explained_E_b = ex.p[kParamEb];
+      if (!base.given) {
+        out.explained_wheelbase_m = out.explained_E_b * c.robot.wheelbase_m;
+        out.explained_diameter_left_m = CorrectionLeft(out.explained_E_d) * c.robot.wheel_diameter_left_m;
+        out.explained_diameter_right_m = CorrectionRight(out.explained_E_d) * c.robot.wheel_diameter_right_m;
+      }
     }
     out.explanation_stop = ex.stop_reason;
     out.symptoms = ex.symptoms;

@@ -229,6 +229,11 @@ struct DiagnoseSummary {
   /// baseline leaves out can drive its E_b far off (s4 of the June
   /// sessions with a 47 mm marker: E_b 1.245; explained, 1.00).
   double explained_E_d = 1.0, explained_E_b = 1.0;
+  /// The robot those E_d, E_b describe (B&F eqs. 4.31, 4.32 on the
+  /// manifest's robot: wheelbase E_b b, diameters c_L D_L, c_R D_R) [m];
+  /// 0 when there is no explanation step or the model is given. Printed
+  /// beside the baseline's (JSON verdict.explained_model).
+  double explained_wheelbase_m = 0.0, explained_diameter_left_m = 0.0, explained_diameter_right_m = 0.0;
   std::string explanation_stop;
   /// Fits the explanation met that no robot can have, or noise effects at
   /// zero (Explanation::symptoms): symptoms, never steps (JSON `symptoms`).
