@@ -121,6 +121,31 @@ TEST_CASE("DART campaigns: the explained model's E_b is the engine's where the b
   CHECK(Diagnose("clean")["verdict"]["explained_model"].is_null());
 }
 
+TEST_CASE("DART campaigns: a clock the stops pull off is flagged against the moving samples", "[diagnose][dart]") {
+  // Robot A, a sliding stop and a +34.0 ms clock (seed 10415): the fit on
+  // all pieces takes part of the slide into the clock; the moving samples
+  // alone (clock_check) are the engine's. Reference: truth.md.
+  const auto& j = Diagnose("slide_clock");
+  const double tau = TruthNumber("slide_clock", R"(clock offset ([-+0-9.]+) ms)") * 1e-3;
+  const auto* c = Candidate(j, "time_offset");
+  REQUIRE(c != nullptr);
+  const auto& k = (*c)["clock_check"];
+  const double se = k["moving_se_s"].get<double>();
+  CHECK(std::abs(k["moving_value_s"].get<double>() - tau) < 2.0 * se);
+  double explained = std::numeric_limits<double>::quiet_NaN();
+  for (const auto& st : j["explanation"])
+    if (st["effect"] == "time_offset") explained = st["params"]["tau"].get<double>();
+  CHECK(std::abs(explained - tau) > 3.0 * se);
+  const auto warned = [](const nlohmann::json& d) {
+    return std::any_of(d["warnings"].begin(), d["warnings"].end(), [](const nlohmann::json& w) {
+      return w.get<std::string>().rfind("time_offset: the explanation's tau", 0) == 0;
+    });
+  };
+  CHECK(warned(j));
+  // A clock alone (the engine's -28.7 ms, fitted within 3 ms above): no warning.
+  CHECK_FALSE(warned(Diagnose("clock_fixed")));
+}
+
 TEST_CASE("DART campaigns: sliding stops are named stop_slide, never a clock", "[diagnose][dart]") {
   const auto& j = Diagnose("stop_slide");
   INFO(j["verdict"].dump());

@@ -398,6 +398,44 @@ std::string RepeatsAdvice(const RepeatNoise& r, double bl, double br, double kl,
                    : "nearer the baseline's, so the mean effects may not be all the difference");
 }
 
+/// A named clock whose value in the explanation the moving samples alone
+/// (Candidate::ClockCheck: where a slide or a scrub at the stops cannot
+/// act) contradict by more than 3 of their standard errors, the check's own
+/// level, and by more than the effect's own practical floor at the
+/// campaign's speeds (a 0.5 ms difference 5 standard errors out is no
+/// reason to re-record): a warning and what to record (docs/diagnosis.md,
+/// "The clock's size beside a slide or a turn scrub"). Only effects with
+/// one parameter and a check with a standard error (the fixed clock).
+std::vector<std::string> ClockDisagreements(const CampaignData& c, double negligible, const DiagnoseSummary& out) {
+  const effects::CampaignScale campaign = CampaignScaleOf(c, negligible);
+  std::vector<std::string> w;
+  for (const ExplanationStep& st : out.explanation) {
+    const std::string name = sim::EffectToString(st.effect);
+    if (st.params.size() != 1 ||
+        std::find(out.verdict_effects.begin(), out.verdict_effects.end(), name) == out.verdict_effects.end())
+      continue;
+    for (const Candidate& cd : out.candidates) {
+      const Candidate::ClockCheck& k = cd.clock;
+      if (cd.effect != st.effect || !k.checked || !k.supported || !(k.se > 0.0)) continue;
+      const auto& [param, value] = *st.params.begin();
+      const double z = (value - k.value) / k.se;
+      if (std::abs(z) <= 3.0 || !PracticalFloor(st.effect, {{param, value - k.value}}, campaign).empty()) continue;
+      const double d = std::abs(value - k.value);
+      w.push_back(fmt::format(
+          "{}: the explanation's {} = {:.1f} ms, but the moving samples alone (the ends of {} pieces in a motion's "
+          "cruise, where a slide or a scrub at the stops cannot act) give {:.1f} +- {:.1f} ms: {:.1f} ms apart ({:.1f} "
+          "of their standard errors; {:.2f} mm at the campaign's {:.2f} m/s, {:.2f} mrad at {:.2f} rad/s). Something at "
+          "the stops pulls the fit on all pieces (on the physics engine a sliding stop or a turn scrub did, and the "
+          "moving samples were right). Where that difference matters, record runs with long stretches at constant "
+          "speed and diagnose them alone before shifting the timestamps",
+          name, param, 1e3 * value, k.pieces, 1e3 * k.value, 1e3 * k.se, 1e3 * d, std::abs(z),
+          1e3 * d * campaign.speed_mps, campaign.speed_mps, 1e3 * d * campaign.turn_rate_radps,
+          campaign.turn_rate_radps));
+    }
+  }
+  return w;
+}
+
 /// What the baseline's wheel noise took in (docs/diagnosis.md): a note
 /// when a k of the baseline is more than 1.5 x (the level of the repeated
 /// runs' check, RepeatDisagreement) the k its pieces show once the
@@ -500,6 +538,7 @@ void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit
     out.heldout_shrink_against_baseline = ex.baseline_heldout_shrink;
     if (std::string n = WheelNoiseTookIn(ex, out); !n.empty()) out.notes.push_back(std::move(n));
     NameEffects(ex, options, v, out);
+    for (std::string& w : ClockDisagreements(c, options.negligible, out)) out.warnings.push_back(std::move(w));
     explained = std::move(ex);
     timer.Lap("stepwise explanation");
   }
