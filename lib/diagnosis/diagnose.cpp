@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "calibration/umbmark.hpp"
 #include "core/errors.hpp"
 #include "diagnosis/campaign_scale.hpp"
 #include "diagnosis/advice.hpp"
@@ -28,7 +29,6 @@
 #include "diagnosis/verdict.hpp"
 #include "diagnosis/where.hpp"
 #include "effects/registry.hpp"
-#include "model/true_robot.hpp"
 #include "planning/advice.hpp"
 
 namespace umbmark::diag {
@@ -121,6 +121,12 @@ BaselineSummary Summarise(const CampaignData& c, const BaselineStart& start, con
   return bs;
 }
 
+/// Whether the verdict names `effect` (out.verdict_effects).
+bool Named(const DiagnoseSummary& out, sim::EffectKind effect) {
+  const std::string name = sim::EffectToString(effect);
+  return std::find(out.verdict_effects.begin(), out.verdict_effects.end(), name) != out.verdict_effects.end();
+}
+
 /// With a given model: parameters in the user's terms (baseline_given.hpp)
 /// and the corrections for every parameter error the verdict names.
 void DescribeGivenModel(const CampaignData& c, const GivenModel& given, DiagnoseSummary& out) {
@@ -130,9 +136,7 @@ void DescribeGivenModel(const CampaignData& c, const GivenModel& given, Diagnose
   }
   for (ExplanationStep& s : out.explanation) {
     s.params = DescribeGivenParams(s.effect, s.params, c.robot, given);
-    const bool named = std::find(out.verdict_effects.begin(), out.verdict_effects.end(),
-                                 sim::EffectToString(s.effect)) != out.verdict_effects.end();
-    if (!named || !sim::IsParameterError(s.effect)) continue;
+    if (!Named(out, s.effect) || !sim::IsParameterError(s.effect)) continue;
     for (ParameterCorrection& pc : Corrections(s.effect, s.params, given, out.negligible_threshold)) out.corrections.push_back(std::move(pc));
   }
 }
@@ -410,10 +414,8 @@ std::vector<std::string> ClockDisagreements(const CampaignData& c, double neglig
   const effects::CampaignScale campaign = CampaignScaleOf(c, negligible);
   std::vector<std::string> w;
   for (const ExplanationStep& st : out.explanation) {
+    if (st.params.size() != 1 || !Named(out, st.effect)) continue;
     const std::string name = sim::EffectToString(st.effect);
-    if (st.params.size() != 1 ||
-        std::find(out.verdict_effects.begin(), out.verdict_effects.end(), name) == out.verdict_effects.end())
-      continue;
     for (const Candidate& cd : out.candidates) {
       const Candidate::ClockCheck& k = cd.clock;
       if (cd.effect != st.effect || !k.checked || !k.supported || !(k.se > 0.0)) continue;
@@ -516,9 +518,10 @@ void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit
       out.explained_E_d = ex.p[kParamEd];
       out.explained_E_b = ex.p[kParamEb];
       if (!base.given) {
-        out.explained_wheelbase_m = out.explained_E_b * c.robot.wheelbase_m;
-        out.explained_diameter_left_m = CorrectionLeft(out.explained_E_d) * c.robot.wheel_diameter_left_m;
-        out.explained_diameter_right_m = CorrectionRight(out.explained_E_d) * c.robot.wheel_diameter_right_m;
+        const RobotParams r = ApplyCorrection(c.robot, out.explained_E_d, out.explained_E_b);
+        out.explained_wheelbase_m = r.wheelbase_m;
+        out.explained_diameter_left_m = r.wheel_diameter_left_m;
+        out.explained_diameter_right_m = r.wheel_diameter_right_m;
       }
     }
     out.explanation_stop = ex.stop_reason;
@@ -546,8 +549,7 @@ void ExplainGap(const CampaignData& c, const MeanModel& model, const BaselineFit
   // (Effect::DesignNote).
   effects::DesignFacts design = DesignFactsOf(c, base.p[kParamEb]);
   for (const Candidate& cd : out.candidates) {
-    const std::string name = sim::EffectToString(cd.effect);
-    if (std::find(out.verdict_effects.begin(), out.verdict_effects.end(), name) != out.verdict_effects.end()) continue;
+    if (Named(out, cd.effect)) continue;
     design.separable = cd.identifiable && !cd.weak;
     if (std::string n = effects::Of(cd.effect).DesignNote(design); !n.empty()) out.notes.push_back(std::move(n));
   }
